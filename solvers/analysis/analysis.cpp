@@ -1,0 +1,223 @@
+#include "analysis/analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+#include "common/granular_model.hpp"
+
+namespace shaker::analysis {
+namespace {
+
+/// Height where a field crosses `level` between bins i and j, linearly interpolated.
+double crossing(const Profile& p, std::size_t i, std::size_t j, double level) {
+  const double a = p.nu[i], b = p.nu[j];
+  const double s = (level - a) / (b - a);
+  return p.z[i] + s * (p.z[j] - p.z[i]);
+}
+
+bool in_layer(const Profile& p, std::size_t i) { return p.nu[i] > layer_volume_fraction; }
+
+double standard_error(const std::vector<double>& se, std::size_t i) {
+  return se.empty() ? 0.0 : se[i];
+}
+
+/// The smallest change of T between bins i and j that is not noise.
+double significant_change(const Profile& p, std::size_t i, std::size_t j, double fraction,
+                          double peak_temperature, const ShockCriteria& c) {
+  const double combined = std::hypot(standard_error(p.T_se, i), standard_error(p.T_se, j));
+  return std::max(fraction * peak_temperature, c.standard_errors * combined);
+}
+
+double interpolate(const std::vector<double>& z, const std::vector<double>& f, double at) {
+  const auto upper = std::upper_bound(z.begin(), z.end(), at);
+  if (upper == z.begin()) return f.front();
+  if (upper == z.end()) return f.back();
+  const auto j = static_cast<std::size_t>(upper - z.begin());
+  const double s = (at - z[j - 1]) / (z[j] - z[j - 1]);
+  return f[j - 1] + s * (f[j] - f[j - 1]);
+}
+
+}  // namespace
+
+std::optional<Layer> find_layer(const Profile& p) {
+  std::optional<std::size_t> first, last;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (in_layer(p, i)) {
+      if (!first) first = i;
+      last = i;
+    }
+  if (!first) return std::nullopt;
+  Layer layer;
+  layer.bottom = *first == 0 ? p.z[0] - 0.5 * p.bin_height
+                             : crossing(p, *first - 1, *first, layer_volume_fraction);
+  layer.top = *last + 1 == p.size() ? p.z[*last] + 0.5 * p.bin_height
+                                     : crossing(p, *last, *last + 1, layer_volume_fraction);
+  return layer;
+}
+
+double center_of_mass(const Profile& p) {
+  double mass = 0.0, moment = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    mass += p.n[i];
+    moment += p.n[i] * p.z[i];
+  }
+  return mass > 0.0 ? moment / mass : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<double> mach_number(const Profile& p, double e) {
+  std::vector<double> ma(p.size(), 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!(p.nu[i] > 0.0 && p.T[i] > 0.0)) continue;
+    ma[i] = std::abs(p.uz[i] - p.plate_v) / model::sound_speed(p.nu[i], p.T[i], e);
+  }
+  return ma;
+}
+
+double max_mach_in_layer(const Profile& p, double e) {
+  const auto ma = mach_number(p, e);
+  double best = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (in_layer(p, i)) best = std::max(best, ma[i]);
+  return best;
+}
+
+std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& c) {
+  // Walk up from the plate: the running temperature maximum inside the layer becomes the top
+  // of the compressed region once T has fallen significantly below it; the running minimum
+  // after it becomes the bottom of the undisturbed region once T has risen again.
+  std::optional<std::size_t> peak, trough;
+  std::size_t i = 0;
+  for (; i < p.size(); ++i) {
+    if (in_layer(p, i) && (!peak || p.T[i] > p.T[*peak])) peak = i;
+    if (peak && p.T[*peak] - p.T[i] > significant_change(p, *peak, i, c.relative_drop,
+                                                         p.T[*peak], c))
+      break;
+  }
+  if (!peak || i == p.size()) return std::nullopt;
+  trough = i;
+  for (; i < p.size(); ++i) {
+    if (p.T[i] < p.T[*trough]) trough = i;
+    if (p.T[i] - p.T[*trough] >
+        significant_change(p, *trough, i, c.relative_rise, p.T[*peak], c))
+      break;
+  }
+  if (i == p.size()) return std::nullopt;  // no undisturbed region above: no shock in the layer
+  // A shock compresses: the undisturbed material must be in the layer and less dense than
+  // the compressed material (this rejects the hot, dilute lower edge of a falling layer).
+  if (!in_layer(p, *trough) || p.nu[*trough] >= p.nu[*peak]) return std::nullopt;
+
+  std::size_t steepest = *peak;
+  for (std::size_t k = *peak; k < *trough; ++k)
+    if (p.T[k] - p.T[k + 1] > p.T[steepest] - p.T[steepest + 1]) steepest = k;
+  Shock shock;
+  shock.location = 0.5 * (p.z[steepest] + p.z[steepest + 1]);
+  shock.compressed_top = p.z[*peak];
+  shock.undisturbed_bottom = p.z[*trough];
+  shock.width = shock.undisturbed_bottom - shock.compressed_top;
+  shock.mean_free_path = model::mean_free_path(0.5 * (p.n[steepest] + p.n[steepest + 1]));
+  return shock;
+}
+
+PhaseSummary summarize(const Profile& p, double e) {
+  PhaseSummary s;
+  s.phase = p.phase;
+  s.plate_z = p.plate_z;
+  s.center_of_mass = center_of_mass(p);
+  s.max_mach = max_mach_in_layer(p, e);
+  s.layer = find_layer(p);
+  s.shock = find_shock(p);
+  return s;
+}
+
+std::optional<double> shock_speed(const std::vector<Profile>& profiles, const ShockCriteria& c) {
+  std::vector<double> t, h;
+  for (const auto& p : profiles) {
+    const auto shock = find_shock(p, c);
+    if (shock) {
+      t.push_back(p.time);
+      h.push_back(shock->location - p.plate_z);
+    } else if (!t.empty()) {
+      break;
+    }
+  }
+  if (t.size() < 2) return std::nullopt;
+  const double n = static_cast<double>(t.size());
+  const double tm = std::accumulate(t.begin(), t.end(), 0.0) / n;
+  const double hm = std::accumulate(h.begin(), h.end(), 0.0) / n;
+  double sth = 0.0, stt = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    sth += (t[k] - tm) * (h[k] - hm);
+    stt += (t[k] - tm) * (t[k] - tm);
+  }
+  return sth / stt;
+}
+
+SeriesDifference series_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) throw std::invalid_argument("series_difference: lengths differ");
+  SeriesDifference d;
+  double squared = 0.0, reference = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (std::isnan(a[k]) || std::isnan(b[k])) continue;
+    squared += (a[k] - b[k]) * (a[k] - b[k]);
+    reference += b[k] * b[k];
+    ++d.count;
+  }
+  if (d.count == 0) return d;
+  const double n = static_cast<double>(d.count);
+  d.absolute_rms = std::sqrt(squared / n);
+  d.fractional_rms = reference > 0.0 ? d.absolute_rms / std::sqrt(reference / n)
+                                     : std::numeric_limits<double>::quiet_NaN();
+  return d;
+}
+
+ProfileNorms profile_difference(const Profile& a, const Profile& b, const std::string& field) {
+  const auto member = field == "nu"  ? &Profile::nu
+                      : field == "T" ? &Profile::T
+                                     : throw std::invalid_argument("unknown field " + field);
+  ProfileNorms norms;
+  if (a.size() == 0 || b.size() == 0) return norms;
+  double sum = 0.0, squares = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a.z[i] < b.z.front() || a.z[i] > b.z.back()) continue;
+    const double d = std::abs((a.*member)[i] - interpolate(b.z, b.*member, a.z[i]));
+    sum += d;
+    squares += d * d;
+    norms.linf = std::max(norms.linf, d);
+    ++norms.count;
+  }
+  if (norms.count) {
+    norms.l1 = sum / static_cast<double>(norms.count);
+    norms.l2 = std::sqrt(squares / static_cast<double>(norms.count));
+  }
+  return norms;
+}
+
+RunComparison compare_runs(const RunRecord& a, const RunRecord& b) {
+  if (a.profiles.size() != b.profiles.size())
+    throw std::invalid_argument("compare: the runs store different numbers of phases");
+  RunComparison r;
+  std::vector<double> shock_a, shock_b, com_a, com_b;
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < a.profiles.size(); ++k) {
+    const Profile& pa = a.profiles[k];
+    const Profile& pb = b.profiles[k];
+    if (std::abs(pa.phase - pb.phase) > 1e-9)
+      throw std::invalid_argument("compare: the runs store different phases");
+    r.phases.push_back(pa.phase);
+    const auto sa = find_shock(pa), sb = find_shock(pb);
+    shock_a.push_back(sa ? sa->location : nan);
+    shock_b.push_back(sb ? sb->location : nan);
+    com_a.push_back(center_of_mass(pa));
+    com_b.push_back(center_of_mass(pb));
+    r.nu_norms.push_back(profile_difference(pa, pb, "nu"));
+    r.T_norms.push_back(profile_difference(pa, pb, "T"));
+  }
+  r.shock_location = series_difference(shock_a, shock_b);
+  r.center_of_mass = series_difference(com_a, com_b);
+  return r;
+}
+
+}  // namespace shaker::analysis

@@ -1,0 +1,86 @@
+#include "app/commands.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "analysis/analysis.hpp"
+#include "common/config.hpp"
+#include "common/run_file.hpp"
+#include "continuum/run_continuum.hpp"
+#include "md/run_md.hpp"
+
+namespace shaker {
+namespace {
+
+config::Config load(const RunOptions& options) {
+  return config::Config::load(options.config_file, options.overrides);
+}
+
+std::string optional_number(const std::optional<double>& x, int precision = 3) {
+  return x ? fmt::format("{:.{}f}", *x, precision) : std::string("-");
+}
+
+}  // namespace
+
+CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::string& help,
+                             RunOptions& options) {
+  auto* sub = app.add_subcommand(name, help);
+  sub->add_option("CONFIG", options.config_file, "case file (TOML)")->required();
+  sub->add_option("--set", options.overrides,
+                  "override a configuration key, e.g. --set material.e=0.8 (repeatable)")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  return sub;
+}
+
+int command_md(const RunOptions& options) { return md::run(load(options)); }
+int command_continuum(const RunOptions& options) { return continuum::run(load(options)); }
+
+int command_config(const RunOptions& options) {
+  fmt::print("{}", load(options).to_toml());
+  return 0;
+}
+
+int command_analyze(const std::string& run_file) {
+  const RunRecord run = read_run_file(run_file);
+  fmt::print("# {}: solver {}, {}, e = {}, program {} ({})\n", run_file, run.solver,
+             run.model_variant, run.e, run.program_version, run.git_commit);
+  fmt::print("{:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>7}\n", "phase", "plate_z",
+             "layer_lo", "layer_hi", "com", "shock_z", "width", "d/xi", "max_Ma");
+  for (const auto& p : run.profiles) {
+    const auto s = analysis::summarize(p, run.e);
+    fmt::print("{:7.4f} {:8.3f} {:>8} {:>8} {:8.3f} {:>8} {:>7} {:>7} {:7.2f}\n", s.phase,
+               s.plate_z, optional_number(s.layer ? std::optional(s.layer->bottom) : std::nullopt),
+               optional_number(s.layer ? std::optional(s.layer->top) : std::nullopt),
+               s.center_of_mass,
+               optional_number(s.shock ? std::optional(s.shock->location) : std::nullopt),
+               optional_number(s.shock ? std::optional(s.shock->width) : std::nullopt, 2),
+               optional_number(s.shock ? std::optional(s.shock->width_over_mfp()) : std::nullopt, 2),
+               s.max_mach);
+  }
+  fmt::print("# average shock speed (plate frame): {}\n",
+             optional_number(analysis::shock_speed(run.profiles)));
+  return 0;
+}
+
+int command_compare(const std::string& first, const std::string& second) {
+  const RunRecord a = read_run_file(first), b = read_run_file(second);
+  const auto r = analysis::compare_runs(a, b);
+  fmt::print("# A = {} ({}), B = {} ({}, reference)\n", first, a.solver, second, b.solver);
+  fmt::print("shock location: fractional RMS {:.4f}, absolute RMS {:.3f} sigma over {} phases\n",
+             r.shock_location.fractional_rms, r.shock_location.absolute_rms,
+             r.shock_location.count);
+  fmt::print("centre of mass: fractional RMS {:.4f}, absolute RMS {:.3f} sigma over {} phases\n",
+             r.center_of_mass.fractional_rms, r.center_of_mass.absolute_rms,
+             r.center_of_mass.count);
+  fmt::print("{:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "phase", "nu_L1", "nu_L2", "nu_max",
+             "T_L1", "T_L2", "T_max");
+  for (std::size_t k = 0; k < r.phases.size(); ++k)
+    fmt::print("{:7.4f} {:9.4f} {:9.4f} {:9.4f} {:9.4f} {:9.4f} {:9.4f}\n", r.phases[k],
+               r.nu_norms[k].l1, r.nu_norms[k].l2, r.nu_norms[k].linf, r.T_norms[k].l1,
+               r.T_norms[k].l2, r.T_norms[k].linf);
+  return 0;
+}
+
+}  // namespace shaker

@@ -1,0 +1,336 @@
+#include "common/config.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <toml.hpp>
+
+#include "common/errors.hpp"
+
+namespace shaker::config {
+
+// ---- Ranges and builders ----------------------------------------------------------------
+
+bool Range::contains(double x) const {
+  if (!std::isfinite(x)) return false;
+  const bool above = lo_open ? x > lo : x >= lo;
+  const bool below = hi_open ? x < hi : x <= hi;
+  return above && below;
+}
+
+std::string Range::describe() const {
+  const bool has_lo = lo > -1e307, has_hi = hi < 1e307;
+  std::string s;
+  if (has_lo) s += fmt::format("{} {} ", lo, lo_open ? "<" : "<=");
+  s += "value";
+  if (has_hi) s += fmt::format(" {} {}", hi_open ? "<" : "<=", hi);
+  return s;
+}
+
+Range closed(double lo, double hi) { return Range{lo, hi, false, false}; }
+Range positive(double hi) { return Range{0.0, hi, true, false}; }
+Range at_least(double lo, double hi) { return Range{lo, hi, false, false}; }
+
+ParameterSpec real(std::string key, double dflt, Range range, std::string meaning) {
+  return {std::move(key), Kind::real, dflt, range, {}, std::move(meaning)};
+}
+ParameterSpec integer(std::string key, std::int64_t dflt, Range range, std::string meaning) {
+  return {std::move(key), Kind::integer, dflt, range, {}, std::move(meaning)};
+}
+ParameterSpec boolean(std::string key, bool dflt, std::string meaning) {
+  return {std::move(key), Kind::boolean, dflt, {}, {}, std::move(meaning)};
+}
+ParameterSpec text(std::string key, std::string dflt, std::vector<std::string> choices,
+                   std::string meaning) {
+  return {std::move(key), Kind::text, std::move(dflt), {}, std::move(choices), std::move(meaning)};
+}
+ParameterSpec real_list(std::string key, std::vector<double> dflt, Range range,
+                        std::string meaning) {
+  return {std::move(key), Kind::real_list, std::move(dflt), range, {}, std::move(meaning)};
+}
+
+const std::vector<ParameterSpec>& schema() {
+  static const std::vector<ParameterSpec> all = [] {
+    std::vector<ParameterSpec> specs = common_parameters();
+    for (auto& part : {md_parameters(), continuum_parameters()})
+      specs.insert(specs.end(), part.begin(), part.end());
+    return specs;
+  }();
+  return all;
+}
+
+const ParameterSpec& find_spec(const std::string& key) {
+  const auto& specs = schema();
+  const auto it =
+      std::find_if(specs.begin(), specs.end(), [&](const auto& s) { return s.key == key; });
+  if (it == specs.end()) {
+    // Name the section's keys so that a typo is easy to fix.
+    const std::string section = key.substr(0, key.find('.'));
+    std::vector<std::string> known;
+    for (const auto& s : specs)
+      if (s.key.rfind(section + ".", 0) == 0) known.push_back(s.key);
+    throw InputError(fmt::format("unknown configuration key '{}'{}", key,
+                                 known.empty() ? std::string(" (no such section)")
+                                               : fmt::format(" (known in [{}]: {})", section,
+                                                             fmt::join(known, ", "))));
+  }
+  return *it;
+}
+
+// ---- Values -------------------------------------------------------------------------------
+
+namespace {
+
+std::string kind_name(Kind kind) {
+  switch (kind) {
+    case Kind::real: return "a real number";
+    case Kind::integer: return "an integer";
+    case Kind::boolean: return "true or false";
+    case Kind::text: return "a string";
+    case Kind::real_list: return "a list of real numbers";
+  }
+  return "?";
+}
+
+std::string format_real(double x) {
+  std::string s = fmt::format("{}", x);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";  // TOML floats need a dot
+  return s;
+}
+
+void check_range(const ParameterSpec& spec, double x, const std::string& shown) {
+  if (!spec.range.contains(x))
+    throw InputError(fmt::format("configuration key '{}' = {} is out of range (allowed: {})",
+                                 spec.key, shown, spec.range.describe()));
+}
+
+/// Checks a value against its spec and returns it in the spec's own type.
+Value validate(const ParameterSpec& spec, Value value) {
+  if (spec.kind == Kind::real && std::holds_alternative<std::int64_t>(value))
+    value = static_cast<double>(std::get<std::int64_t>(value));
+  const bool right_type = value.index() == spec.default_value.index();
+  if (!right_type)
+    throw InputError(fmt::format("configuration key '{}' = {} has the wrong type (expected {})",
+                                 spec.key, format_value(value), kind_name(spec.kind)));
+  switch (spec.kind) {
+    case Kind::real: check_range(spec, std::get<double>(value), format_value(value)); break;
+    case Kind::integer:
+      check_range(spec, static_cast<double>(std::get<std::int64_t>(value)), format_value(value));
+      break;
+    case Kind::real_list:
+      for (double x : std::get<std::vector<double>>(value)) check_range(spec, x, format_real(x));
+      break;
+    case Kind::text: {
+      const auto& s = std::get<std::string>(value);
+      if (!spec.choices.empty() &&
+          std::find(spec.choices.begin(), spec.choices.end(), s) == spec.choices.end())
+        throw InputError(fmt::format("configuration key '{}' = \"{}\" is not allowed (allowed: {})",
+                                     spec.key, s, fmt::join(spec.choices, ", ")));
+      break;
+    }
+    case Kind::boolean: break;
+  }
+  return value;
+}
+
+Value from_toml_value(const std::string& key, const toml::value& v) {
+  if (v.is_floating()) return v.as_floating();
+  if (v.is_integer()) return static_cast<std::int64_t>(v.as_integer());
+  if (v.is_boolean()) return v.as_boolean();
+  if (v.is_string()) return v.as_string().str;
+  if (v.is_array()) {
+    std::vector<double> xs;
+    for (const auto& x : v.as_array()) {
+      if (x.is_floating()) xs.push_back(x.as_floating());
+      else if (x.is_integer()) xs.push_back(static_cast<double>(x.as_integer()));
+      else
+        throw InputError(fmt::format(
+            "configuration key '{}' has the wrong type (expected a list of real numbers)", key));
+    }
+    return xs;
+  }
+  throw InputError(fmt::format("configuration key '{}' has an unsupported type", key));
+}
+
+/// Flattens nested tables to dotted keys.
+void flatten(const toml::value& table, const std::string& prefix,
+             std::vector<std::pair<std::string, toml::value>>& out) {
+  for (const auto& [name, v] : table.as_table()) {
+    const std::string key = prefix.empty() ? name : prefix + "." + name;
+    if (v.is_table()) flatten(v, key, out);
+    else out.emplace_back(key, v);
+  }
+}
+
+template <class T> bool parse_number(const std::string& s, T& out) {
+  const char* end = s.data() + s.size();
+  auto [ptr, ec] = std::from_chars(s.data(), end, out);
+  return ec == std::errc() && ptr == end;
+}
+
+Value parse_override(const ParameterSpec& spec, const std::string& raw) {
+  auto bad = [&] {
+    return InputError(fmt::format("--set {}={}: cannot read '{}' as {}", spec.key, raw, raw,
+                                  kind_name(spec.kind)));
+  };
+  switch (spec.kind) {
+    case Kind::real: {
+      double x;
+      if (!parse_number(raw, x)) throw bad();
+      return x;
+    }
+    case Kind::integer: {
+      std::int64_t x;
+      if (!parse_number(raw, x)) throw bad();
+      return x;
+    }
+    case Kind::boolean:
+      if (raw == "true") return true;
+      if (raw == "false") return false;
+      throw bad();
+    case Kind::text: return raw;
+    case Kind::real_list: {
+      std::string body = raw;
+      std::erase_if(body, [](char c) { return c == '[' || c == ']' || c == ' '; });
+      std::vector<double> xs;
+      std::stringstream ss(body);
+      for (std::string item; std::getline(ss, item, ',');) {
+        double x;
+        if (!parse_number(item, x)) throw bad();
+        xs.push_back(x);
+      }
+      return xs;
+    }
+  }
+  throw bad();
+}
+
+}  // namespace
+
+std::string format_value(const Value& value) {
+  return std::visit(
+      [](const auto& v) -> std::string {
+        using V = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<V, double>) return format_real(v);
+        else if constexpr (std::is_same_v<V, std::int64_t>) return fmt::format("{}", v);
+        else if constexpr (std::is_same_v<V, bool>) return v ? "true" : "false";
+        else if constexpr (std::is_same_v<V, std::string>) return fmt::format("\"{}\"", v);
+        else {
+          std::vector<std::string> items;
+          for (double x : v) items.push_back(format_real(x));
+          return fmt::format("[{}]", fmt::join(items, ", "));
+        }
+      },
+      value);
+}
+
+// ---- Config -------------------------------------------------------------------------------
+
+Config::Config() {
+  for (const auto& spec : schema()) values_[spec.key] = spec.default_value;
+}
+
+namespace {
+Config parse_document(std::istream& in, const std::string& origin) {
+  toml::value document;
+  try {
+    document = toml::parse(in, origin);
+  } catch (const std::exception& error) {
+    throw InputError(fmt::format("{}: not valid TOML:\n{}", origin, error.what()));
+  }
+  std::vector<std::pair<std::string, toml::value>> entries;
+  flatten(document, "", entries);
+  std::sort(entries.begin(), entries.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  Config config;
+  for (const auto& [key, v] : entries) {
+    try {
+      config.set_value(key, from_toml_value(key, v));
+    } catch (const InputError& error) {
+      throw InputError(fmt::format("{}: {}", origin, error.what()));
+    }
+  }
+  return config;
+}
+}  // namespace
+
+Config Config::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  Config config;
+  if (!file.empty()) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(fmt::format("cannot open configuration file '{}'", file.string()));
+    config = parse_document(in, file.string());
+  }
+  for (const auto& assignment : overrides) config.set(assignment);
+  return config;
+}
+
+Config Config::from_toml(const std::string& toml_text, const std::string& origin) {
+  std::istringstream in(toml_text);
+  return parse_document(in, origin);
+}
+
+void Config::set(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError(fmt::format("--set '{}': expected key=value", assignment));
+  const std::string key = assignment.substr(0, eq);
+  const auto& spec = find_spec(key);
+  values_[key] = validate(spec, parse_override(spec, assignment.substr(eq + 1)));
+}
+
+void Config::set_value(const std::string& key, const Value& value) {
+  values_[key] = validate(find_spec(key), value);
+}
+
+const Value& Config::get(const std::string& key, Kind kind) const {
+  const auto& spec = find_spec(key);
+  if (spec.kind != kind)
+    throw std::logic_error(fmt::format("configuration key '{}' read as the wrong type", key));
+  return values_.at(key);
+}
+
+double Config::real(const std::string& key) const { return std::get<double>(get(key, Kind::real)); }
+std::int64_t Config::integer(const std::string& key) const {
+  return std::get<std::int64_t>(get(key, Kind::integer));
+}
+bool Config::boolean(const std::string& key) const {
+  return std::get<bool>(get(key, Kind::boolean));
+}
+const std::string& Config::text(const std::string& key) const {
+  return std::get<std::string>(get(key, Kind::text));
+}
+const std::vector<double>& Config::real_list(const std::string& key) const {
+  return std::get<std::vector<double>>(get(key, Kind::real_list));
+}
+
+std::string Config::to_toml() const {
+  std::string out;
+  std::string section;
+  for (const auto& spec : schema()) {
+    const auto dot = spec.key.find('.');
+    const std::string this_section = spec.key.substr(0, dot);
+    if (this_section != section) {
+      out += fmt::format("{}[{}]\n", out.empty() ? "" : "\n", this_section);
+      section = this_section;
+    }
+    out += fmt::format("{} = {}\n", spec.key.substr(dot + 1), format_value(values_.at(spec.key)));
+  }
+  return out;
+}
+
+std::string Config::hash() const {
+  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a, 64 bit
+  for (unsigned char c : to_toml()) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+}  // namespace shaker::config

@@ -1,0 +1,88 @@
+#pragma once
+// Case configuration: one TOML file per case, every parameter declared once in a schema
+// (key, type, default, allowed range, meaning). Loading rejects unknown keys, wrong types and
+// out-of-range values with InputError naming the key, the value and the allowed range.
+// The effective configuration (defaults + file + --set overrides) serialises back to TOML and
+// is stored in every output file.
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace shaker::config {
+
+using Value = std::variant<double, std::int64_t, bool, std::string, std::vector<double>>;
+enum class Kind { real, integer, boolean, text, real_list };
+
+/// Allowed interval of a number; open or closed at each end.
+struct Range {
+  double lo = -1e308, hi = 1e308;
+  bool lo_open = false, hi_open = false;
+  bool contains(double x) const;
+  std::string describe() const;
+};
+Range closed(double lo, double hi);
+Range positive(double hi = 1e308);      ///< (0, hi]
+Range at_least(double lo, double hi = 1e308);
+
+struct ParameterSpec {
+  std::string key;  ///< "section.name"
+  Kind kind;
+  Value default_value;
+  Range range;                       ///< numbers and each element of a list
+  std::vector<std::string> choices;  ///< text: allowed values (empty: any text)
+  std::string meaning;               ///< units of physics.md and what it controls
+};
+
+// Builders keep the schema tables short and readable.
+ParameterSpec real(std::string key, double dflt, Range range, std::string meaning);
+ParameterSpec integer(std::string key, std::int64_t dflt, Range range, std::string meaning);
+ParameterSpec boolean(std::string key, bool dflt, std::string meaning);
+ParameterSpec text(std::string key, std::string dflt, std::vector<std::string> choices,
+                   std::string meaning);
+ParameterSpec real_list(std::string key, std::vector<double> dflt, Range range,
+                        std::string meaning);
+
+/// The whole schema: common keys, then the MD and continuum sections.
+const std::vector<ParameterSpec>& schema();
+// Each part of the schema is declared beside the code that reads it.
+std::vector<ParameterSpec> common_parameters();
+std::vector<ParameterSpec> md_parameters();
+std::vector<ParameterSpec> continuum_parameters();
+
+class Config {
+ public:
+  /// Defaults only.
+  Config();
+  /// Defaults, then the file (if non-empty path), then "key=value" overrides in order.
+  static Config load(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+  /// Parses a TOML document given as text (used for configurations stored in output files).
+  static Config from_toml(const std::string& toml_text, const std::string& origin);
+
+  /// Applies one "key=value" override (--set); throws InputError.
+  void set(const std::string& assignment);
+  void set_value(const std::string& key, const Value& value);
+
+  double real(const std::string& key) const;
+  std::int64_t integer(const std::string& key) const;
+  bool boolean(const std::string& key) const;
+  const std::string& text(const std::string& key) const;
+  const std::vector<double>& real_list(const std::string& key) const;
+
+  /// The full effective configuration as TOML, every key of the schema, in schema order.
+  std::string to_toml() const;
+  /// A short stable hash of to_toml(), for reusing finished runs.
+  std::string hash() const;
+
+ private:
+  const Value& get(const std::string& key, Kind kind) const;
+  std::map<std::string, Value> values_;
+};
+
+const ParameterSpec& find_spec(const std::string& key);  ///< throws InputError if unknown
+std::string format_value(const Value& value);           ///< TOML literal
+
+}  // namespace shaker::config

@@ -1,0 +1,78 @@
+#pragma once
+// A thin RAII layer over the HDF5 C API, and atomic output (write to a temporary file in the
+// same directory, rename on success, remove on failure).
+#include <hdf5.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace shaker::h5 {
+
+/// Owns one HDF5 identifier and closes it with the right H5?close.
+class Handle {
+ public:
+  Handle() = default;
+  explicit Handle(hid_t id);
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& other) noexcept;
+  Handle& operator=(Handle&& other) noexcept;
+  ~Handle();
+  hid_t id() const { return id_; }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+};
+
+Handle create_file(const std::filesystem::path& path);  ///< truncates
+Handle open_file(const std::filesystem::path& path);    ///< read only; InputError if not HDF5
+Handle create_group(hid_t parent, const std::string& name);
+Handle open_group(hid_t parent, const std::string& name);
+bool exists(hid_t parent, const std::string& name);
+std::vector<std::string> members(hid_t group);
+
+void write(hid_t parent, const std::string& name, const std::vector<double>& data);
+void write(hid_t parent, const std::string& name, const std::vector<std::int64_t>& data);
+/// Row-major matrix (rows x cols).
+void write(hid_t parent, const std::string& name, const std::vector<double>& data,
+           std::size_t rows, std::size_t cols);
+std::vector<double> read_doubles(hid_t parent, const std::string& name);
+std::vector<std::int64_t> read_integers(hid_t parent, const std::string& name);
+/// Dimensions of a dataset.
+std::vector<std::size_t> shape(hid_t parent, const std::string& name);
+
+void write_attribute(hid_t object, const std::string& name, const std::string& value);
+void write_attribute(hid_t object, const std::string& name, double value);
+void write_attribute(hid_t object, const std::string& name, std::int64_t value);
+std::string read_string_attribute(hid_t object, const std::string& name);
+double read_double_attribute(hid_t object, const std::string& name);
+std::int64_t read_integer_attribute(hid_t object, const std::string& name);
+bool has_attribute(hid_t object, const std::string& name);
+
+}  // namespace shaker::h5
+
+namespace shaker {
+
+/// A file written under a temporary name and renamed into place by commit(). If the object
+/// is destroyed without commit() (an exception, a bad input), the temporary file is removed
+/// and nothing exists under the final name.
+class AtomicOutput {
+ public:
+  explicit AtomicOutput(std::filesystem::path final_path);
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+  ~AtomicOutput();
+  const std::filesystem::path& temporary_path() const { return temporary_; }
+  void commit();
+
+ private:
+  std::filesystem::path final_, temporary_;
+  bool committed_ = false;
+};
+
+/// Writes a text file atomically.
+void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace shaker

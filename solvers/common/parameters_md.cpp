@@ -1,0 +1,27 @@
+// Keys of the MD solver (physics.md, "Molecular dynamics").
+#include "common/config.hpp"
+
+namespace shaker::config {
+
+std::vector<ParameterSpec> md_parameters() {
+  return {
+      real("md.box_width", 20.0, Range{1.0, 1e4, true, false},
+           "periodic box edge in x and y (units sigma); must exceed one diameter"),
+      real("md.ceiling", 200.0, positive(1e6),
+           "height of the fixed ceiling in the lab frame; must lie above the plate's top 2A + 1"),
+      real("md.bin_height", 1.0, positive(10.0), "height of the sampling bins"),
+      text("md.initial_state", "flat_layer", {"flat_layer", "gas", "checkpoint"},
+           "flat_layer: slightly randomised layer at rest on the plate; gas: homogeneous gas "
+           "at md.gas_volume_fraction and md.gas_temperature; checkpoint: md.checkpoint"),
+      real("md.gas_volume_fraction", 0.1, Range{0.0, 0.55, true, false},
+           "gas initial state: volume fraction"),
+      real("md.gas_temperature", 1.0, positive(1e6), "gas initial state: temperature"),
+      text("md.checkpoint", "", {}, "checkpoint file to start from (initial_state = checkpoint)"),
+      text("md.collapse_guard", "off", {"off", "tc"},
+           "off: stop with an error when inelastic collapse starts; tc: collisions within "
+           "md.tc of a particle's previous collision are elastic (TC model)"),
+      real("md.tc", 1e-5, positive(1.0), "TC model contact duration t_c"),
+  };
+}
+
+}  // namespace shaker::config

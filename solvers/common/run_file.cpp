@@ -1,0 +1,147 @@
+#include "common/run_file.hpp"
+
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <chrono>
+#include <sstream>
+
+#include "common/errors.hpp"
+#include "common/hdf5_file.hpp"
+#include "common/version.hpp"
+
+namespace shaker {
+namespace {
+
+using FieldOf = std::vector<double> Profile::*;
+struct FieldName {
+  const char* name;
+  FieldOf field;
+  bool optional;
+};
+// Per-phase fields stored as [phases x bins] matrices.
+constexpr FieldName profile_fields[] = {
+    {"z", &Profile::z, false},          {"n", &Profile::n, false},
+    {"nu", &Profile::nu, false},        {"uz", &Profile::uz, false},
+    {"T", &Profile::T, false},          {"samples", &Profile::samples, true},
+    {"n_se", &Profile::n_se, true},     {"uz_se", &Profile::uz_se, true},
+    {"T_se", &Profile::T_se, true},
+};
+using ScalarOf = double Profile::*;
+struct ScalarName {
+  const char* name;
+  ScalarOf field;
+};
+constexpr ScalarName profile_scalars[] = {{"time", &Profile::time},
+                                          {"phase", &Profile::phase},
+                                          {"plate_z", &Profile::plate_z},
+                                          {"plate_v", &Profile::plate_v},
+                                          {"bin_height", &Profile::bin_height}};
+
+std::string utc_now() {
+  return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::now()));
+}
+
+void write_profiles(hid_t file, const std::vector<Profile>& profiles) {
+  h5::Handle group = h5::create_group(file, "profiles");
+  const std::size_t phases = profiles.size();
+  const std::size_t bins = phases ? profiles.front().size() : 0;
+  for (const auto& p : profiles)
+    if (p.size() != bins) throw std::logic_error("profiles differ in their number of bins");
+  for (const auto& [name, field] : profile_scalars) {
+    std::vector<double> values;
+    for (const auto& p : profiles) values.push_back(p.*field);
+    h5::write(group.id(), name, values);
+  }
+  for (const auto& [name, field, optional] : profile_fields) {
+    const bool present = phases && !(profiles.front().*field).empty();
+    if (!present && optional) continue;
+    std::vector<double> matrix;
+    matrix.reserve(phases * bins);
+    for (const auto& p : profiles) {
+      const auto& column = p.*field;
+      if (column.size() != bins)
+        throw std::logic_error(fmt::format("profile field '{}' has the wrong length", name));
+      matrix.insert(matrix.end(), column.begin(), column.end());
+    }
+    h5::write(group.id(), name, matrix, phases, bins);
+  }
+}
+
+std::vector<Profile> read_profiles(hid_t file) {
+  h5::Handle group = h5::open_group(file, "profiles");
+  const auto phase = h5::read_doubles(group.id(), "phase");
+  std::vector<Profile> profiles(phase.size());
+  for (const auto& [name, field] : profile_scalars) {
+    const auto values = h5::read_doubles(group.id(), name);
+    if (values.size() != profiles.size())
+      throw InputError(fmt::format("profiles/{} has {} entries, expected {}", name, values.size(),
+                                   profiles.size()));
+    for (std::size_t k = 0; k < profiles.size(); ++k) profiles[k].*field = values[k];
+  }
+  for (const auto& [name, field, optional] : profile_fields) {
+    if (optional && !h5::exists(group.id(), name)) continue;
+    const auto dims = h5::shape(group.id(), name);
+    if (dims.size() != 2 || dims[0] != profiles.size())
+      throw InputError(fmt::format("profiles/{} is not a [phases x bins] matrix", name));
+    const auto values = h5::read_doubles(group.id(), name);
+    for (std::size_t k = 0; k < profiles.size(); ++k)
+      profiles[k].*field = std::vector<double>(values.begin() + static_cast<long>(k * dims[1]),
+                                               values.begin() + static_cast<long>((k + 1) * dims[1]));
+  }
+  return profiles;
+}
+
+}  // namespace
+
+void write_run_file(const std::filesystem::path& path, const RunRecord& record) {
+  AtomicOutput output(path);
+  {
+    h5::Handle file = h5::create_file(output.temporary_path());
+    h5::write_attribute(file.id(), "schema_version", std::int64_t{output_schema_version});
+    h5::write_attribute(file.id(), "program_version", std::string(program_version()));
+    h5::write_attribute(file.id(), "git_commit", std::string(git_commit()));
+    h5::write_attribute(file.id(), "created", utc_now());
+    h5::write_attribute(file.id(), "solver", record.solver);
+    h5::write_attribute(file.id(), "model_variant", record.model_variant);
+    h5::write_attribute(file.id(), "configuration", record.configuration);
+    h5::write_attribute(file.id(), "restitution_for_analysis", record.e);
+    write_profiles(file.id(), record.profiles);
+    h5::Handle series = h5::create_group(file.id(), "timeseries");
+    h5::write_attribute(series.id(), "columns", fmt::format("{}", fmt::join(record.series.names, ",")));
+    for (std::size_t i = 0; i < record.series.names.size(); ++i)
+      h5::write(series.id(), record.series.names[i], record.series.columns[i]);
+  }
+  output.commit();
+}
+
+RunRecord read_run_file(const std::filesystem::path& path) {
+  try {
+    h5::Handle file = h5::open_file(path);
+    RunRecord record;
+    record.schema_version = static_cast<int>(h5::read_integer_attribute(file.id(), "schema_version"));
+    if (record.schema_version != output_schema_version)
+      throw InputError(fmt::format("schema version {} is not supported (this program reads {})",
+                                   record.schema_version, output_schema_version));
+    record.program_version = h5::read_string_attribute(file.id(), "program_version");
+    record.git_commit = h5::read_string_attribute(file.id(), "git_commit");
+    record.created = h5::read_string_attribute(file.id(), "created");
+    record.solver = h5::read_string_attribute(file.id(), "solver");
+    record.model_variant = h5::read_string_attribute(file.id(), "model_variant");
+    record.configuration = h5::read_string_attribute(file.id(), "configuration");
+    record.e = h5::read_double_attribute(file.id(), "restitution_for_analysis");
+    record.profiles = read_profiles(file.id());
+    h5::Handle series = h5::open_group(file.id(), "timeseries");
+    std::stringstream names(h5::read_string_attribute(series.id(), "columns"));
+    for (std::string name; std::getline(names, name, ',');)
+      record.series.add(name, h5::read_doubles(series.id(), name));
+    return record;
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("run file '{}': {}", path.string(), error.what()));
+  } catch (const std::runtime_error& error) {
+    throw InputError(fmt::format("run file '{}' is unreadable: {}", path.string(), error.what()));
+  }
+}
+
+}  // namespace shaker
