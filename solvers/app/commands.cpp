@@ -6,6 +6,7 @@
 
 #include "analysis/analysis.hpp"
 #include "common/config.hpp"
+#include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
 #include "md/run_md.hpp"
@@ -42,25 +43,37 @@ int command_config(const RunOptions& options) {
   return 0;
 }
 
-int command_analyze(const std::string& run_file) {
+int command_analyze(const std::string& run_file, const std::string& csv_file) {
   const RunRecord run = read_run_file(run_file);
   fmt::print("# {}: solver {}, {}, e = {}, program {} ({})\n", run_file, run.solver,
              run.model_variant, run.e, run.program_version, run.git_commit);
   fmt::print("{:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>7}\n", "phase", "plate_z",
              "layer_lo", "layer_hi", "com", "shock_z", "width", "d/xi", "max_Ma");
+  std::string csv = "phase,time,plate_z,layer_bottom,layer_top,center_of_mass,shock_location,"
+                    "shock_width,width_over_mfp,max_mach\n";
+  auto field = [](bool present, double value) {
+    return present ? fmt::format("{}", value) : std::string("nan");
+  };
   for (const auto& p : run.profiles) {
     const auto s = analysis::summarize(p, run.e);
+    const auto layer = s.layer.value_or(analysis::Layer{});
+    const auto shock = s.shock.value_or(analysis::Shock{});
+    const bool l = s.layer.has_value(), k = s.shock.has_value();
     fmt::print("{:7.4f} {:8.3f} {:>8} {:>8} {:8.3f} {:>8} {:>7} {:>7} {:7.2f}\n", s.phase,
-               s.plate_z, optional_number(s.layer ? std::optional(s.layer->bottom) : std::nullopt),
-               optional_number(s.layer ? std::optional(s.layer->top) : std::nullopt),
-               s.center_of_mass,
-               optional_number(s.shock ? std::optional(s.shock->location) : std::nullopt),
-               optional_number(s.shock ? std::optional(s.shock->width) : std::nullopt, 2),
-               optional_number(s.shock ? std::optional(s.shock->width_over_mfp()) : std::nullopt, 2),
+               s.plate_z, optional_number(l ? std::optional(layer.bottom) : std::nullopt),
+               optional_number(l ? std::optional(layer.top) : std::nullopt), s.center_of_mass,
+               optional_number(k ? std::optional(shock.location) : std::nullopt),
+               optional_number(k ? std::optional(shock.width) : std::nullopt, 2),
+               optional_number(k ? std::optional(shock.width_over_mfp()) : std::nullopt, 2),
                s.max_mach);
+    csv += fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.phase, p.time, s.plate_z,
+                       field(l, layer.bottom), field(l, layer.top), s.center_of_mass,
+                       field(k, shock.location), field(k, shock.width),
+                       field(k, k ? shock.width_over_mfp() : 0.0), s.max_mach);
   }
-  fmt::print("# average shock speed (plate frame): {}\n",
-             optional_number(analysis::shock_speed(run.profiles)));
+  const auto speed = analysis::shock_speed(run.profiles);
+  fmt::print("# average shock speed (plate frame): {}\n", optional_number(speed));
+  if (!csv_file.empty()) write_text_atomically(csv_file, csv);
   return 0;
 }
 

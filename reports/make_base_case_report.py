@@ -1,0 +1,139 @@
+#!/usr/bin/python3
+"""Writes the base-case report (markdown + PNG plots) from the run files of ci/base-case.sh.
+
+Reads only files: <runs>/<solver>.h5 (the HDF5 run-file schema of docs/output-schema.md),
+<runs>/<solver>-analysis.csv (written by `shaker analyze --csv`, so the analysis is the
+project's one C++ implementation) and <runs>/<solver>.log (the solver's stdout summary).
+"""
+import argparse
+import datetime
+import os
+import platform
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+SOLVERS = ("md", "continuum")
+FIGURE_PHASES = (0.0, 0.15, 0.22, 0.40)  # the phases of the paper's Fig. 1
+
+
+def read_run(path):
+    with h5py.File(path, "r") as f:
+        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+        profiles = {k: np.array(f["profiles"][k]) for k in f["profiles"]}
+    return attrs, profiles
+
+
+def read_analysis(path):
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    return data
+
+
+def nearest(phases, target):
+    return int(np.argmin(np.abs(((phases - target + 0.5) % 1.0) - 0.5)))
+
+
+def plot_profiles(runs, out_dir):
+    fig, axes = plt.subplots(2, len(FIGURE_PHASES), figsize=(14, 7), sharey=True)
+    styles = {"md": dict(marker="o", ms=3, ls="none"), "continuum": dict(ls="-")}
+    for col, phase in enumerate(FIGURE_PHASES):
+        for solver, (attrs, prof) in runs.items():
+            k = nearest(prof["phase"], phase)
+            z = prof["z"][k] - prof["plate_z"][k]
+            axes[0, col].plot(prof["nu"][k], z, label=solver, **styles[solver])
+            axes[1, col].plot(prof["T"][k], z, label=solver, **styles[solver])
+        axes[0, col].set_title(f"f t = {phase:.2f}")
+        axes[0, col].set_xlabel("nu")
+        axes[1, col].set_xlabel("T")
+    for row in range(2):
+        axes[row, 0].set_ylabel("height above plate")
+        axes[row, 0].set_ylim(0, 40)
+    axes[0, 0].legend()
+    fig.tight_layout()
+    path = os.path.join(out_dir, "base-case-profiles.png")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return os.path.basename(path)
+
+
+def plot_trajectories(analyses, out_dir):
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for solver, a in analyses.items():
+        ax.plot(a["phase"], a["center_of_mass"], label=f"{solver} centre of mass")
+        ax.plot(a["phase"], a["shock_location"], "o", ms=3, label=f"{solver} shock")
+        ax.plot(a["phase"], a["plate_z"], "k:", lw=1)
+    ax.set_xlabel("f t")
+    ax.set_ylabel("height (lab frame)")
+    ax.legend()
+    fig.tight_layout()
+    path = os.path.join(out_dir, "base-case-trajectories.png")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return os.path.basename(path)
+
+
+def fmt(x, digits=3):
+    return "-" if not np.isfinite(x) else f"{x:.{digits}f}"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--runs", required=True)
+    parser.add_argument("--output", required=True)
+    parser.add_argument("--status", nargs="*", default=[],
+                        help="solver=ok:milliseconds or solver=unavailable:0")
+    args = parser.parse_args()
+
+    status = dict(s.split("=", 1) for s in args.status)
+    runs, analyses = {}, {}
+    for solver in SOLVERS:
+        h5 = os.path.join(args.runs, f"{solver}.h5")
+        if status.get(solver, "").startswith("ok") and os.path.exists(h5):
+            runs[solver] = read_run(h5)
+            analyses[solver] = read_analysis(os.path.join(args.runs, f"{solver}-analysis.csv"))
+
+    out_dir = os.path.dirname(os.path.abspath(args.output))
+    lines = ["# Base case: Gamma = 3, f = 0.095, e = 0.9, H = 9", ""]
+    commit = next((a["git_commit"] for a, _ in runs.values()), "no run")
+    lines += [f"- date: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M UTC}",
+              f"- machine: {platform.node()} ({platform.machine()}, {os.cpu_count()} cores)",
+              f"- commit: {commit}", ""]
+    lines += ["| solver | status | wall time (s) | model variant |", "| --- | --- | --- | --- |"]
+    for solver in SOLVERS:
+        state, _, ms = status.get(solver, "not run:0").partition(":")
+        variant = runs[solver][0].get("model_variant", "") if solver in runs else ""
+        shown = {"ok": "ran", "unavailable": "not implemented yet"}.get(state, state)
+        lines.append(f"| {solver} | {shown} | {int(ms) / 1000:.1f} | {variant} |")
+    lines.append("")
+    for solver in SOLVERS:
+        log = os.path.join(args.runs, f"{solver}.log")
+        if solver in runs and os.path.exists(log):
+            lines += [f"## {solver} run summary", "", "```", open(log).read().strip(), "```", ""]
+    if runs:
+        lines += ["## Profiles at the phases of the paper's Fig. 1", "",
+                  f"![nu and T]({plot_profiles(runs, out_dir)})", "",
+                  "## Centre of mass and shock location over a cycle", "",
+                  f"![trajectories]({plot_trajectories(analyses, out_dir)})", ""]
+        for solver, a in analyses.items():
+            lines += [f"## {solver}: analysis per phase (every fifth stored phase)", "",
+                      "| f t | plate | layer bottom | layer top | centre of mass | shock | d | d/xi | max Ma |",
+                      "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+            for row in a[::5]:
+                lines.append("| " + " | ".join(fmt(row[c]) for c in (
+                    "phase", "plate_z", "layer_bottom", "layer_top", "center_of_mass",
+                    "shock_location", "shock_width", "width_over_mfp", "max_mach")) + " |")
+            lines.append("")
+    else:
+        lines += ["No solver is available yet, so there is nothing to plot.", ""]
+    with open(args.output + ".partial", "w") as f:
+        f.write("\n".join(lines))
+    os.replace(args.output + ".partial", args.output)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
