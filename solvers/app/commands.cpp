@@ -77,7 +77,8 @@ int command_analyze(const std::string& run_file, const std::string& csv_file) {
   return 0;
 }
 
-int command_compare(const std::string& first, const std::string& second) {
+int command_compare(const std::string& first, const std::string& second,
+                    const std::string& csv_file) {
   const RunRecord a = read_run_file(first), b = read_run_file(second);
   const auto r = analysis::compare_runs(a, b);
   fmt::print("# A = {} ({}), B = {} ({}, reference)\n", first, a.solver, second, b.solver);
@@ -93,6 +94,28 @@ int command_compare(const std::string& first, const std::string& second) {
     fmt::print("{:7.4f} {:9.4f} {:9.4f} {:9.4f} {:9.4f} {:9.4f} {:9.4f}\n", r.phases[k],
                r.nu_norms[k].l1, r.nu_norms[k].l2, r.nu_norms[k].linf, r.T_norms[k].l1,
                r.T_norms[k].l2, r.T_norms[k].linf);
+  if (!csv_file.empty()) {
+    std::string csv = "metric,value\n";
+    auto row = [&](const char* name, double value) { csv += fmt::format("{},{}\n", name, value); };
+    row("shock_location_fractional_rms", r.shock_location.fractional_rms);
+    row("shock_location_absolute_rms", r.shock_location.absolute_rms);
+    row("shock_location_phases", static_cast<double>(r.shock_location.count));
+    row("center_of_mass_fractional_rms", r.center_of_mass.fractional_rms);
+    row("center_of_mass_absolute_rms", r.center_of_mass.absolute_rms);
+    row("center_of_mass_phases", static_cast<double>(r.center_of_mass.count));
+    double nu_l1 = 0.0, T_l1 = 0.0, nu_max = 0.0, T_max = 0.0;
+    for (std::size_t k = 0; k < r.phases.size(); ++k) {
+      nu_l1 += r.nu_norms[k].l1 / static_cast<double>(r.phases.size());
+      T_l1 += r.T_norms[k].l1 / static_cast<double>(r.phases.size());
+      nu_max = std::max(nu_max, r.nu_norms[k].linf);
+      T_max = std::max(T_max, r.T_norms[k].linf);
+    }
+    row("nu_l1_mean_over_phases", nu_l1);
+    row("nu_linf_max_over_phases", nu_max);
+    row("T_l1_mean_over_phases", T_l1);
+    row("T_linf_max_over_phases", T_max);
+    write_text_atomically(csv_file, csv);
+  }
   return 0;
 }
 

@@ -19,6 +19,7 @@ int command_md(const RunOptions& options);
 int command_continuum(const RunOptions& options);
 int command_config(const RunOptions& options);
 int command_analyze(const std::string& run_file, const std::string& csv_file);
-int command_compare(const std::string& first, const std::string& second);
+int command_compare(const std::string& first, const std::string& second,
+                    const std::string& csv_file);
 
 }  // namespace shaker

@@ -32,12 +32,13 @@ int main(int argc, char** argv) {
   analyze->add_option("RUN", run_file, "HDF5 run file")->required();
   analyze->add_option("--csv", analysis_csv, "also write the table as CSV to this file");
 
-  std::string first, second;
+  std::string first, second, compare_csv;
   auto* compare = app.add_subcommand(
       "compare", "Agreement metrics between two runs (physics.md): fractional RMS of shock "
                  "location and centre of mass, profile norms of nu and T");
   compare->add_option("A", first, "HDF5 run file")->required();
   compare->add_option("B", second, "HDF5 run file (the reference)")->required();
+  compare->add_option("--csv", compare_csv, "also write the metrics as metric,value CSV");
 
   try {
     app.parse(argc, argv);
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
     if (app.got_subcommand("config")) return command_config(show_config);
     if (app.got_subcommand("analyze")) return command_analyze(run_file, analysis_csv);
-    if (app.got_subcommand("compare")) return command_compare(first, second);
+    if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
   } catch (const InputError& error) {
     fmt::print(stderr, "shaker: error: {}\n", error.what());
     return 2;
