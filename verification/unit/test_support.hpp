@@ -1,0 +1,45 @@
+#pragma once
+// Helpers shared by the unit tests: a private temporary directory per test (so `ctest -j` is
+// safe) and relative comparison with the measured error in the failure message.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+namespace shaker::testing {
+
+/// A fresh directory named after the running test and the process; removed on destruction.
+class TemporaryDirectory {
+ public:
+  TemporaryDirectory() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string("shaker-unit-") + info->test_suite_name() + "-" + info->name() +
+                       "-" + std::to_string(::getpid());
+    for (char& c : name)
+      if (c == '/') c = '_';
+    path_ = std::filesystem::temp_directory_path() / name;
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  TemporaryDirectory(const TemporaryDirectory&) = delete;
+  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
+  ~TemporaryDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// |actual - expected| / |expected| (absolute difference when expected is zero).
+inline double relative_error(double actual, double expected) {
+  const double difference = std::abs(actual - expected);
+  return expected == 0.0 ? difference : difference / std::abs(expected);
+}
+
+}  // namespace shaker::testing
