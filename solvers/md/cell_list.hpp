@@ -1,0 +1,76 @@
+#pragma once
+// Cell list with cells of edge >= sigma: a particle can only meet particles in its own and
+// the 26 surrounding cells before it leaves its cell (the cell crossing is itself an event).
+// Doubly linked lists per cell keep insertion and removal O(1) without allocation.
+#include <cstdint>
+#include <vector>
+
+#include "md/geometry.hpp"
+#include "md/particles.hpp"
+
+namespace shaker::md {
+
+class CellList {
+ public:
+  /// Grid for the geometry; n particles, all unassigned. Throws InputError if the box is
+  /// narrower than three cells (the neighbour stencil would see a cell twice).
+  void build(const Geometry& geometry, std::size_t n);
+
+  int cell_of(const Vec3& r) const;
+  void insert(std::int32_t particle, int cell);
+  void remove(std::int32_t particle);
+  int cell(std::int32_t particle) const { return cell_[particle]; }
+
+  int nx() const { return nx_; }
+  int ny() const { return ny_; }
+  int nz() const { return nz_; }
+  int ix(int c) const { return c % nx_; }
+  int iy(int c) const { return (c / nx_) % ny_; }
+  int iz(int c) const { return c / (nx_ * ny_); }
+  int index(int x, int y, int z) const { return (z * ny_ + y) * nx_ + x; }
+  double edge_x() const { return ex_; }
+  double edge_y() const { return ey_; }
+  double edge_z() const { return ez_; }
+
+  /// Calls f(j, shift) for every particle j in the 27 cells around cell c; shift is the
+  /// periodic image offset to add to j's position.
+  template <class F> void for_each_neighbor(int c, F&& f) const;
+
+  // Raw lists, stored in checkpoints so that a restart visits neighbours in the same order.
+  std::vector<std::int32_t> head_, next_, prev_, cell_;
+
+ private:
+  int nx_ = 0, ny_ = 0, nz_ = 0;
+  double ex_ = 1.0, ey_ = 1.0, ez_ = 1.0;
+  double width_ = 0.0, height_ = 0.0;
+  bool periodic_z_ = false;
+};
+
+template <class F> void CellList::for_each_neighbor(int c, F&& f) const {
+  const int cx = ix(c), cy = iy(c), cz = iz(c);
+  for (int dz = -1; dz <= 1; ++dz) {
+    int z = cz + dz;
+    double sz = 0.0;
+    if (z < 0 || z >= nz_) {
+      if (!periodic_z_) continue;
+      sz = z < 0 ? -height_ : height_;
+      z = z < 0 ? z + nz_ : z - nz_;
+    }
+    for (int dy = -1; dy <= 1; ++dy) {
+      int y = cy + dy;
+      double sy = 0.0;
+      if (y < 0) { y += ny_; sy = -width_; }
+      else if (y >= ny_) { y -= ny_; sy = width_; }
+      for (int dx = -1; dx <= 1; ++dx) {
+        int x = cx + dx;
+        double sx = 0.0;
+        if (x < 0) { x += nx_; sx = -width_; }
+        else if (x >= nx_) { x -= nx_; sx = width_; }
+        const Vec3 shift{sx, sy, sz};
+        for (std::int32_t j = head_[index(x, y, z)]; j >= 0; j = next_[j]) f(j, shift);
+      }
+    }
+  }
+}
+
+}  // namespace shaker::md

@@ -1,0 +1,87 @@
+#pragma once
+// The future event list: one pending event per particle, keyed by its time (ties broken by
+// particle index, so the order of events is a total order and a restart replays it exactly).
+// IndexedHeap is an indexed binary heap, O(log N) per update.
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace shaker::md {
+
+class IndexedHeap {
+ public:
+  void reset(std::size_t n) {
+    heap_.clear();
+    position_.assign(n, -1);
+  }
+  bool empty() const { return heap_.empty(); }
+  std::int32_t top() const { return heap_.front().id; }
+  double top_time() const {
+    return heap_.empty() ? std::numeric_limits<double>::infinity() : heap_.front().time;
+  }
+  /// Inserts the particle or changes its key.
+  void update(std::int32_t id, double time) {
+    std::int32_t at = position_[id];
+    if (at < 0) {
+      at = static_cast<std::int32_t>(heap_.size());
+      heap_.push_back({time, id});
+      position_[id] = at;
+      sift_up(at);
+      return;
+    }
+    const bool earlier = less({time, id}, heap_[at]);
+    heap_[at].time = time;
+    if (earlier) sift_up(at);
+    else sift_down(at);
+  }
+  /// Checks the heap property and the index (for the end-of-run consistency check).
+  bool consistent() const {
+    for (std::size_t k = 0; k < heap_.size(); ++k) {
+      if (position_[heap_[k].id] != static_cast<std::int32_t>(k)) return false;
+      if (k > 0 && less(heap_[k], heap_[(k - 1) / 2])) return false;
+    }
+    return true;
+  }
+  std::size_t size() const { return heap_.size(); }
+  std::size_t bytes_per_entry() const { return sizeof(Entry) + sizeof(std::int32_t); }
+
+ private:
+  struct Entry {
+    double time;
+    std::int32_t id;
+  };
+  static bool less(const Entry& a, const Entry& b) {
+    return a.time < b.time || (a.time == b.time && a.id < b.id);
+  }
+  void place(std::int32_t at, const Entry& e) {
+    heap_[at] = e;
+    position_[e.id] = at;
+  }
+  void sift_up(std::int32_t at) {
+    const Entry e = heap_[at];
+    while (at > 0) {
+      const std::int32_t parent = (at - 1) / 2;
+      if (!less(e, heap_[parent])) break;
+      place(at, heap_[parent]);
+      at = parent;
+    }
+    place(at, e);
+  }
+  void sift_down(std::int32_t at) {
+    const Entry e = heap_[at];
+    const auto n = static_cast<std::int32_t>(heap_.size());
+    for (;;) {
+      std::int32_t child = 2 * at + 1;
+      if (child >= n) break;
+      if (child + 1 < n && less(heap_[child + 1], heap_[child])) ++child;
+      if (!less(heap_[child], e)) break;
+      place(at, heap_[child]);
+      at = child;
+    }
+    place(at, e);
+  }
+  std::vector<Entry> heap_;
+  std::vector<std::int32_t> position_;
+};
+
+}  // namespace shaker::md

@@ -1,0 +1,47 @@
+#pragma once
+// Particle state of the event-driven MD: free flight under gravity between events, each
+// particle carrying its own local time (it is only updated when it takes part in an event).
+#include <cstdint>
+#include <vector>
+
+namespace shaker::md {
+
+struct Vec3 {
+  double x = 0.0, y = 0.0, z = 0.0;
+  Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
+};
+inline Vec3 operator+(Vec3 a, const Vec3& b) { return a += b; }
+inline Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
+inline Vec3 operator*(double s, const Vec3& a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+/// One cache line per particle: what every prediction reads.
+struct alignas(64) Particle {
+  Vec3 r, v;
+  double t = 0.0;               ///< local time at which r and v are valid
+  double last_collision = -1e300;  ///< time of the last pair or wall collision (TC guard)
+};
+
+/// Position and velocity at time t >= p.t, without modifying p (gravity g along -z).
+inline void state_at(const Particle& p, double t, double g, Vec3& r, Vec3& v) {
+  const double dt = t - p.t;
+  r = {p.r.x + p.v.x * dt, p.r.y + p.v.y * dt, p.r.z + (p.v.z - 0.5 * g * dt) * dt};
+  v = {p.v.x, p.v.y, p.v.z - g * dt};
+}
+
+/// Brings p to time t.
+inline void advance(Particle& p, double t, double g) {
+  state_at(p, t, g, p.r, p.v);
+  p.t = t;
+}
+
+/// Everything needed to start or continue a run: positions, velocities and local times.
+/// The event-queue and cell-list parts are optional (a checkpoint stores them so that a
+/// restart continues bit for bit; a fresh state leaves them empty).
+struct State {
+  double time = 0.0;
+  std::vector<Particle> particles;
+};
+
+}  // namespace shaker::md

@@ -1,0 +1,285 @@
+#include "md/simulation.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace shaker::md {
+
+Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial)
+    : geometry_(geometry), rules_(rules) {
+  const std::size_t n = initial.particles.size();
+  data_.time = initial.time;
+  data_.particles = initial.particles;
+  data_.events.assign(n, Event{});
+  data_.counters.assign(n, 0);
+  data_.streaks.assign(n, 0);
+  cells_.build(geometry_, n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Particle& p = data_.particles[i];
+    advance(p, data_.time, geometry_.gravity);  // predictions assume p.t == now
+    cells_.insert(static_cast<std::int32_t>(i), cells_.cell_of(p.r));
+  }
+  queue_.reset(n);
+  for (std::size_t i = 0; i < n; ++i) predict(static_cast<std::int32_t>(i));
+}
+
+Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, SimulationData saved)
+    : geometry_(geometry), rules_(rules), data_(std::move(saved)) {
+  const std::size_t n = data_.particles.size();
+  cells_.build(geometry_, n);
+  cells_.head_ = std::move(data_.cell_head);
+  cells_.next_ = std::move(data_.cell_next);
+  cells_.prev_ = std::move(data_.cell_prev);
+  cells_.cell_ = std::move(data_.cell_of);
+  data_.cell_head.clear();
+  data_.cell_next.clear();
+  data_.cell_prev.clear();
+  data_.cell_of.clear();
+  queue_.reset(n);
+  for (std::size_t i = 0; i < n; ++i)
+    queue_.update(static_cast<std::int32_t>(i), data_.events[i].time);
+}
+
+SimulationData Simulation::save() const {
+  SimulationData copy = data_;
+  copy.cell_head = cells_.head_;
+  copy.cell_next = cells_.next_;
+  copy.cell_prev = cells_.prev_;
+  copy.cell_of = cells_.cell_;
+  return copy;
+}
+
+void Simulation::advance_to(double t) {
+  while (!queue_.empty() && queue_.top_time() <= t) step();
+  data_.time = t;
+}
+
+void Simulation::step() {
+  const std::int32_t i = queue_.top();
+  const Event event = data_.events[i];
+  data_.time = event.time;
+  const double now = data_.time, g = geometry_.gravity;
+  Particle& p = data_.particles[i];
+  advance(p, now, g);
+  Tally& tally = data_.tally;
+  switch (event.kind) {
+    case EventKind::pair: {
+      const std::int32_t j = event.partner;
+      if (data_.counters[j] != event.partner_counter) {
+        ++tally.stale;
+        break;
+      }
+      Particle& q = data_.particles[j];
+      advance(q, now, g);
+      Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
+      r.x -= geometry_.width * std::round(r.x / geometry_.width);
+      r.y -= geometry_.width * std::round(r.y / geometry_.width);
+      if (geometry_.periodic_z) r.z -= geometry_.height * std::round(r.z / geometry_.height);
+      const PairCollision c = collide_pair(p, q, r, now, rules_);
+      ++tally.pair;
+      if (c.happened) {
+        tally.pair_loss += c.loss;
+        tally.virial += c.virial;
+        tally.guard_activations += c.elastic_by_guard ? 1 : 0;
+        note_collision(i, j);
+        note_collision(j, i);
+      }
+      predict(j);
+      break;
+    }
+    case EventKind::plate:
+    case EventKind::ceiling: {
+      const bool plate = event.kind == EventKind::plate;
+      const WallCollision c = plate ? collide_wall(p, geometry_.plate.velocity(now), 1.0, now, rules_)
+                                    : collide_wall(p, 0.0, -1.0, now, rules_);
+      ++(plate ? tally.plate : tally.ceiling);
+      if (c.changed) {
+        tally.plate_work += c.work;
+        tally.wall_loss += c.loss;
+        tally.guard_activations += c.elastic_by_guard ? 1 : 0;
+        note_collision(i, -1);
+      } else {
+        ++tally.grazes;
+      }
+      break;
+    }
+    case EventKind::cell:
+      ++tally.cell;
+      cross_cell(i, event.partner);
+      break;
+  }
+  predict(i);
+}
+
+void Simulation::note_collision(std::int32_t i, std::int32_t partner) {
+  Particle& p = data_.particles[i];
+  ++data_.counters[i];
+  const double now = data_.time;
+  if (!rules_.tc_guard) {
+    if (now - p.last_collision < collapse_interval) {
+      if (++data_.streaks[i] >= collapse_streak) {
+        const std::string with = partner >= 0 ? fmt::format("particle {}", partner) : "a wall";
+        throw CollapseError(fmt::format(
+            "inelastic collapse at t = {:.9g}: particle {} (with {}) has had {} collisions in a "
+            "row less than {:g} apart (collision rate above {:.3g} per unit time); set "
+            "md.collapse_guard = \"tc\" or use a larger e",
+            now, i, with, data_.streaks[i], collapse_interval, 1.0 / collapse_interval));
+      }
+    } else {
+      data_.streaks[i] = 0;
+    }
+  }
+  p.last_collision = now;
+}
+
+double Simulation::cell_crossing_delay(const Particle& p, int c, std::int32_t& direction) const {
+  double best = never;
+  auto linear = [&](double u, double vu, double lo, double hi, std::int32_t axis) {
+    if (vu > 0.0) {
+      const double dt = std::max(hi - u, 0.0) / vu;
+      if (dt < best) { best = dt; direction = 2 * axis + 1; }
+    } else if (vu < 0.0) {
+      const double dt = std::max(u - lo, 0.0) / -vu;
+      if (dt < best) { best = dt; direction = 2 * axis; }
+    }
+  };
+  const double x0 = cells_.ix(c) * cells_.edge_x(), y0 = cells_.iy(c) * cells_.edge_y();
+  const double z0 = cells_.iz(c) * cells_.edge_z();
+  linear(p.r.x, p.v.x, x0, x0 + cells_.edge_x(), 0);
+  linear(p.r.y, p.v.y, y0, y0 + cells_.edge_y(), 1);
+  if (geometry_.periodic_z && geometry_.gravity == 0.0) {
+    linear(p.r.z, p.v.z, z0, z0 + cells_.edge_z(), 2);
+    return best;
+  }
+  // Vertical: the walls bound the outermost rows, and gravity bends the path back down.
+  const int iz = cells_.iz(c);
+  const bool wrap = geometry_.periodic_z;
+  const double up = (iz + 1 < cells_.nz() || wrap) ? rise_delay(p.r.z, p.v.z, geometry_.gravity, z0 + cells_.edge_z()) : never;
+  const double down = up == never && (iz > 0 || wrap) ? fall_delay(p.r.z, p.v.z, geometry_.gravity, z0) : never;
+  if (up < best) { best = up; direction = 5; }
+  if (down < best) { best = down; direction = 4; }
+  return best;
+}
+
+void Simulation::cross_cell(std::int32_t i, std::int32_t direction) {
+  Particle& p = data_.particles[i];
+  const int c = cells_.cell(i);
+  int x = cells_.ix(c), y = cells_.iy(c), z = cells_.iz(c);
+  const int step = (direction & 1) ? 1 : -1;
+  auto move = [&](int& index, int count, double& coordinate, double length) {
+    index += step;
+    if (index < 0) { index += count; coordinate += length; }
+    else if (index >= count) { index -= count; coordinate -= length; }
+  };
+  switch (direction / 2) {
+    case 0: move(x, cells_.nx(), p.r.x, geometry_.width); break;
+    case 1: move(y, cells_.ny(), p.r.y, geometry_.width); break;
+    default: move(z, cells_.nz(), p.r.z, geometry_.height); break;
+  }
+  cells_.remove(i);
+  cells_.insert(i, cells_.index(x, y, z));
+}
+
+void Simulation::predict(std::int32_t i) {
+  const Particle& p = data_.particles[i];
+  const double now = data_.time, g = geometry_.gravity;
+  const int c = cells_.cell(i);
+  Event event;
+  event.kind = EventKind::cell;
+  double best = cell_crossing_delay(p, c, event.partner);
+  cells_.for_each_neighbor(c, [&](std::int32_t j, const Vec3& shift) {
+    if (j == i) return;
+    Vec3 rj, vj;
+    state_at(data_.particles[j], now, g, rj, vj);
+    const double dt = pair_contact_delay(p.r - rj - shift, p.v - vj);
+    if (dt < best) {
+      best = dt;
+      event.kind = EventKind::pair;
+      event.partner = j;
+    }
+  });
+  if (event.kind == EventKind::pair) event.partner_counter = data_.counters[event.partner];
+  if (!geometry_.periodic_z) {
+    const int iz = cells_.iz(c);
+    if (iz == cells_.nz() - 1) {
+      const double dt = rise_delay(p.r.z, p.v.z, g, geometry_.height - 0.5);
+      if (dt < best) { best = dt; event.kind = EventKind::ceiling; }
+    }
+    // Only the rows the plate (and a particle on it) can reach need the plate search.
+    if (iz * cells_.edge_z() < geometry_.plate_top() + 0.5) {
+      const double t = plate_finder_.first_contact(p.r.z, p.v.z, now, now + best, geometry_);
+      if (t - now < best) { best = t - now; event.kind = EventKind::plate; }
+    }
+  }
+  event.time = now + best;
+  data_.events[i] = event;
+  queue_.update(i, event.time);
+}
+
+void Simulation::positions_at(double t, std::vector<Vec3>& r, std::vector<Vec3>& v) const {
+  const std::size_t n = data_.particles.size();
+  r.resize(n);
+  v.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    state_at(data_.particles[i], t, geometry_.gravity, r[i], v[i]);
+    r[i].x -= geometry_.width * std::floor(r[i].x / geometry_.width);
+    r[i].y -= geometry_.width * std::floor(r[i].y / geometry_.width);
+    if (geometry_.periodic_z) r[i].z -= geometry_.height * std::floor(r[i].z / geometry_.height);
+  }
+}
+
+double Simulation::kinetic_energy(double t) const {
+  double sum = 0.0;
+  Vec3 r, v;
+  for (const Particle& p : data_.particles) {
+    state_at(p, t, geometry_.gravity, r, v);
+    sum += 0.5 * dot(v, v);
+  }
+  return sum;
+}
+
+double Simulation::potential_energy(double t) const {
+  double sum = 0.0;
+  Vec3 r, v;
+  for (const Particle& p : data_.particles) {
+    state_at(p, t, geometry_.gravity, r, v);
+    sum += geometry_.gravity * r.z;
+  }
+  return sum;
+}
+
+std::size_t Simulation::count_overlaps(double t, double tolerance) const {
+  std::vector<Vec3> r, v;
+  positions_at(t, r, v);
+  const double limit = (1.0 - tolerance) * (1.0 - tolerance);
+  std::size_t overlaps = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const auto self = static_cast<std::int32_t>(i);
+    cells_.for_each_neighbor(cells_.cell(self), [&](std::int32_t j, const Vec3&) {
+      if (j <= self) return;
+      Vec3 d = r[i] - r[static_cast<std::size_t>(j)];
+      d.x -= geometry_.width * std::round(d.x / geometry_.width);
+      d.y -= geometry_.width * std::round(d.y / geometry_.width);
+      if (geometry_.periodic_z) d.z -= geometry_.height * std::round(d.z / geometry_.height);
+      if (dot(d, d) < limit) ++overlaps;
+    });
+  }
+  return overlaps;
+}
+
+bool Simulation::queue_consistent() const {
+  if (!queue_.consistent() || queue_.size() != data_.particles.size()) return false;
+  for (const Event& e : data_.events)
+    if (!(e.time >= data_.time) && e.time != never) return false;
+  return true;
+}
+
+std::size_t Simulation::bytes_per_particle() const {
+  const std::size_t n = std::max<std::size_t>(1, data_.particles.size());
+  const std::size_t per_particle = sizeof(Particle) + sizeof(Event) + 2 * sizeof(std::uint32_t) +
+                                   3 * sizeof(std::int32_t) + queue_.bytes_per_entry();
+  return per_particle + cells_.head_.size() * sizeof(std::int32_t) / n;
+}
+
+}  // namespace shaker::md

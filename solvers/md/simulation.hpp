@@ -1,0 +1,106 @@
+#pragma once
+// The event loop: pop the earliest pending event, bring the particles involved to its time,
+// apply the rule, predict their next events. Stale events are recognised lazily: a pair event
+// remembers the partner's collision counter at prediction time.
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "md/cell_list.hpp"
+#include "md/collision_rules.hpp"
+#include "md/event_prediction.hpp"
+#include "md/event_queue.hpp"
+#include "md/geometry.hpp"
+#include "md/particles.hpp"
+
+namespace shaker::md {
+
+enum class EventKind : std::uint8_t { pair, plate, ceiling, cell };
+
+struct Event {
+  double time = never;
+  std::int32_t partner = -1;         ///< pair: the other particle; cell: direction 0..5
+  std::uint32_t partner_counter = 0; ///< pair: partner's collision counter when predicted
+  EventKind kind = EventKind::cell;
+};
+
+/// Running totals of a run (all kept in checkpoints).
+struct Tally {
+  std::uint64_t pair = 0, plate = 0, ceiling = 0, cell = 0, stale = 0;
+  std::uint64_t guard_activations = 0, grazes = 0;
+  double plate_work = 0.0, pair_loss = 0.0, wall_loss = 0.0;
+  double virial = 0.0;  ///< sum of r_ab . (impulse on a) over pair collisions
+  std::uint64_t collisions() const { return pair + plate + ceiling; }
+};
+
+/// Everything that determines the future of a run: a checkpoint stores exactly this.
+struct SimulationData {
+  double time = 0.0;
+  std::vector<Particle> particles;
+  std::vector<Event> events;
+  std::vector<std::uint32_t> counters;  ///< collisions of each particle (invalidates events)
+  std::vector<std::uint32_t> streaks;   ///< consecutive very short collision intervals
+  std::vector<std::int32_t> cell_head, cell_next, cell_prev, cell_of;
+  Tally tally;
+};
+
+/// Collapse detector (guard off): a particle whose collisions follow each other within
+/// collapse_interval more than collapse_streak times in a row is taken to be collapsing.
+inline constexpr double collapse_interval = 1e-9;
+inline constexpr std::uint32_t collapse_streak = 100;
+
+/// Thrown when inelastic collapse starts and no guard is on (exit code 1, not bad input).
+class CollapseError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Simulation {
+ public:
+  /// A fresh run from particle states (cells and events are built here).
+  Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial);
+  /// A continued run: cells, events and counters exactly as saved.
+  Simulation(const Geometry& geometry, const CollisionRules& rules, SimulationData saved);
+
+  /// Processes every event with time <= t, then sets the clock to t.
+  void advance_to(double t);
+  /// Processes exactly one event (tests and benchmarks).
+  void step();
+
+  double time() const { return data_.time; }
+  const Geometry& geometry() const { return geometry_; }
+  const Tally& tally() const { return data_.tally; }
+  /// A copy of the complete state, cell lists included (for checkpoints).
+  SimulationData save() const;
+  const std::vector<Particle>& particles() const { return data_.particles; }
+  std::size_t size() const { return data_.particles.size(); }
+  void set_restitution(const Restitution& restitution) { rules_.restitution = restitution; }
+  const CollisionRules& rules() const { return rules_; }
+
+  /// Positions (wrapped into the box in x, y) and velocities of all particles at t >= time().
+  void positions_at(double t, std::vector<Vec3>& r, std::vector<Vec3>& v) const;
+  double kinetic_energy(double t) const;
+  double potential_energy(double t) const;  ///< g z in the lab frame
+  /// Pairs closer than 1 - tolerance at time t (cell-list search).
+  std::size_t count_overlaps(double t, double tolerance) const;
+  /// Heap property, index, and every pending event in the future of time().
+  bool queue_consistent() const;
+  std::size_t bytes_per_particle() const;
+
+ private:
+  void initialise_queue();
+  void predict(std::int32_t i);
+  double cell_crossing_delay(const Particle& p, int cell, std::int32_t& direction) const;
+  void cross_cell(std::int32_t i, std::int32_t direction);
+  void note_collision(std::int32_t i, std::int32_t partner);
+
+  Geometry geometry_;
+  CollisionRules rules_;
+  SimulationData data_;
+  CellList cells_;
+  IndexedHeap queue_;
+  PlateContactFinder plate_finder_;
+};
+
+}  // namespace shaker::md
