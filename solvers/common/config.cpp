@@ -97,6 +97,27 @@ std::string kind_name(Kind kind) {
   return "?";
 }
 
+/// A TOML basic string: quotes, backslashes and control characters escaped, so that any
+/// text (a Windows path, a name with quotes) reads back unchanged.
+std::string quote_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+          out += fmt::format("\\u{:04X}", static_cast<unsigned char>(c));
+        else
+          out += c;
+    }
+  }
+  return out + "\"";
+}
+
 std::string format_real(double x) {
   std::string s = fmt::format("{}", x);
   if (s.find_first_of(".eEn") == std::string::npos) s += ".0";  // TOML floats need a dot
@@ -219,7 +240,7 @@ std::string format_value(const Value& value) {
         if constexpr (std::is_same_v<V, double>) return format_real(v);
         else if constexpr (std::is_same_v<V, std::int64_t>) return fmt::format("{}", v);
         else if constexpr (std::is_same_v<V, bool>) return v ? "true" : "false";
-        else if constexpr (std::is_same_v<V, std::string>) return fmt::format("\"{}\"", v);
+        else if constexpr (std::is_same_v<V, std::string>) return quote_string(v);
         else {
           std::vector<std::string> items;
           for (double x : v) items.push_back(format_real(x));

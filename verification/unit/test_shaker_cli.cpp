@@ -1,0 +1,145 @@
+// The `shaker` program's handling of its command line and of bad input: help exits 0, a
+// missing argument or bad input exits 2 with a message naming the key, and nothing is written
+// under the output name. SHAKER_PROGRAM is $<TARGET_FILE:shaker>, passed in by CMake.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+
+namespace {
+
+struct Result {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+/// Runs `shaker ARGS` through the shell (arguments are single-quoted).
+Result run_shaker(const std::vector<std::string>& args) {
+  std::string command = std::string("'") + SHAKER_PROGRAM + "'";
+  for (const auto& a : args) command += " '" + a + "'";
+  command += " 2>&1";
+  Result r;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return r;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) r.output.append(buffer, n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+TEST(ShakerProgram, HelpExitsZeroForTheProgramAndEverySubcommand) {
+  const Result top = run_shaker({"--help"});
+  EXPECT_EQ(top.exit_code, 0) << top.output;
+  for (const char* sub : {"md", "continuum", "config", "analyze", "compare"})
+    EXPECT_NE(top.output.find(sub), std::string::npos) << "--help does not list " << sub;
+  for (const char* sub : {"md", "continuum", "config", "analyze", "compare"}) {
+    const Result r = run_shaker({sub, "--help"});
+    EXPECT_EQ(r.exit_code, 0) << sub << " --help: " << r.output;
+    EXPECT_FALSE(r.output.empty()) << sub;
+  }
+  for (const char* sub : {"md", "continuum", "config"})
+    EXPECT_NE(run_shaker({sub, "--help"}).output.find("--set"), std::string::npos) << sub;
+  EXPECT_EQ(run_shaker({"--version"}).exit_code, 0);
+}
+
+TEST(ShakerProgram, MissingArgumentsExitTwo) {
+  const std::vector<std::vector<std::string>> calls = {
+      {}, {"md"}, {"continuum"}, {"analyze"}, {"compare"}, {"compare", "only-one.h5"},
+      {"no-such-subcommand"}, {"config", "--set"}};
+  for (const auto& args : calls) {
+    const Result r = run_shaker(args);
+    std::string shown;
+    for (const auto& a : args) shown += a + " ";
+    EXPECT_EQ(r.exit_code, 2) << "shaker " << shown << "-> " << r.output;
+  }
+}
+
+struct BadCase {
+  const char* file_text;  // nullptr: the good file plus `override`
+  const char* override;   // --set argument or nullptr
+  const char* key;        // what the message must name
+};
+
+TEST(ShakerProgram, BadInputExitsTwoNamingTheKeyAndWritesNothing) {
+  const shaker::testing::TemporaryDirectory dir;
+  write_file(dir / "good.toml", "[shaker]\ngamma = 3.0\n");
+  const BadCase cases[] = {
+      {"[material]\nee = 0.8\n", nullptr, "material.ee"},           // unknown key
+      {"[materials]\ne = 0.8\n", nullptr, "materials.e"},           // unknown section
+      {"[shaker]\ngamma = \"3\"\n", nullptr, "shaker.gamma"},      // string for a number
+      {"[layer]\nparticles = 10.5\n", nullptr, "layer.particles"},  // float for an integer
+      {"[material]\ne = 1.5\n", nullptr, "material.e"},             // out of range
+      {"[layer]\nparticles = -3\n", nullptr, "layer.particles"},    // negative N
+      {"[shaker]\ngamma = -1.0\n", nullptr, "shaker.gamma"},        // Gamma < 0
+      {"[md]\nbox_width = 0.5\n", nullptr, "md.box_width"},         // narrower than a particle
+      {"[material]\nrestitution = \"elastic\"\n", nullptr, "material.restitution"},  // choice
+      {"[shaker\ngamma = 3.0\n", nullptr, "bad.toml"},              // malformed TOML
+      {nullptr, "shaker.gamma=abc", "shaker.gamma"},                // malformed --set value
+      {nullptr, "shaker.gamma", "shaker.gamma"},                    // --set without '='
+      {nullptr, "material.e=2", "material.e"},                      // --set out of range
+      {nullptr, "nosuch.key=1", "nosuch.key"},                      // --set unknown key
+  };
+  for (const char* sub : {"md", "continuum", "config"})
+    for (const auto& c : cases) {
+      const auto output = dir / "out.h5";
+      std::vector<std::string> args = {sub};
+      if (c.file_text) {
+        write_file(dir / "bad.toml", c.file_text);
+        args.push_back((dir / "bad.toml").string());
+      } else {
+        args.push_back((dir / "good.toml").string());
+        args.insert(args.end(), {"--set", c.override});
+      }
+      args.insert(args.end(), {"--set", "run.output=" + output.string()});
+      const Result r = run_shaker(args);
+      SCOPED_TRACE(std::string(sub) + " with " + (c.file_text ? c.file_text : c.override));
+      EXPECT_EQ(r.exit_code, 2) << r.output;
+      EXPECT_NE(r.output.find(c.key), std::string::npos)
+          << "the message does not name '" << c.key << "': " << r.output;
+      EXPECT_FALSE(std::filesystem::exists(output)) << "something was written under the output name";
+    }
+  // Every file in the directory is one the test wrote.
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_TRUE(entry.path().filename() == "good.toml" || entry.path().filename() == "bad.toml")
+        << "unexpected file " << entry.path();
+}
+
+TEST(ShakerProgram, MissingOrForeignFilesExitTwo) {
+  const shaker::testing::TemporaryDirectory dir;
+  write_file(dir / "not-hdf5.h5", "this is text, not HDF5\n");
+  const std::vector<std::vector<std::string>> calls = {
+      {"config", (dir / "missing.toml").string()},
+      {"md", (dir / "missing.toml").string()},
+      {"analyze", (dir / "missing.h5").string()},
+      {"analyze", (dir / "not-hdf5.h5").string()},
+      {"compare", (dir / "not-hdf5.h5").string(), (dir / "missing.h5").string()}};
+  for (const auto& args : calls) {
+    const Result r = run_shaker(args);
+    EXPECT_EQ(r.exit_code, 2) << args[0] << " " << args[1] << ": " << r.output;
+    EXPECT_NE(r.output.find(std::filesystem::path(args[1]).filename().string()), std::string::npos)
+        << "the message does not name the file: " << r.output;
+  }
+}
+
+TEST(ShakerProgram, ConfigPrintsTheEffectiveConfiguration) {
+  const shaker::testing::TemporaryDirectory dir;
+  write_file(dir / "case.toml", "[material]\ne = 0.8\n");
+  const Result r = run_shaker({"config", (dir / "case.toml").string(), "--set", "shaker.gamma=4.5"});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("e = 0.8\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("gamma = 4.5\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("particles = 3937\n"), std::string::npos) << r.output;
+}
+
+}  // namespace
