@@ -1,0 +1,226 @@
+#include "error_table.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/hdf5_file.hpp"
+
+namespace shaker::convergence {
+
+namespace {
+constexpr const char* errors_header = "study,field,norm,level,h,error";
+
+std::string checked_name(const std::string& name) {
+  if (name.empty() || name.find_first_of(",\"\n\r") != std::string::npos)
+    throw std::invalid_argument("CSV name must be non-empty without commas, quotes or line breaks: '" +
+                                name + "'");
+  return name;
+}
+
+std::string number(double x) { return fmt::format("{:.17g}", x); }
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream stream(line);
+  std::string cell;
+  while (std::getline(stream, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+double parse_number(const std::string& text, std::size_t line_number) {
+  try {
+    std::size_t used = 0;
+    const double x = std::stod(text, &used);
+    if (used != text.size()) throw std::invalid_argument(text);
+    return x;
+  } catch (const std::exception&) {
+    // stod rejects nothing it can read; NaN written by fmt is "nan", which stod accepts.
+    throw std::runtime_error(fmt::format("error table line {}: '{}' is not a number",
+                                         line_number, text));
+  }
+}
+
+bool within(double measured, double expected, double tolerance) {
+  return std::isfinite(measured) && std::abs(measured - expected) <= tolerance;
+}
+}  // namespace
+
+void ErrorTable::add(ErrorRow row) {
+  checked_name(row.study);
+  checked_name(row.field);
+  checked_name(row.norm);
+  rows_.push_back(std::move(row));
+}
+
+void ErrorTable::add_norms(const std::string& study, const std::string& field, int level,
+                           double h, const ErrorNorms& norms) {
+  add({study, field, "L1", level, h, norms.l1});
+  add({study, field, "L2", level, h, norms.l2});
+  add({study, field, "Linf", level, h, norms.linf});
+}
+
+std::vector<ErrorTable::Key> ErrorTable::series_keys() const {
+  std::vector<Key> keys;
+  for (const auto& row : rows_) {
+    const bool seen = std::any_of(keys.begin(), keys.end(), [&](const Key& k) {
+      return k.study == row.study && k.field == row.field && k.norm == row.norm;
+    });
+    if (!seen) keys.push_back({row.study, row.field, row.norm});
+  }
+  return keys;
+}
+
+std::vector<ErrorRow> ErrorTable::series(const Key& key) const {
+  std::vector<ErrorRow> out;
+  for (const auto& row : rows_)
+    if (row.study == key.study && row.field == key.field && row.norm == key.norm) out.push_back(row);
+  std::sort(out.begin(), out.end(), [](const ErrorRow& a, const ErrorRow& b) { return a.h > b.h; });
+  return out;
+}
+
+std::string ErrorTable::to_csv() const {
+  std::string text = std::string(errors_header) + "\n";
+  for (const auto& row : rows_)
+    text += fmt::format("{},{},{},{},{},{}\n", row.study, row.field, row.norm, row.level,
+                        number(row.h), number(row.error));
+  return text;
+}
+
+ErrorTable ErrorTable::from_csv(const std::string& text) {
+  std::stringstream stream(text);
+  std::string line;
+  if (!std::getline(stream, line) || line != errors_header)
+    throw std::runtime_error(std::string("error table: first line must be '") + errors_header +
+                             "'");
+  ErrorTable table;
+  std::size_t line_number = 1;
+  while (std::getline(stream, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    const auto cells = split(line);
+    if (cells.size() != 6)
+      throw std::runtime_error(
+          fmt::format("error table line {}: expected 6 columns, found {}", line_number, cells.size()));
+    ErrorRow row{cells[0], cells[1], cells[2], 0, parse_number(cells[4], line_number),
+                 parse_number(cells[5], line_number)};
+    row.level = static_cast<int>(parse_number(cells[3], line_number));
+    table.add(std::move(row));
+  }
+  return table;
+}
+
+void ErrorTable::write_csv(const std::filesystem::path& path) const {
+  write_text_atomically(path, to_csv());
+}
+
+ErrorTable ErrorTable::read_csv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open error table " + path.string());
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return from_csv(buffer.str());
+}
+
+bool OrderCheck::pass() const {
+  const bool next_ok = std::isnan(pair_order_next) && fit_points < 3
+                           ? true
+                           : within(pair_order_next, design_order, tolerance);
+  return within(fitted_order, design_order, tolerance) &&
+         within(pair_order_finest, design_order, tolerance) && next_ok;
+}
+
+std::vector<OrderCheck> check_orders(const ErrorTable& table, double design_order,
+                                     double tolerance, std::size_t fit_points) {
+  std::vector<OrderCheck> checks;
+  for (const auto& key : table.series_keys()) {
+    const auto rows = table.series(key);  // coarse to fine
+    if (rows.size() < 2)
+      throw std::invalid_argument("check_orders: series " + key.study + "/" + key.field + "/" +
+                                  key.norm + " has fewer than two levels");
+    std::vector<double> h, e;
+    for (const auto& row : rows) {
+      h.push_back(row.h);
+      e.push_back(row.error);
+    }
+    OrderCheck check{key.study, key.field, key.norm};
+    check.design_order = design_order;
+    check.tolerance = tolerance;
+    const std::size_t m = rows.size();
+    // A zero or negative error makes the order undefined: recorded as NaN, which fails.
+    const auto pair = [&](std::size_t coarse, std::size_t fine) {
+      if (!(e[coarse] > 0.0 && e[fine] > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+      return observed_order(e[coarse], e[fine], h[coarse] / h[fine]);
+    };
+    check.pair_order_finest = pair(m - 2, m - 1);
+    check.pair_order_next = m >= 3 ? pair(m - 3, m - 2) : std::numeric_limits<double>::quiet_NaN();
+    try {
+      const OrderFit fit = fit_order(h, e, fit_points);
+      check.fit_points = fit.points;
+      check.fitted_order = fit.order;
+      check.order_std_error = fit.order_std_error;
+    } catch (const std::invalid_argument&) {
+      check.fit_points = std::min(fit_points, m);
+      check.fitted_order = check.order_std_error = std::numeric_limits<double>::quiet_NaN();
+    }
+    checks.push_back(check);
+  }
+  return checks;
+}
+
+std::string orders_to_csv(std::span<const OrderCheck> checks) {
+  std::string text =
+      "study,field,norm,fit_points,fitted_order,order_std_error,pair_order_finest,"
+      "pair_order_next,design_order,tolerance,pass\n";
+  for (const auto& c : checks)
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", checked_name(c.study),
+                        checked_name(c.field), checked_name(c.norm), c.fit_points,
+                        number(c.fitted_order), number(c.order_std_error),
+                        number(c.pair_order_finest), number(c.pair_order_next),
+                        number(c.design_order), number(c.tolerance), c.pass() ? 1 : 0);
+  return text;
+}
+
+void write_orders_csv(const std::filesystem::path& path, std::span<const OrderCheck> checks) {
+  write_text_atomically(path, orders_to_csv(checks));
+}
+
+bool GciRow::pass() const {
+  return within(result.asymptotic_ratio, 1.0, asymptotic_tolerance);
+}
+
+GciRow make_gci_row(const std::string& study, const std::string& quantity, double h1, double h2,
+                    double h3, double phi1, double phi2, double phi3,
+                    double asymptotic_tolerance) {
+  return GciRow{study, quantity, h1, h2, h3, phi1, phi2, phi3,
+                three_grid_gci(h1, h2, h3, phi1, phi2, phi3), asymptotic_tolerance};
+}
+
+std::string gci_to_csv(std::span<const GciRow> rows) {
+  std::string text =
+      "study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,relative_difference21,"
+      "extrapolated_error21,gci21,gci32,asymptotic_ratio,convergence,asymptotic_tolerance,pass\n";
+  for (const auto& row : rows) {
+    const GciResult& r = row.result;
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                        checked_name(row.study), checked_name(row.quantity), number(row.h1),
+                        number(row.h2), number(row.h3), number(row.phi1), number(row.phi2),
+                        number(row.phi3), number(r.order), number(r.phi_extrapolated),
+                        number(r.relative_difference21), number(r.extrapolated_error21),
+                        number(r.gci21), number(r.gci32), number(r.asymptotic_ratio),
+                        to_string(r.kind), number(row.asymptotic_tolerance), row.pass() ? 1 : 0);
+  }
+  return text;
+}
+
+void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows) {
+  write_text_atomically(path, gci_to_csv(rows));
+}
+
+}  // namespace shaker::convergence

@@ -1,0 +1,92 @@
+#pragma once
+// Error tables and study summaries as small CSV files, the input of
+// reports/make_convergence_report.py (its docstring documents the same schema).
+//
+//   <name>.errors.csv  study,field,norm,level,h,error
+//   <name>.orders.csv  study,field,norm,fit_points,fitted_order,order_std_error,
+//                      pair_order_finest,pair_order_next,design_order,tolerance,pass
+//   <name>.gci.csv     study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,
+//                      relative_difference21,extrapolated_error21,gci21,gci32,
+//                      asymptotic_ratio,convergence,asymptotic_tolerance,pass
+//
+// Numbers are written with 17 significant digits (exact round trip); names may not contain
+// commas, quotes or line breaks. Files are written atomically (temp file + rename).
+#include <cstddef>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "convergence.hpp"
+
+namespace shaker::convergence {
+
+struct ErrorRow {
+  std::string study;  ///< e.g. "mms-1d-full-space"
+  std::string field;  ///< n, ux, uy, uz, T, ...
+  std::string norm;   ///< L1, L2, Linf
+  int level = 0;      ///< 0 = coarsest
+  double h = 0.0;     ///< grid spacing or time step
+  double error = 0.0;
+};
+
+class ErrorTable {
+ public:
+  void add(ErrorRow row);
+  /// The three norms of one field on one level.
+  void add_norms(const std::string& study, const std::string& field, int level, double h,
+                 const ErrorNorms& norms);
+  const std::vector<ErrorRow>& rows() const { return rows_; }
+
+  /// Distinct (study, field, norm) triples in first-appearance order.
+  struct Key {
+    std::string study, field, norm;
+  };
+  std::vector<Key> series_keys() const;
+  /// Rows of one series sorted from coarse to fine (decreasing h).
+  std::vector<ErrorRow> series(const Key& key) const;
+
+  std::string to_csv() const;
+  static ErrorTable from_csv(const std::string& text);  ///< throws std::runtime_error
+  void write_csv(const std::filesystem::path& path) const;
+  static ErrorTable read_csv(const std::filesystem::path& path);
+
+ private:
+  std::vector<ErrorRow> rows_;
+};
+
+/// Observed order of one series against its design order.
+struct OrderCheck {
+  std::string study, field, norm;
+  std::size_t fit_points = 0;
+  double fitted_order = 0.0;       ///< least-squares slope over the fit_points finest levels
+  double order_std_error = 0.0;
+  double pair_order_finest = 0.0;  ///< two-level order of the finest pair
+  double pair_order_next = 0.0;    ///< of the next pair (NaN with only two levels)
+  double design_order = 0.0;
+  double tolerance = 0.0;
+  /// Fitted and both pair orders within tolerance of the design order (NaN fails).
+  bool pass() const;
+};
+
+/// One OrderCheck per series of the table; each series needs at least two levels.
+std::vector<OrderCheck> check_orders(const ErrorTable& table, double design_order,
+                                     double tolerance, std::size_t fit_points = 3);
+std::string orders_to_csv(std::span<const OrderCheck> checks);
+void write_orders_csv(const std::filesystem::path& path, std::span<const OrderCheck> checks);
+
+/// A quantity of interest on three grids with its GCI analysis.
+struct GciRow {
+  std::string study, quantity;
+  double h1 = 0.0, h2 = 0.0, h3 = 0.0, phi1 = 0.0, phi2 = 0.0, phi3 = 0.0;
+  GciResult result;
+  double asymptotic_tolerance = 0.1;  ///< pass: |asymptotic_ratio - 1| <= tolerance
+  bool pass() const;
+};
+GciRow make_gci_row(const std::string& study, const std::string& quantity, double h1, double h2,
+                    double h3, double phi1, double phi2, double phi3,
+                    double asymptotic_tolerance = 0.1);
+std::string gci_to_csv(std::span<const GciRow> rows);
+void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows);
+
+}  // namespace shaker::convergence

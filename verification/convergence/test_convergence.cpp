@@ -1,0 +1,260 @@
+// Convergence arithmetic on inputs whose answers are known in closed form, and the GCI
+// worked example of Celik et al., J. Fluids Eng. 130 (2008) 078001, Table 1. The expected
+// GCI numbers were computed independently by celik_reference.py (bisection instead of the
+// fixed-point iteration used here); the paper's own rounded values are p = 1.53 and
+// phi_ext = 6.1685 for the monotonic column.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "common/units.hpp"
+#include "convergence.hpp"
+#include "error_table.hpp"
+
+namespace cv = shaker::convergence;
+
+namespace {
+std::vector<double> halving(double h0, int levels) {
+  std::vector<double> h;
+  for (int k = 0; k < levels; ++k) h.push_back(h0 / std::pow(2.0, k));
+  return h;
+}
+
+std::filesystem::path fresh_directory(const std::string& test_name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("shaker-convergence-" + test_name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
+}  // namespace
+
+TEST(ObservedOrder, RecoversExactPowerLaw) {
+  for (double p : {1.0, 2.0, 2.5, 4.0}) {
+    const double coarse = 3.7 * std::pow(0.1, p), fine = 3.7 * std::pow(0.05, p);
+    EXPECT_NEAR(cv::observed_order(coarse, fine, 2.0), p, 1e-10) << "p = " << p;
+  }
+}
+
+TEST(ObservedOrder, RejectsNonPositiveInput) {
+  EXPECT_THROW(cv::observed_order(0.0, 1.0, 2.0), std::invalid_argument);
+  EXPECT_THROW(cv::observed_order(1.0, 1.0, 1.0), std::invalid_argument);
+}
+
+TEST(FitOrder, ExactPowerLawGivesSlopeAndZeroScatter) {
+  const auto h = halving(0.2, 5);
+  std::vector<double> e;
+  for (double x : h) e.push_back(0.42 * x * x);
+  const cv::OrderFit fit = cv::fit_order(h, e, 3);
+  EXPECT_NEAR(fit.order, 2.0, 1e-10);
+  EXPECT_NEAR(fit.log_constant, std::log(0.42), 1e-9);
+  EXPECT_LT(fit.order_std_error, 1e-10);
+  EXPECT_EQ(fit.points, 3u);
+}
+
+TEST(FitOrder, UsesTheFinestLevelsWhateverTheirOrder) {
+  // Coarse levels off the power law must not affect a fit over the three finest.
+  std::vector<double> h{0.0125, 0.2, 0.025, 0.1, 0.05};
+  std::vector<double> e;
+  for (double x : h) e.push_back(x > 0.06 ? 1.0 : 5.0 * x * x * x);
+  EXPECT_NEAR(cv::fit_order(h, e, 3).order, 3.0, 1e-10);
+}
+
+TEST(FitOrder, HigherOrderTermGivesTheExpectedBias) {
+  // E = C h^2 (1 + D h): the pair order is 2 + ln((1 + D h_c)/(1 + D h_f)) / ln 2 exactly,
+  // and the least-squares slope lies between the pair orders it spans.
+  const double D = 0.5;
+  const auto h = halving(0.1, 4);
+  std::vector<double> e;
+  for (double x : h) e.push_back(2.0 * x * x * (1.0 + D * x));
+  for (std::size_t k = 0; k + 1 < h.size(); ++k) {
+    const double expected = 2.0 + std::log((1.0 + D * h[k]) / (1.0 + D * h[k + 1])) / std::log(2.0);
+    EXPECT_NEAR(cv::observed_order(e[k], e[k + 1], 2.0), expected, 1e-12);
+  }
+  const cv::OrderFit fit = cv::fit_order(h, e, 3);
+  const double finest_pair = cv::observed_order(e[2], e[3], 2.0);
+  const double next_pair = cv::observed_order(e[1], e[2], 2.0);
+  EXPECT_GT(fit.order, finest_pair);
+  EXPECT_LT(fit.order, next_pair);
+  EXPECT_NEAR(fit.order, 2.0, 0.03);  // the bias is D h / ln 2 ~ 0.018 at h = 0.025
+  EXPECT_GT(fit.order_std_error, 0.0);
+}
+
+TEST(FitOrder, NeedsTwoPointsAndPositiveErrors) {
+  const std::vector<double> h{0.1}, e{1.0};
+  EXPECT_THROW(cv::fit_order(h, e), std::invalid_argument);
+  const std::vector<double> h2{0.1, 0.05}, e2{1.0, 0.0};
+  EXPECT_THROW(cv::fit_order(h2, e2), std::invalid_argument);
+  const std::vector<double> e3{1.0, 0.25};
+  const cv::OrderFit two = cv::fit_order(h2, e3);
+  EXPECT_NEAR(two.order, 2.0, 1e-12);
+  EXPECT_TRUE(std::isnan(two.order_std_error));
+}
+
+TEST(Richardson, ExactForASinglePowerTerm) {
+  const auto phi = [](double h) { return 1.2345 + 0.7 * h * h; };
+  EXPECT_NEAR(cv::richardson_extrapolate(phi(0.05), phi(0.1), 2.0, 2.0), 1.2345, 1e-13);
+  const auto cubic = [](double h) { return -4.0 + 3.0 * h * h * h; };
+  EXPECT_NEAR(cv::richardson_extrapolate(cubic(0.1), cubic(0.15), 1.5, 3.0), -4.0, 1e-13);
+}
+
+TEST(Gci, CelikMonotonicExample) {
+  const double h1 = std::pow(18000.0, -0.5), h2 = std::pow(8000.0, -0.5),
+               h3 = std::pow(4500.0, -0.5);
+  const cv::GciResult g = cv::three_grid_gci(h1, h2, h3, 6.063, 5.972, 5.863);
+  EXPECT_EQ(g.kind, cv::ConvergenceKind::monotonic);
+  EXPECT_TRUE(g.order_converged);
+  EXPECT_NEAR(g.r21, 1.5, 1e-12);
+  EXPECT_NEAR(g.r32, 4.0 / 3.0, 1e-12);
+  EXPECT_LT(relative(g.order, 1.533969020628196), 1e-9);
+  EXPECT_LT(relative(g.phi_extrapolated, 6.168495572330159), 1e-9);
+  EXPECT_LT(relative(g.relative_difference21, 0.015009071416790254), 1e-12);
+  EXPECT_LT(relative(g.extrapolated_error21, 0.01710231791417311), 1e-8);
+  EXPECT_LT(relative(g.gci21, 0.021749870594210814), 1e-8);
+  EXPECT_LT(relative(g.gci32, 0.04112851061833544), 1e-8);
+  EXPECT_LT(relative(g.asymptotic_ratio, 1.01523777628935), 1e-8);
+  // The paper's rounded values.
+  EXPECT_NEAR(g.order, 1.53, 0.005);
+  EXPECT_NEAR(g.phi_extrapolated, 6.1685, 5e-5);
+}
+
+TEST(Gci, CelikOscillatoryExampleIsFlagged) {
+  const double h1 = std::pow(18000.0, -0.5), h2 = std::pow(4500.0, -0.5),
+               h3 = std::pow(980.0, -0.5);
+  const cv::GciResult g = cv::three_grid_gci(h1, h2, h3, 6.0042, 5.9624, 6.0909);
+  EXPECT_EQ(g.kind, cv::ConvergenceKind::oscillatory);
+  EXPECT_EQ(cv::to_string(g.kind), "oscillatory");
+  EXPECT_TRUE(g.order_converged);
+  EXPECT_LT(relative(g.order, 1.507691655935596), 1e-9);
+  EXPECT_LT(relative(g.phi_extrapolated, 6.026873682714785), 1e-9);
+  EXPECT_LT(relative(g.gci21, 0.004720379633170305), 1e-8);
+  EXPECT_LT(relative(g.asymptotic_ratio, 0.9312240836978866), 1e-8);
+}
+
+TEST(Gci, UniformRatioSecondOrderIsInTheAsymptoticRange) {
+  const auto phi = [](double h) { return 2.0 + 0.3 * h * h; };
+  const cv::GciResult g = cv::three_grid_gci(0.025, 0.05, 0.1, phi(0.025), phi(0.05), phi(0.1));
+  EXPECT_NEAR(g.order, 2.0, 1e-9);
+  EXPECT_NEAR(g.phi_extrapolated, 2.0, 1e-12);
+  // Relative differences divide by phi1 and phi2 respectively, so in the asymptotic range the
+  // ratio is phi1 / phi2 rather than exactly 1.
+  EXPECT_NEAR(g.asymptotic_ratio, phi(0.025) / phi(0.05), 1e-9);
+  EXPECT_LE(g.iterations, 2);
+  // GCI21 = 1.25 |phi1 - phi2| / |phi1| / (r^p - 1).
+  EXPECT_NEAR(g.gci21, 1.25 * std::abs(phi(0.025) - phi(0.05)) / phi(0.025) / 3.0, 1e-15);
+}
+
+TEST(Gci, StagnantAndBadOrderingAreReported) {
+  const cv::GciResult g = cv::three_grid_gci(0.1, 0.2, 0.4, 1.0, 1.0, 1.5);
+  EXPECT_EQ(g.kind, cv::ConvergenceKind::stagnant);
+  EXPECT_TRUE(std::isnan(g.order));
+  EXPECT_THROW(cv::three_grid_gci(0.2, 0.1, 0.4, 1.0, 1.1, 1.2), std::invalid_argument);
+}
+
+TEST(Gci, TwoGridsUseSafetyFactorThree) {
+  const cv::TwoGridGci g = cv::two_grid_gci(0.05, 0.1, 1.01, 1.04, 2.0);
+  EXPECT_NEAR(g.gci21, 3.0 * (0.03 / 1.01) / 3.0, 1e-15);
+  EXPECT_NEAR(g.phi_extrapolated, 1.0, 1e-13);
+}
+
+TEST(ErrorNorms, ConstantAndSineOffsets) {
+  const std::size_t n = 64;
+  std::vector<double> exact(n), shifted(n), wave(n);
+  double max_sin = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = (static_cast<double>(i) + 0.5) / static_cast<double>(n);
+    exact[i] = std::cos(3.0 * x);
+    shifted[i] = exact[i] - 0.25;
+    wave[i] = exact[i] + 1e-3 * std::sin(2.0 * shaker::pi * x);
+    max_sin = std::max(max_sin, std::abs(std::sin(2.0 * shaker::pi * x)));
+  }
+  const cv::ErrorNorms c = cv::error_norms(shifted, exact);
+  EXPECT_NEAR(c.l1, 0.25, 1e-15);
+  EXPECT_NEAR(c.l2, 0.25, 1e-15);
+  EXPECT_NEAR(c.linf, 0.25, 1e-15);
+  // Midpoint sums of sin^2 over whole periods are exactly N/2.
+  const cv::ErrorNorms w = cv::error_norms(wave, exact);
+  EXPECT_NEAR(w.l2, 1e-3 / std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(w.linf, 1e-3 * max_sin, 1e-15);
+  EXPECT_NEAR(w.l1, 2e-3 / shaker::pi, 1e-6);  // midpoint rule of |sin|, error O(1/N^2)
+  EXPECT_THROW(cv::error_norms(std::vector<double>(3), std::vector<double>(4)),
+               std::invalid_argument);
+}
+
+TEST(ErrorTable, RoundTripsThroughCsvExactly) {
+  const auto dir = fresh_directory("RoundTrip");
+  cv::ErrorTable table;
+  table.add({"mms-1d", "n", "L1", 0, 0.1, 1.0 / 3.0});
+  table.add({"mms-1d", "n", "L1", 1, 0.05, 1e-300});
+  table.add({"mms-1d", "uz", "Linf", 1, 0.05, std::numeric_limits<double>::quiet_NaN()});
+  table.add_norms("mms-1d", "T", 2, 0.025, {1.25e-7, 2.5e-7, std::nextafter(1.0, 2.0)});
+  const auto path = dir / "study.errors.csv";
+  table.write_csv(path);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir),
+                          std::filesystem::directory_iterator{}),
+            1);  // no temporary left behind
+  const cv::ErrorTable back = cv::ErrorTable::read_csv(path);
+  ASSERT_EQ(back.rows().size(), table.rows().size());
+  for (std::size_t k = 0; k < table.rows().size(); ++k) {
+    const auto& a = table.rows()[k];
+    const auto& b = back.rows()[k];
+    EXPECT_EQ(a.study, b.study);
+    EXPECT_EQ(a.field, b.field);
+    EXPECT_EQ(a.norm, b.norm);
+    EXPECT_EQ(a.level, b.level);
+    EXPECT_EQ(a.h, b.h);
+    if (std::isnan(a.error)) {
+      EXPECT_TRUE(std::isnan(b.error));
+    } else {
+      EXPECT_EQ(a.error, b.error);
+    }
+  }
+  EXPECT_EQ(back.to_csv(), table.to_csv());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ErrorTable, RejectsMalformedCsvAndNames) {
+  EXPECT_THROW(cv::ErrorTable::from_csv("study,field\n"), std::runtime_error);
+  EXPECT_THROW(cv::ErrorTable::from_csv("study,field,norm,level,h,error\na,b,L1,0,0.1\n"),
+               std::runtime_error);
+  EXPECT_THROW(cv::ErrorTable::from_csv("study,field,norm,level,h,error\na,b,L1,0,0.1,x1\n"),
+               std::runtime_error);
+  cv::ErrorTable table;
+  EXPECT_THROW(table.add({"a,b", "n", "L1", 0, 1.0, 1.0}), std::invalid_argument);
+}
+
+TEST(OrderChecks, PassAndFailAgainstTheBand) {
+  cv::ErrorTable table;
+  const auto h = halving(0.1, 4);
+  for (int k = 0; k < 4; ++k) {
+    const double x = h[static_cast<std::size_t>(k)];
+    table.add({"s", "n", "L2", k, x, 0.3 * x * x});
+    table.add({"s", "T", "L2", k, x, 0.3 * x});  // first order: fails a second-order band
+  }
+  const auto checks = cv::check_orders(table, 2.0, 0.1, 3);
+  ASSERT_EQ(checks.size(), 2u);
+  EXPECT_TRUE(checks[0].pass());
+  EXPECT_NEAR(checks[0].fitted_order, 2.0, 1e-10);
+  EXPECT_FALSE(checks[1].pass());
+  EXPECT_NEAR(checks[1].fitted_order, 1.0, 1e-10);
+  const std::string csv = cv::orders_to_csv(checks);
+  EXPECT_NE(csv.find("s,n,L2,3,"), std::string::npos);
+  EXPECT_NE(csv.find(",0\n"), std::string::npos);  // the failing row says so
+
+  const auto dir = fresh_directory("OrderChecks");
+  cv::write_orders_csv(dir / "s.orders.csv", checks);
+  const cv::GciRow row = cv::make_gci_row("s", "shock", 0.025, 0.05, 0.1, 1.0 + 0.025 * 0.025,
+                                          1.0 + 0.05 * 0.05, 1.0 + 0.1 * 0.1);
+  EXPECT_TRUE(row.pass());
+  const std::vector<cv::GciRow> rows{row};
+  cv::write_gci_csv(dir / "s.gci.csv", rows);
+  EXPECT_TRUE(std::filesystem::exists(dir / "s.gci.csv"));
+  EXPECT_NE(cv::gci_to_csv(rows).find(",monotonic,"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
