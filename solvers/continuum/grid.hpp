@@ -1,0 +1,42 @@
+#pragma once
+// Uniform finite-volume grid with two ghost layers. The same grid serves the 1D vertical
+// column (only z resolved, fields per unit plate area) and the 3D box (periodic x, y): the
+// dimension is a run-time parameter of every kernel, never a second copy of the solver.
+#include <cstddef>
+
+namespace shaker::continuum {
+
+enum class ZBoundary { walls, periodic };  ///< periodic z exists for manufactured solutions
+
+struct Grid {
+  static constexpr int ghosts = 2;  ///< enough for limited MUSCL reconstruction
+  int dimension = 1;                ///< 1 or 3
+  int nx = 1, ny = 1, nz = 1;       ///< interior cells per direction
+  double h = 0.1;                   ///< cell size, the same in every direction
+  ZBoundary z_boundary = ZBoundary::walls;
+
+  int ghosts_xy() const { return dimension == 3 ? ghosts : 0; }
+  std::ptrdiff_t stride_y() const { return nx + 2 * ghosts_xy(); }
+  std::ptrdiff_t stride_z() const { return stride_y() * (ny + 2 * ghosts_xy()); }
+  std::ptrdiff_t stride(int direction) const {
+    return direction == 0 ? 1 : direction == 1 ? stride_y() : stride_z();
+  }
+  std::size_t size() const { return static_cast<std::size_t>(stride_z() * (nz + 2 * ghosts)); }
+  std::size_t interior_cells() const { return static_cast<std::size_t>(nx) * ny * nz; }
+  /// Storage index of interior cell (i, j, k); ghosts have indices -ghosts .. n + ghosts - 1.
+  std::ptrdiff_t index(int i, int j, int k) const {
+    return (i + ghosts_xy()) + stride_y() * (j + ghosts_xy()) + stride_z() * (k + ghosts);
+  }
+  /// Directions that carry fluxes: z only in 1D, x, y and z in 3D.
+  int first_direction() const { return dimension == 3 ? 0 : 2; }
+  double center(int i) const { return (i + 0.5) * h; }
+  /// Volume of a cell; in 1D the column has unit cross section, so amounts are per unit area.
+  double cell_volume() const { return dimension == 3 ? h * h * h : h; }
+  double height() const { return nz * h; }
+};
+
+/// A grid of cell size h over [0, width]^2 x [0, height]; throws InputError naming the key
+/// when the cell size does not divide the box.
+Grid make_grid(int dimension, double width, double height, double h);
+
+}  // namespace shaker::continuum

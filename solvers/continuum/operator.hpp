@@ -1,0 +1,105 @@
+#pragma once
+// The right-hand side dU/dt = -div F(U) + S(U, t) of the Jenkins–Richman equations
+// (physics.md, "Continuum") on a Grid, callable on its own: every physical term can be
+// switched off and an external source per cell and time can be added (the manufactured-
+// solution harness needs both). Frame: the container's; walls at z = 0 and z = height.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "common/granular_model.hpp"
+#include "common/shaker_kinematics.hpp"
+#include "continuum/grid.hpp"
+#include "continuum/state.hpp"
+
+namespace shaker::continuum {
+
+enum class EquationOfState { granular, ideal_gas };  ///< ideal_gas: p = n T, gamma = 5/3
+enum class Limiter { minmod, mc, van_leer };
+enum class RiemannSolver { hllc, hll };              ///< hll is the simple reference
+
+/// Which terms enter the operator. `advection` is the whole inviscid (Riemann) flux;
+/// `pressure` = false makes that flux pressureless.
+struct Terms {
+  bool advection = true, pressure = true;
+  bool shear_viscosity = true, bulk_viscosity = true, conduction = true;
+  bool collisional_loss = true, gravity = true, frame_force = true;
+  bool artificial_dissipation = true;  ///< only with paper transport
+};
+
+/// Artificial dissipation of the `paper` variant, confined to low density:
+///   mu_art = viscosity * n h c s(nu),  kappa_art = conductivity * n h c s(nu),
+///   s(nu) = 1 / (1 + (nu / volume_fraction)^4),
+/// c the local sound speed, h the cell size. It vanishes like h with refinement and is
+/// negligible where nu >> volume_fraction (the layer and the shock).
+struct ArtificialDissipation {
+  double viscosity = 0.5;
+  double conductivity = 0.5;
+  double volume_fraction = 0.01;
+};
+
+struct PhysicsSettings {
+  EquationOfState eos = EquationOfState::granular;
+  double e = 0.9;  ///< the continuum's restitution coefficient
+  model::Transport transport = model::Transport::paper;
+  ArtificialDissipation artificial;
+  Limiter limiter = Limiter::mc;
+  RiemannSolver riemann = RiemannSolver::hllc;
+  Terms terms;
+  ShakerKinematics shaker{3.0, 0.095};
+};
+
+/// Optional source added per cell: (t, x, y, z, out[variable_count]) adds to out.
+/// In 1D x = y = 0. Used by the manufactured-solution harness.
+using ExternalSource = std::function<void(double, double, double, double, double*)>;
+
+/// What the operator evaluates: everything, or the parts an operator split separates.
+enum class Part { all, hyperbolic_and_sources, diffusive };
+
+class Operator {
+ public:
+  Operator(const Grid& grid, const PhysicsSettings& settings);
+
+  /// dUdt = L(U, t). Fills U's ghost cells first (so U is not const). Throws DomainError
+  /// (constitutive function outside its domain) on a broken state.
+  void rhs(double t, State& U, State& dUdt, Part part = Part::all);
+
+  /// Largest stable explicit steps at the last evaluated state (call after rhs):
+  /// advective cfl * h / max(sum_d |u_d| + c), and FE diffusive h^2 / (2 dim D_max).
+  double advective_step(double cfl) const;
+  double diffusive_step() const;
+
+  void fill_ghosts(State& U) const;  ///< walls (mirror) or periodic, x, y periodic
+  /// Gravity plus frame force per unit mass at time t (z component).
+  double body_force(double t) const;
+
+  const Grid& grid() const { return grid_; }
+  PhysicsSettings& settings() { return settings_; }
+  const PhysicsSettings& settings() const { return settings_; }
+  ExternalSource external_source;  ///< empty: none
+
+  // Closure of the last evaluation, per cell (ghosts included).
+  struct Closure {
+    std::vector<double> p, c, chi, mu, lambda, kappa;  ///< chi = p / (n T)
+  };
+  const Closure& closure() const { return closure_; }
+  const std::array<std::vector<double>, variable_count>& primitives() const { return w_; }
+
+ private:
+  void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp
+  void add_inviscid_fluxes(State& dUdt);                                     // riemann.cpp
+  void add_diffusive_fluxes(State& dUdt);                                    // viscous_flux.cpp
+  void add_sources(double t, const State& U, State& dUdt);                   // sources.cpp
+
+  Grid grid_;
+  PhysicsSettings settings_;
+  std::array<std::vector<double>, variable_count> w_;  ///< n, ux, uy, uz, T
+  Closure closure_;
+  bool transport_evaluated_ = false;
+};
+
+Limiter limiter_from_string(const std::string& name);          ///< throws InputError
+RiemannSolver riemann_from_string(const std::string& name);    ///< throws InputError
+
+}  // namespace shaker::continuum

@@ -1,0 +1,40 @@
+// Volume sources: gravity and the frame force of the oscillating container (body force per
+// unit mass -g (1 + Gamma cos(omega t)) in z), the collisional energy loss gamma of the
+// model, and the optional external (manufactured) source.
+#include "continuum/operator.hpp"
+
+namespace shaker::continuum {
+
+double Operator::body_force(double t) const {
+  double g = 0.0;
+  if (settings_.terms.gravity) g -= gravity;
+  if (settings_.terms.frame_force) g -= settings_.shaker.acceleration(t);
+  return g;
+}
+
+void Operator::add_sources(double t, const State& U, State& dUdt) {
+  const Grid& g = grid_;
+  const double force = body_force(t);
+  const bool loss = settings_.terms.collisional_loss;
+  const double e = settings_.e;
+  const bool external = static_cast<bool>(external_source);
+  // The external source is a user callback: it stays serial.
+#pragma omp parallel for schedule(static) if (g.nz > 1 && g.interior_cells() > 4096 && !external)
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const std::ptrdiff_t c = g.index(i, j, k);
+        dUdt.q[momentum_z][c] += U.q[density][c] * force;
+        dUdt.q[energy][c] += U.q[momentum_z][c] * force;
+        if (loss) dUdt.q[energy][c] -= model::collisional_loss(w_[0][c], w_[4][c], e);
+        if (external) {
+          double extra[variable_count] = {0, 0, 0, 0, 0};
+          const double x = g.dimension == 3 ? g.center(i) : 0.0;
+          const double y = g.dimension == 3 ? g.center(j) : 0.0;
+          external_source(t, x, y, g.center(k), extra);
+          for (int v = 0; v < variable_count; ++v) dUdt.q[v][c] += extra[v];
+        }
+      }
+}
+
+}  // namespace shaker::continuum

@@ -1,0 +1,177 @@
+#include "continuum/time_integrator.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace shaker::continuum {
+
+TimeIntegrator::TimeIntegrator(const Grid& grid, const PhysicsSettings& physics,
+                               const IntegratorSettings& settings)
+    : op_(grid, physics), settings_(settings) {
+  for (State* s : {&U_, &U0_, &U1_, &U2_, &K_, &K0_, &start_}) s->resize(grid.size());
+}
+
+void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y,
+                          double c, const State& k) const {
+  const Grid& g = op_.grid();
+#pragma omp parallel for schedule(static) if (g.interior_cells() > 4096)
+  for (int kz = 0; kz < g.nz; ++kz)
+    for (int j = 0; j < g.ny; ++j) {
+      const std::ptrdiff_t first = g.index(0, j, kz);
+      for (int v = 0; v < variable_count; ++v) {
+        const double* X = x.q[v].data() + first;
+        const double* Y = y.q[v].data() + first;
+        const double* Kv = k.q[v].data() + first;
+        double* O = out.q[v].data() + first;
+        for (int i = 0; i < g.nx; ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
+      }
+    }
+}
+
+bool TimeIntegrator::admissible(State& s, double t, std::string& failure) {
+  const Grid& g = op_.grid();
+  const double floor = settings_.temperature_floor;
+  std::int64_t floors = 0;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const std::ptrdiff_t c = g.index(i, j, k);
+        const double n = s.q[density][c];
+        bool finite = std::isfinite(n) && std::isfinite(s.q[energy][c]);
+        for (int v = momentum_x; v <= momentum_z; ++v) finite = finite && std::isfinite(s.q[v][c]);
+        if (!finite || !(n > 0.0) || !(volume_fraction(n) < nu_max)) {
+          failure = fmt::format("t = {:.10g}, cell (i, j, k) = ({}, {}, {}) at z = {:.6g}: n = {:.6g}, "
+                                "E = {:.6g} (need 0 < nu < nu_max and finite values)",
+                                t, i, j, k, g.center(k), n, s.q[energy][c]);
+          return false;
+        }
+        const double kinetic = 0.5 * (s.q[momentum_x][c] * s.q[momentum_x][c] +
+                                      s.q[momentum_y][c] * s.q[momentum_y][c] +
+                                      s.q[momentum_z][c] * s.q[momentum_z][c]) / n;
+        if (s.q[energy][c] - kinetic < 1.5 * n * floor) {
+          s.q[energy][c] = kinetic + 1.5 * n * floor;
+          ++floors;
+        }
+      }
+  counters_.temperature_floor_uses += floors;
+  return true;
+}
+
+double TimeIntegrator::choose_step(double t_limit) {
+  double dt = settings_.fixed_dt;
+  if (dt <= 0.0) {
+    dt = op_.advective_step(settings_.cfl);
+    if (settings_.diffusion == DiffusionIntegrator::explicit_rk)
+      dt = std::min(dt, settings_.diffusion_number * op_.diffusive_step());
+  }
+  if (!(dt > 0.0) || !std::isfinite(dt)) dt = t_limit - t_;
+  return std::min(dt, t_limit - t_);
+}
+
+bool TimeIntegrator::ssp_runge_kutta(double dt, Part part, std::string& failure) {
+  // U0_ holds the state at t_, K0_ its right-hand side (already evaluated).
+  axpy(U1_, 1.0, U0_, 0.0, U0_, dt, K0_);
+  if (!admissible(U1_, t_ + dt, failure)) return false;
+  op_.rhs(t_ + dt, U1_, K_, part);
+  if (settings_.order == 2) {
+    axpy(U_, 0.5, U0_, 0.5, U1_, 0.5 * dt, K_);
+    return admissible(U_, t_ + dt, failure);
+  }
+  axpy(U2_, 0.75, U0_, 0.25, U1_, 0.25 * dt, K_);
+  if (!admissible(U2_, t_ + 0.5 * dt, failure)) return false;
+  op_.rhs(t_ + 0.5 * dt, U2_, K_, part);
+  axpy(U_, 1.0 / 3.0, U0_, 2.0 / 3.0, U2_, 2.0 / 3.0 * dt, K_);
+  return admissible(U_, t_ + dt, failure);
+}
+
+// RKL2 over dt for the diffusive part, from U_ into U_ (U0_ keeps the step's start state).
+bool TimeIntegrator::rkl2(double dt, std::string& failure) {
+  State Y0 = U_;  // the stage recursion needs Y0, Y_{j-1}, Y_{j-2} and M0 = L(Y0)
+  State M0(Y0);
+  op_.rhs(t_, Y0, M0, Part::diffusive);
+  const double dt_fe = op_.diffusive_step();
+  if (!std::isfinite(dt_fe)) return true;
+  // Stability of s stages: dt <= dt_fe (s^2 + s - 2) / 4 (with the safety factor).
+  const double needed = dt / (settings_.diffusion_number * dt_fe);
+  int s = 2;
+  while ((s * s + s - 2) / 4.0 < needed) ++s;
+  counters_.diffusion_stages += s;
+  auto b = [](int j) { return j <= 2 ? 1.0 / 3.0 : (j * j + j - 2.0) / (2.0 * j * (j + 1.0)); };
+  const double w1 = 4.0 / (s * s + s - 2.0);
+  State Yjm2 = Y0, Yjm1 = Y0, Yj = Y0, L = M0;
+  axpy(Yjm1, 1.0, Y0, 0.0, Y0, b(1) * w1 * dt, M0);
+  if (!admissible(Yjm1, t_, failure)) return false;
+  for (int j = 2; j <= s; ++j) {
+    const double mu = (2.0 * j - 1.0) / j * b(j) / b(j - 1);
+    const double nu = -(j - 1.0) / j * b(j) / b(j - 2);
+    const double mu_tilde = mu * w1;
+    const double gamma_tilde = -(1.0 - b(j - 1)) * mu_tilde;
+    op_.rhs(t_, Yjm1, L, Part::diffusive);
+    axpy(Yj, mu, Yjm1, nu, Yjm2, mu_tilde * dt, L);
+    axpy(Yj, 1.0, Yj, 1.0 - mu - nu, Y0, gamma_tilde * dt, M0);
+    if (!admissible(Yj, t_, failure)) return false;
+    std::swap(Yjm2, Yjm1);
+    std::swap(Yjm1, Yj);
+  }
+  U_.q = Yjm1.q;
+  return true;
+}
+
+bool TimeIntegrator::try_step(double dt, std::string& failure) {
+  try {
+    if (settings_.diffusion == DiffusionIntegrator::explicit_rk)
+      return ssp_runge_kutta(dt, Part::all, failure);
+    U_.q = U0_.q;
+    if (!rkl2(0.5 * dt, failure)) return false;
+    U0_.q = U_.q;
+    op_.rhs(t_, U0_, K0_, Part::hyperbolic_and_sources);
+    if (!ssp_runge_kutta(dt, Part::hyperbolic_and_sources, failure)) return false;
+    return rkl2(0.5 * dt, failure);
+  } catch (const std::domain_error& error) {
+    failure = fmt::format("t = {:.10g}: {}", t_, error.what());
+    return false;
+  }
+}
+
+double TimeIntegrator::step(double t_limit) {
+  U0_.q = U_.q;
+  const Part first = settings_.diffusion == DiffusionIntegrator::explicit_rk
+                         ? Part::all
+                         : Part::hyperbolic_and_sources;
+  try {
+    op_.rhs(t_, U0_, K0_, first);
+  } catch (const std::domain_error& error) {
+    throw StepFailure(fmt::format("continuum: the state at t = {:.10g} is outside the model's "
+                                  "domain: {}", t_, error.what()));
+  }
+  double dt = choose_step(t_limit);
+  // The split scheme overwrites U0_ and K0_; the explicit one leaves them intact.
+  const bool split = settings_.diffusion != DiffusionIntegrator::explicit_rk;
+  if (split) start_.q = U0_.q;
+  std::string failure;
+  for (int attempt = 0; attempt <= settings_.max_retries; ++attempt) {
+    if (try_step(dt, failure)) {
+      t_ = (t_limit - t_ <= dt) ? t_limit : t_ + dt;
+      ++counters_.steps;
+      return dt;
+    }
+    ++counters_.rejected_steps;
+    if (split) {
+      U0_.q = start_.q;
+      op_.rhs(t_, U0_, K0_, first);
+    }
+    U_.q = U0_.q;
+    dt *= 0.5;
+  }
+  throw StepFailure(fmt::format("continuum: step failed after {} retries (last step {:.3g}): {}",
+                                settings_.max_retries, 2.0 * dt, failure));
+}
+
+void TimeIntegrator::advance_to(double t_end) {
+  while (t_ < t_end) step(t_end);
+}
+
+}  // namespace shaker::continuum

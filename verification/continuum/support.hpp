@@ -1,0 +1,60 @@
+#pragma once
+// Shared helpers of the continuum tests: building solvers, norms, least-squares orders.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "continuum/time_integrator.hpp"
+
+namespace shaker::continuum::testing {
+
+/// Physics with only the Euler (Riemann) flux: the dilute ideal gas, gamma = 5/3.
+inline PhysicsSettings euler_physics() {
+  PhysicsSettings p;
+  p.eos = EquationOfState::ideal_gas;
+  p.terms = Terms{true, true, false, false, false, false, false, false, false};
+  return p;
+}
+
+inline Grid column(int cells, double height, int dimension = 1, int horizontal = 1) {
+  Grid g;
+  g.dimension = dimension;
+  g.nz = cells;
+  g.h = height / cells;
+  if (dimension == 3) g.nx = g.ny = horizontal;
+  return g;
+}
+
+/// Least-squares slope of log(error) against log(h): the observed order.
+inline double fitted_order(const std::vector<double>& h, const std::vector<double>& error) {
+  const double m = static_cast<double>(h.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    const double x = std::log(h[i]), y = std::log(error[i]);
+    sx += x; sy += y; sxx += x * x; sxy += x * y;
+  }
+  return (m * sxy - sx * sy) / (m * sxx - sx * sx);
+}
+
+/// A fresh directory for one test, removed first so reruns start clean.
+inline std::filesystem::path test_directory() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("shaker-continuum-" + std::string(info->test_suite_name()) + "-" + info->name());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+inline double total(const Grid& g, const State& s, int variable) {
+  double sum = 0.0;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) sum += s.q[variable][g.index(i, j, k)];
+  return sum * g.cell_volume();
+}
+
+}  // namespace shaker::continuum::testing
