@@ -168,6 +168,7 @@ std::vector<std::int64_t> read_integers(hid_t parent, const std::string& name) {
 }
 
 std::vector<std::size_t> shape(hid_t parent, const std::string& name) {
+  if (!exists(parent, name)) throw InputError(fmt::format("dataset '{}' is missing", name));
   Handle set(checked(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), "open dataset " + name));
   Handle space(checked(H5Dget_space(set.id()), "dataspace of " + name));
   const int rank = H5Sget_simple_extent_ndims(space.id());

@@ -1,0 +1,98 @@
+#!/usr/bin/python3
+"""Reads a run file with h5py (not with the project's reader) and checks its fields.
+
+Usage: check_run_file_h5py.py WRITE_SAMPLE_RUN_FILE
+The helper program writes the sample run of sample_run.hpp into a private temporary
+directory; this script checks the layout of docs/output-schema.md and every value (all dyadic
+rationals, so compared exactly). Exit code 0 when every check holds.
+"""
+import re
+import subprocess
+import sys
+import tempfile
+import tomllib
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+PHASES, BINS = 3, 5
+failures = []
+
+
+def check(condition, what):
+    if not condition:
+        failures.append(what)
+        print(f"FAIL: {what}")
+
+
+def expected_profiles():
+    k = np.arange(PHASES, dtype=float)[:, None]
+    i = np.arange(BINS, dtype=float)[None, :]
+    ones = np.ones((PHASES, BINS))
+    return {
+        "z": (0.5 * i + 0.25) * ones,
+        "n": 0.125 * (i + 1) + k,
+        "nu": 0.0625 * (i + 1) + 0.125 * k,
+        "uz": -0.75 * i + k,
+        "T": 0.0625 * (i + 1) * (k + 1),
+        "samples": 16.0 * i + k,
+        "n_se": 0.03125 * (i + 1) * ones,
+        "uz_se": 0.015625 * (i + k),
+        "T_se": 0.25 * i * ones,
+    }
+
+
+def main():
+    helper = sys.argv[1]
+    with tempfile.TemporaryDirectory(prefix="shaker-unit-h5py-") as directory:
+        path = Path(directory) / "sample.h5"
+        subprocess.run([helper, str(path)], check=True)
+        check(sorted(p.name for p in Path(directory).iterdir()) == ["sample.h5"],
+              "only the final file exists after the write")
+        with h5py.File(path, "r") as f:
+            a = f.attrs
+            check(int(a["schema_version"]) == 1, f"schema_version {a['schema_version']}")
+            for name in ("program_version", "git_commit", "created", "solver", "model_variant",
+                         "configuration"):
+                check(isinstance(a[name], str) and a[name] != "", f"attribute {name} is text")
+            check(re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", a["created"]) is not None,
+                  f"created is ISO 8601 UTC: {a['created']}")
+            check(a["solver"] == "synthetic", f"solver {a['solver']}")
+            check(a["model_variant"] == "constant e; paper transport", "model_variant")
+            check(float(a["restitution_for_analysis"]) == 0.8, "restitution_for_analysis")
+            configuration = tomllib.loads(a["configuration"])
+            check(configuration["material"]["e"] == 0.8, "configuration material.e")
+            check(configuration["case"]["name"] == "sample run", "configuration case.name")
+            check(configuration["layer"]["particles"] == 3937, "configuration layer.particles")
+            check(configuration["shaker"]["gamma"] == 3.0, "configuration shaker.gamma")
+
+            profiles = f["profiles"]
+            k = np.arange(PHASES, dtype=float)
+            for name, values in {"time": 10.0 + 0.25 * k, "phase": 0.25 * k,
+                                 "plate_z": 1.5 * k, "plate_v": -0.5 * k,
+                                 "bin_height": 0.5 * np.ones(PHASES)}.items():
+                data = profiles[name][()]
+                check(data.shape == (PHASES,) and np.array_equal(data, values),
+                      f"profiles/{name} = {data}")
+            for name, values in expected_profiles().items():
+                data = profiles[name][()]
+                check(data.dtype == np.float64, f"profiles/{name} dtype {data.dtype}")
+                check(data.shape == (PHASES, BINS), f"profiles/{name} shape {data.shape}")
+                check(data.shape == values.shape and np.array_equal(data, values),
+                      f"profiles/{name} values")
+
+            series = f["timeseries"]
+            columns = series.attrs["columns"].split(",")
+            check(columns == ["t", "phase", "plate_z", "com_z"], f"timeseries columns {columns}")
+            expected = {"t": [0.0, 0.5, 1.0, 1.5], "phase": [0.0, 0.0475, 0.095, 0.1425],
+                        "plate_z": [0.0, -0.25, 0.5, 0.125], "com_z": [4.5, 4.75, 5.0, 5.25]}
+            for name, values in expected.items():
+                check(np.array_equal(series[name][()], np.array(values)),
+                      f"timeseries/{name} = {series[name][()]}")
+    print(f"{'FAILED' if failures else 'OK'}: {len(failures)} failed checks")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
