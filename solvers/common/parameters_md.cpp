@@ -17,6 +17,9 @@ std::vector<ParameterSpec> md_parameters() {
            "gas initial state: volume fraction"),
       real("md.gas_temperature", 1.0, positive(1e6), "gas initial state: temperature"),
       text("md.checkpoint", "", {}, "checkpoint file to start from (initial_state = checkpoint)"),
+      text("md.checkpoint_output", "", {},
+           "if not empty: checkpoint file written (atomically) with the state at the end of the "
+           "run; a run started from it continues the same trajectory bit for bit"),
       text("md.collapse_guard", "off", {"off", "tc"},
            "off: stop with an error when inelastic collapse starts; tc: collisions within "
            "md.tc of a particle's previous collision are elastic (TC model)"),

@@ -1,0 +1,166 @@
+#include "md/checkpoint.hpp"
+
+#include <fmt/format.h>
+
+#include "common/errors.hpp"
+#include "common/hdf5_file.hpp"
+
+namespace shaker::md {
+namespace {
+
+constexpr int particle_columns = 8;  // r, v, local time, last collision
+
+std::vector<std::int64_t> widen(const auto& values) {
+  return std::vector<std::int64_t>(values.begin(), values.end());
+}
+
+template <class T> std::vector<T> narrow(const std::vector<std::int64_t>& values) {
+  std::vector<T> out(values.size());
+  for (std::size_t k = 0; k < values.size(); ++k) out[k] = static_cast<T>(values[k]);
+  return out;
+}
+
+}  // namespace
+
+void write_checkpoint(const std::filesystem::path& path, const SimulationData& d,
+                      const Geometry& geometry, const std::string& configuration) {
+  AtomicOutput output(path);
+  {
+    const h5::Handle file = h5::create_file(output.temporary_path());
+    const hid_t f = file.id();
+    h5::write_attribute(f, "kind", std::string("shaker md checkpoint"));
+    h5::write_attribute(f, "time", d.time);
+    h5::write_attribute(f, "box_width", geometry.width);
+    h5::write_attribute(f, "box_height", geometry.height);
+    h5::write_attribute(f, "configuration", configuration);
+    const std::size_t n = d.particles.size();
+    std::vector<double> table;
+    table.reserve(n * particle_columns);
+    std::vector<double> event_time;
+    std::vector<std::int64_t> partner, partner_counter, kind;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Particle& p = d.particles[i];
+      for (double x : {p.r.x, p.r.y, p.r.z, p.v.x, p.v.y, p.v.z, p.t, p.last_collision})
+        table.push_back(x);
+      event_time.push_back(d.events[i].time);
+      partner.push_back(d.events[i].partner);
+      partner_counter.push_back(d.events[i].partner_counter);
+      kind.push_back(static_cast<std::int64_t>(d.events[i].kind));
+    }
+    h5::write(f, "particles", table, n, particle_columns);
+    h5::write(f, "event_time", event_time);
+    h5::write(f, "event_partner", partner);
+    h5::write(f, "event_partner_counter", partner_counter);
+    h5::write(f, "event_kind", kind);
+    h5::write(f, "counters", widen(d.counters));
+    h5::write(f, "streaks", widen(d.streaks));
+    h5::write(f, "cell_head", widen(d.cell_head));
+    h5::write(f, "cell_next", widen(d.cell_next));
+    h5::write(f, "cell_prev", widen(d.cell_prev));
+    h5::write(f, "cell_of", widen(d.cell_of));
+    const Tally& t = d.tally;
+    h5::write(f, "tally_counts",
+              std::vector<std::int64_t>{widen(std::vector<std::uint64_t>{
+                  t.pair, t.plate, t.ceiling, t.cell, t.stale, t.guard_activations, t.grazes})});
+    h5::write(f, "tally_energy", std::vector<double>{t.plate_work, t.pair_loss, t.wall_loss, t.virial});
+  }
+  output.commit();
+}
+
+Checkpoint read_checkpoint(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path))
+    throw InputError(fmt::format("md.checkpoint = \"{}\": no such file", path.string()));
+  const h5::Handle file = h5::open_file(path);
+  const hid_t f = file.id();
+  Checkpoint c;
+  try {
+    SimulationData& d = c.data;
+    d.time = h5::read_double_attribute(f, "time");
+    c.width = h5::read_double_attribute(f, "box_width");
+    c.height = h5::read_double_attribute(f, "box_height");
+    c.configuration = h5::read_string_attribute(f, "configuration");
+    const std::vector<double> table = h5::read_doubles(f, "particles");
+    const std::size_t n = table.size() / particle_columns;
+    d.particles.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double* x = &table[i * particle_columns];
+      Particle& p = d.particles[i];
+      p.r = {x[0], x[1], x[2]};
+      p.v = {x[3], x[4], x[5]};
+      p.t = x[6];
+      p.last_collision = x[7];
+    }
+    const auto event_time = h5::read_doubles(f, "event_time");
+    const auto partner = h5::read_integers(f, "event_partner");
+    const auto partner_counter = h5::read_integers(f, "event_partner_counter");
+    const auto kind = h5::read_integers(f, "event_kind");
+    d.events.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      d.events[i].time = event_time.at(i);
+      d.events[i].partner = static_cast<std::int32_t>(partner.at(i));
+      d.events[i].partner_counter = static_cast<std::uint32_t>(partner_counter.at(i));
+      d.events[i].kind = static_cast<EventKind>(kind.at(i));
+    }
+    d.counters = narrow<std::uint32_t>(h5::read_integers(f, "counters"));
+    d.streaks = narrow<std::uint32_t>(h5::read_integers(f, "streaks"));
+    d.cell_head = narrow<std::int32_t>(h5::read_integers(f, "cell_head"));
+    d.cell_next = narrow<std::int32_t>(h5::read_integers(f, "cell_next"));
+    d.cell_prev = narrow<std::int32_t>(h5::read_integers(f, "cell_prev"));
+    d.cell_of = narrow<std::int32_t>(h5::read_integers(f, "cell_of"));
+    const auto counts = h5::read_integers(f, "tally_counts");
+    const auto energy = h5::read_doubles(f, "tally_energy");
+    Tally& t = d.tally;
+    std::uint64_t* fields[] = {&t.pair, &t.plate, &t.ceiling, &t.cell, &t.stale,
+                               &t.guard_activations, &t.grazes};
+    for (std::size_t k = 0; k < 7; ++k) *fields[k] = static_cast<std::uint64_t>(counts.at(k));
+    t.plate_work = energy.at(0);
+    t.pair_loss = energy.at(1);
+    t.wall_loss = energy.at(2);
+    t.virial = energy.at(3);
+    if (d.counters.size() != n || d.streaks.size() != n || d.cell_next.size() != n ||
+        d.cell_prev.size() != n || d.cell_of.size() != n)
+      throw InputError("inconsistent array lengths");
+  } catch (const std::exception& error) {
+    throw InputError(fmt::format("md.checkpoint = \"{}\" is not a valid checkpoint: {}",
+                                 path.string(), error.what()));
+  }
+  return c;
+}
+
+void validate_state(const Geometry& g, const SimulationData& d, double tolerance) {
+  const std::size_t n = d.particles.size();
+  std::vector<Vec3> r(n), v(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(d.particles[i].t <= d.time))
+      throw InputError(fmt::format("checkpoint particle {}: local time {} is after the checkpoint "
+                                   "time {}", i, d.particles[i].t, d.time));
+    state_at(d.particles[i], d.time, g.gravity, r[i], v[i]);
+    const double x = r[i].x, y = r[i].y, z = r[i].z;
+    const bool inside_xy = x >= -tolerance && x <= g.width + tolerance && y >= -tolerance &&
+                           y <= g.width + tolerance;
+    const double z_lo = g.periodic_z ? -tolerance : g.plate.position(d.time) + 0.5 - tolerance;
+    const double z_hi = g.periodic_z ? g.height + tolerance : g.height - 0.5 + tolerance;
+    if (!inside_xy || z < z_lo || z > z_hi || !std::isfinite(dot(v[i], v[i])))
+      throw InputError(fmt::format(
+          "checkpoint particle {} at ({}, {}, {}) is outside the box: allowed 0 <= x, y <= {} "
+          "and {} <= z <= {} at t = {}", i, x, y, z, g.width, z_lo + tolerance, z_hi - tolerance,
+          d.time));
+  }
+  Geometry cells_geometry = g;
+  CellList cells;
+  cells.build(cells_geometry, n);
+  for (std::size_t i = 0; i < n; ++i) cells.insert(static_cast<std::int32_t>(i), cells.cell_of(r[i]));
+  const double limit = (1.0 - tolerance) * (1.0 - tolerance);
+  for (std::size_t i = 0; i < n; ++i) {
+    cells.for_each_neighbor(cells.cell(static_cast<std::int32_t>(i)), [&](std::int32_t j, const Vec3& shift) {
+      if (j <= static_cast<std::int32_t>(i)) return;
+      const Vec3 dr = r[i] - r[static_cast<std::size_t>(j)] - shift;
+      if (dot(dr, dr) < limit)
+        throw InputError(fmt::format(
+            "checkpoint particles {} and {} overlap: centre distance {:.12g}, allowed at least "
+            "1 - {:g} (one diameter)", i, j, std::sqrt(dot(dr, dr)), tolerance));
+    });
+  }
+}
+
+}  // namespace shaker::md

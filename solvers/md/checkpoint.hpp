@@ -1,0 +1,29 @@
+#pragma once
+// Checkpoints: the complete SimulationData (particles with their local times, pending events,
+// collision counters, cell lists, running totals) in an HDF5 file written atomically. A run
+// continued from a checkpoint replays the events of an uninterrupted run bit for bit.
+#include <filesystem>
+#include <string>
+
+#include "md/geometry.hpp"
+#include "md/simulation.hpp"
+
+namespace shaker::md {
+
+struct Checkpoint {
+  SimulationData data;
+  std::string configuration;  ///< effective configuration of the run that wrote it
+  double width = 0.0, height = 0.0;  ///< geometry the cell lists belong to
+};
+
+void write_checkpoint(const std::filesystem::path& path, const SimulationData& data,
+                      const Geometry& geometry, const std::string& configuration);
+/// Throws InputError if the file is missing or malformed.
+Checkpoint read_checkpoint(const std::filesystem::path& path);
+
+/// Throws InputError naming the particle(s) if a particle lies outside the box (below the
+/// plate, above the ceiling, outside [0, width) horizontally) or two particles overlap by more
+/// than `tolerance` at time data.time.
+void validate_state(const Geometry& geometry, const SimulationData& data, double tolerance = 1e-9);
+
+}  // namespace shaker::md

@@ -1,0 +1,51 @@
+#pragma once
+// The run protocols of the configuration: transient cycles then sampled cycles (periodic), or
+// the paper's single shock (periodic state, then a change of restitution at a given phase and
+// one recorded cycle). Sampling never changes the trajectory: it reads particle states at the
+// sampling instants without touching the particles.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/case_parameters.hpp"
+#include "common/config.hpp"
+#include "common/profile.hpp"
+#include "md/simulation.hpp"
+
+namespace shaker::md {
+
+/// The md.* keys, typed.
+struct MdSettings {
+  double ceiling = 200.0;
+  double bin_height = 1.0;
+  std::string initial_state = "flat_layer";
+  double gas_volume_fraction = 0.1, gas_temperature = 1.0;
+  std::string checkpoint, checkpoint_output;
+  bool tc_guard = false;
+  double tc = 1e-5;
+  static MdSettings from(const config::Config& config);
+};
+
+struct EnergyBudget {
+  double plate_work = 0.0, collisional_loss = 0.0, energy_change = 0.0;
+  /// |energy change + loss - work| / max(|work|, |loss|, |energy|)
+  double relative_closure = 0.0;
+};
+
+struct RunOutcome {
+  std::vector<Profile> profiles;
+  TimeSeries series;
+  EnergyBudget budget;
+  std::size_t overlaps = 0;  ///< at the end of the run
+  bool queue_consistent = false;
+  double seconds = 0.0;      ///< wall-clock time of the event loop
+  std::uint64_t collisions = 0, events = 0;
+};
+
+/// Called once per cycle with (cycle done, cycles total, collisions per second).
+using Progress = std::function<void(long, long, double)>;
+
+RunOutcome run_protocol(Simulation& simulation, const CaseParameters& parameters,
+                        const MdSettings& settings, const Progress& progress = {});
+
+}  // namespace shaker::md
