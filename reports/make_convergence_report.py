@@ -1,0 +1,304 @@
+#!/usr/bin/python3
+"""Writes reports/convergence.md (+ PNG plots beside it) from CSV error tables and summaries.
+
+Usage:
+    make_convergence_report.py --input DIR [--output reports/convergence.md]
+                               [--build-dir BUILD] [--build-type TYPE] [--commit SHA] [--strict]
+
+Every file under DIR (searched recursively) whose name ends in one of the suffixes below is
+read; verification/convergence/error_table.hpp writes exactly these files. The first line of
+each is the header shown; numbers are decimal (nan allowed); names contain no commas.
+
+  *.errors.csv   study,field,norm,level,h,error
+      One discrete error norm of one field on one level of one study. `h` is the grid spacing
+      (spatial studies) or time step (temporal studies); `level` 0 is the coarsest. `norm` is
+      L1, L2 or Linf.
+  *.orders.csv   study,field,norm,fit_points,fitted_order,order_std_error,pair_order_finest,
+                 pair_order_next,design_order,tolerance,pass
+      The acceptance check of one error series: the least-squares order over the `fit_points`
+      finest levels, the two-level orders of the finest and next pair, the design order and
+      the band half-width. Passes when the fitted and both pair orders lie within `tolerance`
+      of `design_order` (the next pair may be missing, nan, only when fit_points < 3).
+  *.gci.csv      study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,
+                 relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,
+                 convergence,asymptotic_tolerance,pass
+      A quantity of interest on three grids (1 finest) with Roache's GCI (Fs = 1.25, relative
+      quantities as fractions) and the asymptotic-range ratio GCI32 / (r21^p GCI21); passes
+      when |ratio - 1| <= asymptotic_tolerance.
+
+The pass/fail marks are recomputed here from the numbers; a `pass` column that disagrees is
+reported and counts as a failure. A failing check is listed with its measured value, never
+dropped. The exit code is 0 unless --strict is given and a check fails (2 for unreadable input).
+"""
+import argparse
+import csv
+import glob
+import math
+import os
+import re
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.ticker  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import report_common as rc  # noqa: E402
+
+ERRORS_HEADER = ["study", "field", "norm", "level", "h", "error"]
+ORDERS_HEADER = ["study", "field", "norm", "fit_points", "fitted_order", "order_std_error",
+                 "pair_order_finest", "pair_order_next", "design_order", "tolerance", "pass"]
+GCI_HEADER = ["study", "quantity", "h1", "h2", "h3", "phi1", "phi2", "phi3", "order",
+              "phi_extrapolated", "relative_difference21", "extrapolated_error21", "gci21",
+              "gci32", "asymptotic_ratio", "convergence", "asymptotic_tolerance", "pass"]
+TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence"}
+NORM_ORDER = {"L1": 0, "L2": 1, "Linf": 2}
+
+
+class InputProblem(Exception):
+    pass
+
+
+def read_csv(path, header):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows or rows[0] != header:
+        raise InputProblem(f"{path}: first line must be '{','.join(header)}'")
+    records = []
+    for number, row in enumerate(rows[1:], start=2):
+        if not row:
+            continue
+        if len(row) != len(header):
+            raise InputProblem(f"{path}:{number}: expected {len(header)} columns, found {len(row)}")
+        record = {}
+        for key, cell in zip(header, row):
+            if key in TEXT_COLUMNS:
+                record[key] = cell
+            else:
+                try:
+                    record[key] = float(cell)
+                except ValueError:
+                    raise InputProblem(f"{path}:{number}: {key} = '{cell}' is not a number")
+        records.append(record)
+    return records
+
+
+def read_inputs(directory):
+    found = {"errors": [], "orders": [], "gci": []}
+    files = []
+    for kind, header in (("errors", ERRORS_HEADER), ("orders", ORDERS_HEADER), ("gci", GCI_HEADER)):
+        for path in sorted(glob.glob(os.path.join(directory, "**", f"*.{kind}.csv"), recursive=True)):
+            found[kind].extend(read_csv(path, header))
+            files.append(os.path.relpath(path, directory))
+    return found, files
+
+
+def within(measured, expected, tolerance):
+    return math.isfinite(measured) and abs(measured - expected) <= tolerance
+
+
+def order_passes(row):
+    next_ok = (row["fit_points"] < 3 if math.isnan(row["pair_order_next"])
+               else within(row["pair_order_next"], row["design_order"], row["tolerance"]))
+    return (within(row["fitted_order"], row["design_order"], row["tolerance"])
+            and within(row["pair_order_finest"], row["design_order"], row["tolerance"])
+            and next_ok)
+
+
+def gci_passes(row):
+    return within(row["asymptotic_ratio"], 1.0, row["asymptotic_tolerance"])
+
+
+def verdict(recomputed, claimed):
+    """The mark shown in a table, and whether the check counts as passed."""
+    if claimed is not None and not math.isnan(claimed) and bool(claimed) != recomputed:
+        return f"**FAIL** (file says {'pass' if claimed else 'fail'}, numbers say " \
+               f"{'pass' if recomputed else 'fail'})", False
+    return ("PASS", True) if recomputed else ("**FAIL**", False)
+
+
+def series_of(errors):
+    series = {}
+    for row in errors:
+        series.setdefault(row["study"], {}).setdefault((row["field"], row["norm"]), []).append(row)
+    for study in series.values():
+        for key in study:
+            study[key].sort(key=lambda r: -r["h"])  # coarse to fine
+    return series
+
+
+def pair_orders(rows):
+    out = []
+    for coarse, fine in zip(rows, rows[1:]):
+        if coarse["error"] > 0 and fine["error"] > 0 and coarse["h"] > fine["h"]:
+            out.append(math.log(coarse["error"] / fine["error"]) / math.log(coarse["h"] / fine["h"]))
+        else:
+            out.append(float("nan"))
+    return out
+
+
+def safe_name(study):
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", study)
+
+
+def plot_study(study, series, design_orders, out_dir):
+    norms = sorted({norm for _, norm in series}, key=lambda n: NORM_ORDER.get(n, 9))
+    fig, axes = plt.subplots(1, len(norms), figsize=(4.2 * len(norms), 3.8), squeeze=False)
+    for ax, norm in zip(axes[0], norms):
+        finest = []
+        for (field, series_norm), rows in sorted(series.items()):
+            if series_norm != norm:
+                continue
+            h = np.array([r["h"] for r in rows])
+            e = np.array([r["error"] for r in rows])
+            keep = (h > 0) & (e > 0)
+            ax.loglog(h[keep], e[keep], "o-", ms=4, label=field)
+            if keep.any():
+                finest.append((h[keep].min(), e[keep][np.argmin(h[keep])], h[keep].max()))
+        for p in sorted(design_orders):
+            if not finest:
+                break
+            h_min = min(f[0] for f in finest)
+            h_max = max(f[2] for f in finest)
+            e_anchor = float(np.exp(np.mean([np.log(f[1]) for f in finest])))
+            hs = np.array([h_min, h_max])
+            ax.loglog(hs, e_anchor * (hs / h_min) ** p, "k--", lw=1, label=f"slope {p:g}")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_title(f"{study}: {norm}")
+        ax.set_xlabel("h")
+        ax.set_ylabel("error")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    name = f"convergence-{safe_name(study)}.png"
+    rc.save_figure_atomically(fig, os.path.join(out_dir, name))
+    plt.close(fig)
+    return name
+
+
+def error_tables(series):
+    lines = []
+    for study in sorted(series):
+        hs = sorted({r["h"] for rows in series[study].values() for r in rows}, reverse=True)
+        lines += [f"### {study}: errors", "",
+                  "| field | norm | " + " | ".join(f"h = {rc.fmt(h)}" for h in hs) + " | " +
+                  " | ".join(f"p({i}-{i + 1})" for i in range(len(hs) - 1)) + " |",
+                  "|---" * (2 + 2 * len(hs) - 1) + "|"]
+        keys = sorted(series[study], key=lambda k: (k[0], NORM_ORDER.get(k[1], 9)))
+        for field, norm in keys:
+            rows = series[study][(field, norm)]
+            by_h = {r["h"]: r["error"] for r in rows}
+            orders = pair_orders(rows)
+            cells = [rc.fmt(by_h.get(h, float("nan"))) for h in hs]
+            cells += [rc.fmt(p, 3) for p in orders] + [""] * (len(hs) - 1 - len(orders))
+            lines.append(f"| {field} | {norm} | " + " | ".join(cells) + " |")
+        lines.append("")
+    return lines
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--input", required=True, help="directory of *.errors/orders/gci.csv")
+    parser.add_argument("--output", default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                                         "convergence.md"))
+    parser.add_argument("--build-dir", help="build directory (its CMakeCache gives the build type)")
+    parser.add_argument("--build-type", help="overrides the build type read from --build-dir")
+    parser.add_argument("--commit", help="defaults to git rev-parse HEAD of this repository")
+    parser.add_argument("--strict", action="store_true", help="exit 1 when any check fails")
+    args = parser.parse_args(argv)
+
+    if not os.path.isdir(args.input):
+        print(f"make_convergence_report: --input {args.input} is not a directory", file=sys.stderr)
+        return 2
+    try:
+        data, files = read_inputs(args.input)
+    except InputProblem as problem:
+        print(f"make_convergence_report: {problem}", file=sys.stderr)
+        return 2
+
+    out_dir = os.path.dirname(os.path.abspath(args.output))
+    repository = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    commit = args.commit or rc.git_commit(repository)
+    build_type = args.build_type or rc.build_type_of(args.build_dir)
+
+    order_rows = sorted(data["orders"], key=lambda r: (r["study"], r["field"],
+                                                       NORM_ORDER.get(r["norm"], 9)))
+    gci_rows = sorted(data["gci"], key=lambda r: (r["study"], r["quantity"]))
+    failures = []
+    order_lines = ["## Observed orders against the design order", "",
+                   "| study | field | norm | fitted p (± s.e., points) | p finest pair | "
+                   "p next pair | design | band | result |",
+                   "|---|---|---|---|---|---|---|---|---|"]
+    for r in order_rows:
+        mark, ok = verdict(order_passes(r), r["pass"])
+        fitted = f"{rc.fmt(r['fitted_order'], 4)} ± {rc.fmt(r['order_std_error'], 2)} " \
+                 f"({int(r['fit_points'])})"
+        band = f"{rc.fmt(r['design_order'] - r['tolerance'], 3)}–" \
+               f"{rc.fmt(r['design_order'] + r['tolerance'], 3)}"
+        order_lines.append(f"| {r['study']} | {r['field']} | {r['norm']} | {fitted} | "
+                           f"{rc.fmt(r['pair_order_finest'], 4)} | {rc.fmt(r['pair_order_next'], 4)} | "
+                           f"{rc.fmt(r['design_order'])} | {band} | {mark} |")
+        if not ok:
+            failures.append(f"order {r['study']} / {r['field']} / {r['norm']}: fitted "
+                            f"{rc.fmt(r['fitted_order'], 4)}, pairs {rc.fmt(r['pair_order_finest'], 4)}"
+                            f" and {rc.fmt(r['pair_order_next'], 4)}, design "
+                            f"{rc.fmt(r['design_order'])} ± {rc.fmt(r['tolerance'])}")
+    if not order_rows:
+        order_lines.append("| (no order checks found) | | | | | | | | |")
+    order_lines.append("")
+
+    gci_lines = ["## Grid convergence index of the quantities of interest", "",
+                 "GCI in percent of the fine-grid value (Fs = 1.25); asymptotic ratio = "
+                 "GCI32 / (r21^p GCI21), close to 1 in the asymptotic range.", "",
+                 "| study | quantity | phi1 (fine) | phi2 | phi3 | p | phi extrapolated | "
+                 "e21 % | GCI21 % | GCI32 % | ratio | convergence | result |",
+                 "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in gci_rows:
+        mark, ok = verdict(gci_passes(r), r["pass"])
+        gci_lines.append(
+            f"| {r['study']} | {r['quantity']} | {rc.fmt(r['phi1'], 6)} | {rc.fmt(r['phi2'], 6)} | "
+            f"{rc.fmt(r['phi3'], 6)} | {rc.fmt(r['order'], 4)} | {rc.fmt(r['phi_extrapolated'], 6)} | "
+            f"{rc.fmt(100 * r['relative_difference21'], 3)} | {rc.fmt(100 * r['gci21'], 3)} | "
+            f"{rc.fmt(100 * r['gci32'], 3)} | {rc.fmt(r['asymptotic_ratio'], 4)} | "
+            f"{r['convergence']} | {mark} (band 1 ± {rc.fmt(r['asymptotic_tolerance'])}) |")
+        if not ok:
+            failures.append(f"GCI {r['study']} / {r['quantity']}: asymptotic ratio "
+                            f"{rc.fmt(r['asymptotic_ratio'], 4)} outside 1 ± "
+                            f"{rc.fmt(r['asymptotic_tolerance'])} ({r['convergence']})")
+    if not gci_rows:
+        gci_lines.append("| (no GCI studies found) | | | | | | | | | | | | |")
+    gci_lines.append("")
+
+    series = series_of(data["errors"])
+    plot_lines = ["## Plots", ""]
+    for study in sorted(series):
+        designs = {r["design_order"] for r in order_rows if r["study"] == study}
+        name = plot_study(study, series[study], designs, out_dir)
+        plot_lines += [f"![{study}]({name})", ""]
+
+    checks = len(order_rows) + len(gci_rows)
+    lines = ["# Convergence report", "",
+             f"- commit: {commit}",
+             f"- date: {rc.utc_now()}",
+             f"- machine: {rc.machine_description()}",
+             f"- build type: {build_type}",
+             f"- input: {os.path.abspath(args.input)} ({len(files)} files)", "",
+             "## Summary", "",
+             f"{checks} checks: {checks - len(failures)} pass, {len(failures)} fail."]
+    if not files:
+        lines.append("No error tables or study summaries were found in the input directory.")
+    if failures:
+        lines += ["", "Failing checks (measured values):", ""] + [f"- {f}" for f in failures]
+    lines.append("")
+    lines += order_lines + gci_lines + error_tables(series) + plot_lines
+    lines += ["## Input files", ""] + [f"- {f}" for f in files] + [""]
+    rc.write_text_atomically(args.output, "\n".join(lines))
+    print(f"wrote {args.output}: {checks} checks, {len(failures)} failing")
+    return 1 if (args.strict and failures) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,89 @@
+"""Helpers shared by the report generators: provenance header and atomic file writes.
+
+Nothing under a final output name is ever half-written: text and figures go to a temporary
+name in the same directory and are renamed into place.
+"""
+import datetime
+import os
+import platform
+import subprocess
+import tempfile
+
+
+def git_commit(repository):
+    try:
+        out = subprocess.run(["git", "-C", repository, "rev-parse", "HEAD"], check=True,
+                             capture_output=True, text=True)
+        return out.stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def machine_description():
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{platform.node()} ({cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()})"
+
+
+def build_type_of(build_dir):
+    """CMAKE_BUILD_TYPE from a build directory's CMakeCache.txt, or 'unknown'."""
+    if not build_dir:
+        return "unknown"
+    try:
+        with open(os.path.join(build_dir, "CMakeCache.txt")) as f:
+            for line in f:
+                if line.startswith("CMAKE_BUILD_TYPE:"):
+                    return line.split("=", 1)[1].strip() or "unknown"
+    except OSError:
+        pass
+    return "unknown"
+
+
+def utc_now():
+    return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
+
+
+def write_text_atomically(path, text):
+    directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)
+    fd, temporary = tempfile.mkstemp(dir=directory, prefix=".partial-", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
+
+
+def save_figure_atomically(figure, path, dpi=90):
+    directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)
+    fd, temporary = tempfile.mkstemp(dir=directory, prefix=".partial-", suffix=".png")
+    os.close(fd)
+    try:
+        figure.savefig(temporary, dpi=dpi, format="png")
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
+
+
+def fmt(x, digits=4):
+    """A number for a markdown cell; NaN and missing values print as 'n/a'."""
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return "n/a"
+    if x != x:
+        return "n/a"
+    return f"{x:.{digits}g}"

@@ -1,0 +1,174 @@
+#!/usr/bin/python3
+"""ctest: reports/make_benchmark_report.py on synthetic Google Benchmark JSON.
+
+Argument: the reports/ directory. Two runs of three benchmarks with 9 repetitions each: one
+20% slower, one 20% faster, one unchanged (seeded noise). Checks the throughput rows per
+commit, the comparison rows and verdicts, the exit code and the benchmark named on stderr,
+the threshold option, the Mann-Whitney U implementation against brute-force enumeration, and
+bad input.
+"""
+import itertools
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+REPORTS = os.path.abspath(sys.argv[1])
+SCRIPT = os.path.join(REPORTS, "make_benchmark_report.py")
+sys.path.insert(0, REPORTS)
+import make_benchmark_report as mbr  # noqa: E402
+
+failures = []
+
+
+def check(condition, message):
+    if not condition:
+        failures.append(message)
+        print("FAIL:", message)
+
+
+def google_benchmark_json(commit, benchmarks, rng):
+    """benchmarks: {name: (median time in ns, counter name or None, work per iteration)}"""
+    entries = []
+    for name, (time_ns, counter, work) in benchmarks.items():
+        times = time_ns * (1.0 + 0.01 * rng.standard_normal(9))
+        for k, t in enumerate(times):
+            entry = {"name": name, "family_index": 0, "per_family_instance_index": 0,
+                     "run_name": name, "run_type": "iteration", "repetitions": 9,
+                     "repetition_index": k, "threads": 1, "iterations": 100,
+                     "real_time": t / 1e3, "cpu_time": t / 1e3 * 0.99, "time_unit": "us"}
+            if counter:
+                entry[counter] = work / (t * 1e-9)
+            entries.append(entry)
+        for aggregate in ("mean", "median", "stddev", "cv"):
+            entries.append({"name": f"{name}_{aggregate}", "run_name": name,
+                            "run_type": "aggregate", "aggregate_name": aggregate,
+                            "real_time": 1.0, "cpu_time": 1.0, "time_unit": "us"})
+    return {"context": {"date": "2026-11-22T03:00:00+00:00", "host_name": "synthetic",
+                        "num_cpus": 2, "library_build_type": "release", "commit": commit},
+            "benchmarks": entries}
+
+
+def write_run(history, run_id, commit, benchmarks, seed):
+    rng = np.random.default_rng(seed)
+    os.makedirs(os.path.join(history, run_id))
+    document = google_benchmark_json(commit, benchmarks, rng)
+    with open(os.path.join(history, run_id, "bench_all.json"), "w") as f:
+        json.dump(document, f)
+
+
+def run(*args):
+    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
+
+
+def line_with(text, *fragments):
+    return next((l for l in text.splitlines() if all(f in l for f in fragments)), "")
+
+
+# ---- Mann-Whitney U against enumeration and hand values ------------------------------------
+def brute_force_p(x, y):
+    pooled = list(x) + list(y)
+    n1 = len(x)
+    observed = sum((a > b) + 0.5 * (a == b) for a in x for b in y)
+    mean = n1 * len(y) / 2.0
+    count = total = 0
+    for subset in itertools.combinations(range(len(pooled)), n1):
+        chosen = set(subset)
+        u = sum((pooled[i] > pooled[j]) for i in chosen for j in range(len(pooled)) if j not in chosen)
+        total += 1
+        count += abs(u - mean) >= abs(observed - mean) - 1e-12
+    return count / total
+
+
+x = [0.3, 1.2, 2.5, 4.1, 0.7]
+y = [1.0, 3.3, 2.2, 5.0, 4.4, 6.1]
+u, p, method = mbr.mann_whitney_u(x, y)
+check(method == "exact" and u == 6.0, f"U = {u} ({method}), expected 6 exact")
+check(abs(p - brute_force_p(x, y)) < 1e-12, f"exact p {p} vs enumeration {brute_force_p(x, y)}")
+check(abs(mbr.mann_whitney_u([1, 2, 3], [4, 5, 6])[1] - 0.1) < 1e-15, "3 vs 3 separated: p = 2/20")
+# 9 vs 9 fully separated, normal approximation: z = (40.5 - 0.5) / sqrt(81 * 19 / 12).
+p9 = mbr.mann_whitney_u(range(1, 10), range(10, 19))[1]
+check(abs(p9 - math.erfc(40.0 / math.sqrt(128.25) / math.sqrt(2.0))) < 1e-15 and 4.0e-4 < p9 < 4.3e-4,
+      f"9 vs 9 separated: p = {p9}")
+tied = mbr.mann_whitney_u([1, 1, 2, 5, 7, 7, 8, 9, 9], [2, 3, 3, 4, 6, 6, 10, 11, 12])
+tied_swapped = mbr.mann_whitney_u([2, 3, 3, 4, 6, 6, 10, 11, 12], [1, 1, 2, 5, 7, 7, 8, 9, 9])
+check(tied[2] == "asymptotic" and abs(tied[1] - tied_swapped[1]) < 1e-15 and 0 < tied[1] < 1,
+      f"tied samples: {tied} vs swapped {tied_swapped}")
+
+# ---- The report on a synthetic history ------------------------------------------------------
+work = tempfile.mkdtemp(prefix="shaker-benchmark-report-")
+try:
+    history = os.path.join(work, "history")
+    before = {"BM_md_collisions": (2.0e6, "collisions_per_second", 2000.0),
+              "BM_continuum_step": (5.0e5, "cell_updates_per_second", 1.0e4),
+              "BM_unchanged": (1.0e5, None, 0.0)}
+    after = {"BM_md_collisions": (2.4e6, "collisions_per_second", 2000.0),   # 20% slower
+             "BM_continuum_step": (4.0e5, "cell_updates_per_second", 1.0e4),  # 20% faster
+             "BM_unchanged": (1.0e5, None, 0.0)}
+    write_run(history, "20261120T030000Z-aaaaaaaaaaaa", "a" * 40, before, seed=1)
+    write_run(history, "20261121T030000Z-bbbbbbbbbbbb", "b" * 40, after, seed=2)
+    out = os.path.join(work, "out", "benchmarks.md")
+    result = run("--history", history, "--output", out)
+    check(result.returncode == 1, f"a 20% slowdown must exit 1, got {result.returncode}")
+    check("BM_md_collisions" in result.stderr and "BM_continuum_step" not in result.stderr
+          and "BM_unchanged" not in result.stderr, f"stderr must name the slow one: {result.stderr}")
+    text = open(out).read() if os.path.exists(out) else ""
+    check("### collisions per second" in text and "### cell updates per second" in text,
+          "throughput sections missing")
+    # 2000 collisions per 2 ms = 1e6 /s before, 8.333e5 /s after (medians, 1% noise).
+    row_a = line_with(text, "| 20261120T030000Z-aaaaaaaaaaaa | aaaaaaaaaa | ")
+    row_b = line_with(text, "| 20261121T030000Z-bbbbbbbbbbbb | bbbbbbbbbb | ")
+    check(row_a != "" and row_b != "", "per-commit throughput rows missing")
+    try:
+        a = float(row_a.split("|")[3])
+        b = float(row_b.split("|")[3])
+        check(abs(a / 1e6 - 1) < 0.02 and abs(b / 8.3333e5 - 1) < 0.02,
+              f"collisions/s medians {a}, {b} (expected 1e6, 8.33e5)")
+    except (IndexError, ValueError):
+        check(False, f"throughput rows unreadable: '{row_a}', '{row_b}'")
+    slow = line_with(text, "| BM_md_collisions |", "%")
+    fast = line_with(text, "| BM_continuum_step |", "%")
+    same = line_with(text, "| BM_unchanged |", "%")
+
+    def change_of(row):
+        try:
+            return float(row.split("|")[4].strip().rstrip("%"))
+        except (IndexError, ValueError):
+            return float("nan")
+    check("**SLOWDOWN**" in slow and 17 < change_of(slow) < 23, f"slowdown row: '{slow}'")
+    check("faster" in fast and -23 < change_of(fast) < -17 and "SLOWDOWN" not in fast,
+          f"faster row: '{fast}'")
+    check("SLOWDOWN" not in same and "faster" not in same, f"unchanged row: '{same}'")
+    check("- BM_md_collisions: median time +" in text, "slowdown list missing")
+    png = os.path.join(work, "out", "benchmark-history.png")
+    check(os.path.exists(png) and open(png, "rb").read(4) == b"\x89PNG", "history plot missing")
+
+    relaxed = run("--history", history, "--output", os.path.join(work, "relaxed.md"),
+                  "--threshold", "0.25")
+    check(relaxed.returncode == 0, f"--threshold 0.25 must accept a 20% slowdown, got {relaxed.returncode}")
+    relaxed_row = line_with(open(os.path.join(work, "relaxed.md")).read(), "| BM_md_collisions |", "%")
+    check("significant change within 25%" in relaxed_row, f"relaxed row: '{relaxed_row}'")
+
+    single = os.path.join(work, "single")
+    write_run(single, "20261120T030000Z-aaaaaaaaaaaa", "a" * 40, before, seed=3)
+    result = run("--history", single, "--output", os.path.join(work, "single.md"))
+    check(result.returncode == 0 and "nothing to compare" in open(os.path.join(work, "single.md")).read(),
+          "a single run must report nothing to compare and exit 0")
+
+    broken = os.path.join(work, "broken", "20261120T030000Z-x")
+    os.makedirs(broken)
+    with open(os.path.join(broken, "bench.json"), "w") as f:
+        f.write("{not json")
+    result = run("--history", os.path.dirname(broken), "--output", os.path.join(work, "broken.md"))
+    check(result.returncode == 2 and not os.path.exists(os.path.join(work, "broken.md")),
+          f"bad JSON: exit {result.returncode}")
+finally:
+    shutil.rmtree(work, ignore_errors=True)
+
+print(f"{len(failures)} failures")
+sys.exit(1 if failures else 0)
