@@ -71,6 +71,8 @@ std::vector<double> mach_number(const Profile& p, double e) {
   std::vector<double> ma(p.size(), 0.0);
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!(p.nu[i] > 0.0 && p.T[i] > 0.0)) continue;
+    // An MD bin can be packed beyond nu_max; c diverges as nu -> nu_max, so Ma -> 0 there.
+    if (p.nu[i] >= nu_max) continue;
     ma[i] = std::abs(p.uz[i] - p.plate_v) / model::sound_speed(p.nu[i], p.T[i], e);
   }
   return ma;

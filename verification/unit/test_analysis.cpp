@@ -1,0 +1,434 @@
+// Unit tests of the analysis library (solvers/analysis/analysis.hpp) on synthetic profiles
+// whose answers are known: tanh temperature shocks of known centre and width, layers with
+// known crossings, densities with a closed-form centre of mass, profiles with no shock (clean
+// and with MD-like noise), and the agreement metrics on inputs with known differences.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "analysis/analysis.hpp"
+#include "common/granular_model.hpp"
+#include "common/units.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace shaker;
+using namespace shaker::analysis;
+using Field = std::function<double(double)>;
+
+/// A profile on bins of height h with centres z0 + (i + 1/2) h, from fields of height.
+Profile make_profile(const Field& nu, const Field& T, const Field& uz, std::size_t bins = 60,
+                     double h = 1.0, double z0 = 0.0) {
+  Profile p;
+  p.bin_height = h;
+  for (std::size_t i = 0; i < bins; ++i) {
+    const double z = z0 + (static_cast<double>(i) + 0.5) * h;
+    p.z.push_back(z);
+    p.nu.push_back(nu(z));
+    p.n.push_back(number_density(nu(z)));
+    p.T.push_back(T(z));
+    p.uz.push_back(uz(z));
+  }
+  return p;
+}
+
+/// 1 well below zs, 0 well above, a tanh step of width w.
+double step_down(double z, double zs, double w) { return 0.5 * (1.0 - std::tanh((z - zs) / w)); }
+
+// The shock of physics.md: a dense compressed layer moving with the plate below zs, a less
+// dense layer falling onto it above; T rises with height in both (slope 0.05) and drops by
+// 5 in the shock. The layer ends 14 above the shock.
+constexpr double temperature_slope = 0.05, temperature_jump = 5.0;
+Profile shock_profile(double zs, double w, double plate_v = 1.0) {
+  const auto layer_top = [zs](double z) { return step_down(z, zs + 14.0, 1.5); };
+  Profile p = make_profile(
+      [=](double z) { return (0.2 + 0.3 * step_down(z, zs, w)) * layer_top(z); },
+      [=](double z) { return 0.5 + temperature_slope * z + temperature_jump * step_down(z, zs, w); },
+      [=](double z) { return plate_v * step_down(z, zs, w) - 2.0 * (1.0 - step_down(z, zs, w)); });
+  p.plate_v = plate_v;
+  return p;
+}
+
+/// Distance between the temperature maximum and minimum of the continuous tanh profile.
+double continuous_shock_width(double w) {
+  // dT/dz = slope - jump / (2 w) sech^2(x / w) = 0
+  return 2.0 * w * std::acosh(1.0 / std::sqrt(2.0 * w * temperature_slope / temperature_jump));
+}
+
+// ---- the shock ------------------------------------------------------------------------------
+
+TEST(FindShock, LocatesATanhShockWithinHalfABin) {
+  for (double w : {0.5, 1.0, 2.0})
+    for (double zs : {10.0, 12.3, 14.5, 15.77, 18.2}) {
+      SCOPED_TRACE(::testing::Message() << "centre " << zs << ", width " << w);
+      const Profile p = shock_profile(zs, w);
+      const auto shock = find_shock(p);
+      ASSERT_TRUE(shock.has_value());
+      EXPECT_LE(std::abs(shock->location - zs), 0.5 * p.bin_height) << shock->location;
+      EXPECT_LT(shock->compressed_top, zs);
+      EXPECT_GT(shock->undisturbed_bottom, zs);
+      EXPECT_DOUBLE_EQ(shock->width, shock->undisturbed_bottom - shock->compressed_top);
+      // The mean free path is taken at the shock location: n interpolated between the two
+      // bins around it, so within the range of n of those bins.
+      const auto k = static_cast<std::size_t>(shock->location / p.bin_height - 1.0 + 0.5);
+      ASSERT_NEAR(0.5 * (p.z[k] + p.z[k + 1]), shock->location, 1e-12);
+      EXPECT_DOUBLE_EQ(shock->mean_free_path, model::mean_free_path(0.5 * (p.n[k] + p.n[k + 1])));
+      EXPECT_DOUBLE_EQ(shock->width_over_mfp(), shock->width / shock->mean_free_path);
+    }
+}
+
+TEST(FindShock, WidthGrowsWithTheTanhWidth) {
+  double previous = 0.0;
+  for (double w : {0.5, 1.0, 2.0, 3.0}) {
+    const auto shock = find_shock(shock_profile(14.0, w));
+    ASSERT_TRUE(shock.has_value()) << "w = " << w;
+    EXPECT_GT(shock->width, previous) << "w = " << w;
+    // Each end of the discrete region lies within half a bin of the continuous extremum.
+    EXPECT_NEAR(shock->width, continuous_shock_width(w), 1.0) << "w = " << w;
+    std::printf("[measured] tanh width %.1f: d = %.2f (continuous %.2f)\n", w, shock->width,
+                continuous_shock_width(w));
+    previous = shock->width;
+  }
+}
+
+TEST(FindShock, CountsAShockWhoseCompressedRegionIsThinnerThanABin) {
+  // The temperature maximum sits in the lowest bin above the plate (physics.md).
+  const auto shock = find_shock(shock_profile(1.0, 0.3));
+  ASSERT_TRUE(shock.has_value());
+  EXPECT_EQ(shock->compressed_top, 0.5);
+  EXPECT_EQ(shock->location, 1.0);
+}
+
+TEST(FindShock, ReportsNoneForAMonotoneTemperature) {
+  const Profile p = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                                 [](double z) { return 0.2 + 0.1 * z; }, [](double) { return 0.0; });
+  EXPECT_FALSE(find_shock(p).has_value());
+  // Also when it falls monotonically with height (a layer heated from above is not a shock).
+  const Profile falling = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                                       [](double z) { return 8.0 - 0.1 * z; },
+                                       [](double) { return 0.0; });
+  EXPECT_FALSE(find_shock(falling).has_value());
+}
+
+double gaussian_layer(double z) { return 0.4 * std::exp(-0.5 * std::pow((z - 25.0) / 4.0, 2)); }
+
+TEST(FindShock, ReportsNoneForAUniformlyHotFlyingLayer) {
+  EXPECT_FALSE(find_shock(make_profile(gaussian_layer, [](double) { return 3.0; },
+                                       [](double) { return 1.5; }))
+                   .has_value());
+  // MD style: the empty bins above and below the layer report T = 0.
+  const Profile md = make_profile(gaussian_layer,
+                                  [](double z) { return gaussian_layer(z) > 1e-3 ? 3.0 : 0.0; },
+                                  [](double) { return 1.5; });
+  EXPECT_FALSE(find_shock(md).has_value());
+}
+
+TEST(FindShock, ReportsNoneForTheHotDiluteLowerEdgeOfAFallingLayer) {
+  // T is high where the layer is dilute (both edges) and lowest in its dense middle; the fall
+  // from the hot lower edge into the dense middle is not a shock.
+  const Profile p = make_profile(gaussian_layer,
+                                 [](double z) { return 0.5 + 2.0 * (1.0 - gaussian_layer(z) / 0.4); },
+                                 [](double) { return -3.0; });
+  EXPECT_FALSE(find_shock(p).has_value());
+}
+
+TEST(FindShock, AStandardErrorLargerThanTheDropMeansNoShock) {
+  Profile p = shock_profile(14.0, 1.0);
+  ASSERT_TRUE(find_shock(p).has_value());
+  // The same profile measured with errors of 2 in every bin: a drop of 5 is < 3 * 2 sqrt(2).
+  p.T_se.assign(p.size(), 2.0);
+  EXPECT_FALSE(find_shock(p).has_value());
+  // Errors of 0.1: the drop of 5 and the rise above the trough (0.05 per bin, 0.42 needed)
+  // both stand out of the noise again.
+  p.T_se.assign(p.size(), 0.1);
+  EXPECT_TRUE(find_shock(p).has_value());
+}
+
+/// MD-like sampling noise: the counts of a 20 x 20 box over 10 cycles, per-bin standard errors
+/// sqrt(n / samples) for n and T sqrt(2 / (3 samples)) for T, Gaussian noise of that size.
+Profile with_md_noise(const Profile& clean, std::uint64_t seed) {
+  std::mt19937_64 random(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Profile p = clean;
+  p.samples.assign(p.size(), 0.0);
+  p.n_se.assign(p.size(), 0.0);
+  p.uz_se.assign(p.size(), 0.0);
+  p.T_se.assign(p.size(), 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double samples = std::floor(clean.n[i] * 400.0 * p.bin_height * 10.0);
+    p.samples[i] = samples;
+    if (samples < 2.0) {  // an empty bin: MD has nothing to report
+      p.n[i] = p.nu[i] = p.uz[i] = p.T[i] = 0.0;
+      continue;
+    }
+    p.n_se[i] = clean.n[i] / std::sqrt(samples);
+    p.T_se[i] = clean.T[i] * std::sqrt(2.0 / (3.0 * samples));
+    p.uz_se[i] = std::sqrt(clean.T[i] / samples);
+    p.n[i] = std::max(0.0, clean.n[i] + p.n_se[i] * normal(random));
+    p.nu[i] = volume_fraction(p.n[i]);
+    p.T[i] = std::max(0.0, clean.T[i] + p.T_se[i] * normal(random));
+    p.uz[i] = clean.uz[i] + p.uz_se[i] * normal(random);
+  }
+  return p;
+}
+
+TEST(FindShock, MdLikeNoiseDoesNotProduceAShock) {
+  const Profile resting = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                                       [](double z) { return 0.2 + 0.1 * z; },
+                                       [](double) { return 0.0; });
+  const Profile flying = make_profile(gaussian_layer, [](double) { return 3.0; },
+                                      [](double) { return -1.0; });
+  const Profile falling = make_profile(
+      gaussian_layer, [](double z) { return 0.5 + 2.0 * (1.0 - gaussian_layer(z) / 0.4); },
+      [](double) { return -3.0; });
+  int spurious = 0;
+  for (std::uint64_t seed = 1; seed <= 200; ++seed)
+    for (const Profile* clean : {&resting, &flying, &falling}) {
+      const auto shock = find_shock(with_md_noise(*clean, seed));
+      if (shock) {
+        ++spurious;
+        ADD_FAILURE() << "seed " << seed << ": spurious shock at " << shock->location;
+      }
+    }
+  std::printf("[measured] spurious shocks in 600 noisy shock-free profiles: %d\n", spurious);
+}
+
+TEST(FindShock, FindsARealShockThroughMdLikeNoise) {
+  // Noise can make the neighbouring pair of bins the steepest, so a noisy location may sit on
+  // the bin edge next to the nearest one: within one bin of the centre, and mostly within half.
+  int found = 0, within_half_bin = 0;
+  double worst = 0.0;
+  for (std::uint64_t seed = 1; seed <= 100; ++seed) {
+    const auto shock = find_shock(with_md_noise(shock_profile(13.4, 1.0), seed));
+    if (!shock) continue;
+    ++found;
+    const double error = std::abs(shock->location - 13.4);
+    worst = std::max(worst, error);
+    if (error <= 0.5) ++within_half_bin;
+  }
+  EXPECT_EQ(found, 100);
+  EXPECT_LT(worst, 1.0);
+  EXPECT_GE(within_half_bin, 90);
+  std::printf("[measured] noisy tanh shock: found %d / 100, %d within half a bin, worst location "
+              "error %.2f\n", found, within_half_bin, worst);
+}
+
+// ---- layer, centre of mass, Mach number --------------------------------------------------------
+
+TEST(FindLayer, InterpolatesTheThresholdCrossings) {
+  // A tent nu = 0.4 - 0.05 |z - 15|, linear between bin centres around both crossings of
+  // 0.026: |z - 15| = (0.4 - 0.026) / 0.05 = 7.48.
+  const Profile p = make_profile([](double z) { return std::max(0.0, 0.4 - 0.05 * std::abs(z - 15.0)); },
+                                 [](double) { return 1.0; }, [](double) { return 0.0; }, 40);
+  const auto layer = find_layer(p);
+  ASSERT_TRUE(layer.has_value());
+  EXPECT_NEAR(layer->bottom, 15.0 - 7.48, 1e-12);
+  EXPECT_NEAR(layer->top, 15.0 + 7.48, 1e-12);
+  EXPECT_DOUBLE_EQ(layer_volume_fraction, 0.04 * nu_max);
+}
+
+TEST(FindLayer, ALayerTouchingTheEndsOfTheGridAndNoLayer) {
+  const Profile full = make_profile([](double) { return 0.3; }, [](double) { return 1.0; },
+                                    [](double) { return 0.0; }, 10, 0.5, 2.0);
+  const auto layer = find_layer(full);
+  ASSERT_TRUE(layer.has_value());
+  EXPECT_DOUBLE_EQ(layer->bottom, 2.0);  // the lower edge of the lowest bin
+  EXPECT_DOUBLE_EQ(layer->top, 7.0);     // the upper edge of the highest bin
+  const Profile gas = make_profile([](double) { return 0.02; }, [](double) { return 1.0; },
+                                   [](double) { return 0.0; });
+  EXPECT_FALSE(find_layer(gas).has_value());
+}
+
+TEST(CenterOfMass, MatchesClosedFormForAnExponentialAtmosphere) {
+  // n_i = q^i on centres (i + 1/2) h: sum i q^i / sum q^i in closed form.
+  const double L = 3.0, h = 0.5;
+  const std::size_t N = 80;
+  const Profile p = make_profile([&](double z) { return volume_fraction(std::exp(-z / L)); },
+                                 [](double) { return 1.0; }, [](double) { return 0.0; }, N, h);
+  const double q = std::exp(-h / L), Nd = static_cast<double>(N);
+  const double s0 = (1.0 - std::pow(q, Nd)) / (1.0 - q);
+  const double s1 = q * (1.0 - Nd * std::pow(q, Nd - 1.0) + (Nd - 1.0) * std::pow(q, Nd)) /
+                    ((1.0 - q) * (1.0 - q));
+  EXPECT_NEAR(center_of_mass(p), h * (0.5 + s1 / s0), 1e-12);
+  // A uniform slab from 0 to 10 has its centre at 5.
+  const Profile slab = make_profile([](double z) { return z < 10.0 ? 0.3 : 0.0; },
+                                    [](double) { return 1.0; }, [](double) { return 0.0; }, 30);
+  EXPECT_NEAR(center_of_mass(slab), 5.0, 1e-12);
+  EXPECT_TRUE(std::isnan(center_of_mass(Profile{})));  // no material, no centre
+}
+
+TEST(MachNumber, IsTheSpeedRelativeToThePlateOverTheSoundSpeed) {
+  // Sound speeds at (nu, T, e = 0.9) from the 50-digit references of reference_values.inc.
+  const double c_dilute = 1.295917251137339270791543;  // nu = 1e-3, T = 1
+  const double c_mid = 3.898836954843631951455982;     // nu = 0.3,  T = 1
+  const double c_dense = 25.46671270814647921479268;   // nu = 0.6,  T = 0.5
+  Profile p;
+  p.plate_v = 1.25;
+  p.z = {0.5, 1.5, 2.5, 3.5, 4.5, 5.5};
+  p.nu = {1e-3, 0.3, 0.6, 0.0, 0.3, 0.3};
+  p.T = {1.0, 1.0, 0.5, 1.0, 0.0, 1.0};
+  p.uz = {-2.0, 1.25, 3.0, 7.0, 7.0, -0.75};
+  for (double nu : p.nu) p.n.push_back(number_density(nu));
+  const auto ma = mach_number(p, 0.9);
+  ASSERT_EQ(ma.size(), p.size());
+  EXPECT_NEAR(ma[0], 3.25 / c_dilute, 1e-12);
+  EXPECT_EQ(ma[1], 0.0);  // moving with the plate
+  EXPECT_NEAR(ma[2], 1.75 / c_dense, 1e-12);
+  EXPECT_EQ(ma[3], 0.0);  // no material
+  EXPECT_EQ(ma[4], 0.0);  // no temperature
+  EXPECT_NEAR(ma[5], 2.0 / c_mid, 1e-12);
+  // Only bins inside the layer count for the maximum (bin 0 is too dilute).
+  EXPECT_NEAR(max_mach_in_layer(p, 0.9), 2.0 / c_mid, 1e-12);
+}
+
+TEST(MachNumber, AnOverpackedMdBinDoesNotStopTheAnalysis) {
+  // An MD bin can hold more than nu_max (ordered layers on the plate reach 0.74). The sound
+  // speed diverges as nu -> nu_max, so Ma -> 0 there; the analysis must not throw.
+  Profile p;
+  p.z = {0.5, 1.5};
+  p.nu = {0.70, 0.3};
+  p.T = {0.1, 1.0};
+  p.uz = {0.5, -0.75};
+  p.plate_v = 1.25;
+  for (double nu : p.nu) p.n.push_back(number_density(nu));
+  std::vector<double> ma;
+  ASSERT_NO_THROW(ma = mach_number(p, 0.9));
+  EXPECT_EQ(ma[0], 0.0);
+  EXPECT_NEAR(ma[1], 2.0 / 3.898836954843631951455982, 1e-12);
+  EXPECT_NO_THROW(summarize(p, 0.9));
+}
+
+// ---- shock speed ------------------------------------------------------------------------------
+
+Profile at(double time, double plate_z, Profile p) {
+  p.time = time;
+  p.plate_z = plate_z;
+  return p;
+}
+
+TEST(ShockSpeed, RecoversAKnownSpeedInThePlateFrame) {
+  // The shock sits on bin edges z = 10 + k at t = k / 2 while the plate rises by k / 4: the
+  // speed relative to the plate is (1 - 1/4) / (1/2) = 1.5 exactly.
+  std::vector<Profile> profiles;
+  const Profile calm = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                                    [](double z) { return 0.2 + 0.1 * z; },
+                                    [](double) { return 0.0; });
+  profiles.push_back(at(-0.5, 0.0, calm));  // before the shock forms
+  for (int k = 0; k < 9; ++k)
+    profiles.push_back(at(0.5 * k, 0.25 * k, shock_profile(10.0 + k, 0.6)));
+  profiles.push_back(at(5.0, 2.5, calm));  // the shock has left the layer
+  profiles.push_back(at(5.5, 2.75, shock_profile(30.0, 0.6)));  // a later one is not averaged
+  const auto speed = shock_speed(profiles);
+  ASSERT_TRUE(speed.has_value());
+  EXPECT_NEAR(*speed, 1.5, 1e-12);
+
+  // Off the bin edges the location is quantised to half a bin; the fitted speed stays close.
+  std::vector<Profile> moving;
+  for (int k = 0; k < 10; ++k)
+    moving.push_back(at(0.5 * k, 0.0, shock_profile(10.3 + 0.85 * k, 0.8)));
+  const auto fitted = shock_speed(moving);
+  ASSERT_TRUE(fitted.has_value());
+  EXPECT_NEAR(*fitted, 1.7, 0.1);
+  std::printf("[measured] shock speed 1.7 off the bin edges: fitted %.4f\n", *fitted);
+  // Fewer than two phases with a shock: no speed.
+  EXPECT_FALSE(shock_speed({calm, at(1.0, 0.0, shock_profile(12.0, 1.0)), calm}).has_value());
+}
+
+// ---- agreement metrics ------------------------------------------------------------------------
+
+TEST(SeriesDifference, KnownInputs) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto d = series_difference({1.0, 2.0, 3.0, nan, 7.0}, {1.0, 2.0, 5.0, 4.0, nan});
+  EXPECT_EQ(d.count, 3u);  // only where both exist
+  EXPECT_NEAR(d.absolute_rms, std::sqrt(4.0 / 3.0), 1e-15);
+  EXPECT_NEAR(d.fractional_rms, std::sqrt(4.0 / 30.0), 1e-15);  // / sqrt((1 + 4 + 25) / 3)
+  const auto none = series_difference({nan, 1.0}, {2.0, nan});
+  EXPECT_EQ(none.count, 0u);
+  EXPECT_EQ(none.absolute_rms, 0.0);
+  EXPECT_THROW(series_difference({1.0}, {1.0, 2.0}), std::invalid_argument);
+  EXPECT_TRUE(std::isnan(series_difference({1.0}, {0.0}).fractional_rms));
+}
+
+TEST(ProfileDifference, KnownInputs) {
+  // b is linear in z on a shifted grid, so interpolating it at a's heights is exact.
+  const Profile b = make_profile([](double z) { return 0.1 + 0.01 * z; },
+                                 [](double z) { return 2.0 - 0.03 * z; }, [](double) { return 0.0; },
+                                 20, 1.0, 0.25);
+  const Profile a = make_profile([](double z) { return 0.12 + 0.01 * z; },
+                                 [](double z) { return 2.0 - 0.03 * z + (z < 10.0 ? 0.5 : -1.0); },
+                                 [](double) { return 0.0; }, 22, 1.0, 0.0);
+  const auto nu = profile_difference(a, b, "nu");
+  // a's centres 0.5 .. 21.5, b covers 0.75 .. 19.75: a's 1.5 .. 19.5 count.
+  EXPECT_EQ(nu.count, 19u);
+  EXPECT_NEAR(nu.l1, 0.02, 1e-14);
+  EXPECT_NEAR(nu.l2, 0.02, 1e-14);
+  EXPECT_NEAR(nu.linf, 0.02, 1e-14);
+  const auto T = profile_difference(a, b, "T");
+  // 9 heights below 10 differ by 0.5, 10 above by 1.
+  EXPECT_NEAR(T.l1, (9 * 0.5 + 10 * 1.0) / 19.0, 1e-13);
+  EXPECT_NEAR(T.l2, std::sqrt((9 * 0.25 + 10 * 1.0) / 19.0), 1e-13);
+  EXPECT_NEAR(T.linf, 1.0, 1e-13);
+  EXPECT_THROW(profile_difference(a, b, "uz"), std::invalid_argument);
+}
+
+RunRecord run_of(const std::vector<Profile>& profiles) {
+  RunRecord r;
+  r.profiles = profiles;
+  return r;
+}
+
+std::vector<Profile> shock_run(double shift) {
+  std::vector<Profile> profiles;
+  for (int k = 0; k < 8; ++k) {
+    Profile p = k < 6 ? shock_profile(10.0 + k + shift, 0.8)
+                      : make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                                     [](double z) { return 0.2 + 0.1 * z; },
+                                     [](double) { return 0.0; });
+    p.phase = 0.125 * k;
+    p.time = 10.0 + p.phase;
+    profiles.push_back(p);
+  }
+  return profiles;
+}
+
+TEST(CompareRuns, ARunComparedWithItselfGivesZeros) {
+  const RunRecord a = run_of(shock_run(0.0));
+  const auto r = compare_runs(a, a);
+  EXPECT_EQ(r.phases.size(), 8u);
+  EXPECT_EQ(r.shock_location.count, 6u);
+  EXPECT_EQ(r.shock_location.absolute_rms, 0.0);
+  EXPECT_EQ(r.shock_location.fractional_rms, 0.0);
+  EXPECT_EQ(r.center_of_mass.count, 8u);
+  EXPECT_EQ(r.center_of_mass.absolute_rms, 0.0);
+  EXPECT_EQ(r.center_of_mass.fractional_rms, 0.0);
+  for (std::size_t k = 0; k < r.phases.size(); ++k) {
+    EXPECT_EQ(r.nu_norms[k].linf, 0.0);
+    EXPECT_EQ(r.T_norms[k].l1, 0.0);
+    EXPECT_EQ(r.T_norms[k].count, 60u);
+  }
+}
+
+TEST(CompareRuns, AShockDisplacedByOneBinGivesThatDifference) {
+  const RunRecord a = run_of(shock_run(1.0)), b = run_of(shock_run(0.0));
+  const auto r = compare_runs(a, b);
+  EXPECT_EQ(r.shock_location.count, 6u);
+  EXPECT_NEAR(r.shock_location.absolute_rms, 1.0, 1e-12);
+  double reference = 0.0;  // rms of b's locations 10 .. 15
+  for (int k = 0; k < 6; ++k) reference += (10.0 + k) * (10.0 + k) / 6.0;
+  EXPECT_NEAR(r.shock_location.fractional_rms, 1.0 / std::sqrt(reference), 1e-12);
+  EXPECT_GT(r.center_of_mass.absolute_rms, 0.0);
+
+  RunRecord fewer = b;
+  fewer.profiles.pop_back();
+  EXPECT_THROW(compare_runs(a, fewer), std::invalid_argument);
+  RunRecord shifted = b;
+  shifted.profiles[3].phase += 0.01;
+  EXPECT_THROW(compare_runs(a, shifted), std::invalid_argument);
+}
+
+}  // namespace
