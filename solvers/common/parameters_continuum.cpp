@@ -19,6 +19,28 @@ std::vector<ParameterSpec> continuum_parameters() {
       real("continuum.cfl", 0.4, positive(1.0), "Courant number of the adaptive step"),
       real("continuum.perturbation", 1e-3, closed(0.0, 0.5),
            "3D: relative amplitude of the seeded random perturbation of the initial layer"),
+      real("continuum.initial_temperature", 1e-2, positive(1e6),
+           "temperature of the initial layer and background gas"),
+      real("continuum.background_volume_fraction", 1e-5, Range{0.0, 0.1, true, false},
+           "volume fraction of the dilute gas above the initial layer"),
+      integer("continuum.integrator_order", 2, closed(2, 3), "SSP Runge-Kutta order (2 or 3)"),
+      real("continuum.diffusion_number", 0.8, positive(1.0),
+           "time step as a fraction of the forward-Euler diffusive limit h^2 / (2 dim D)"),
+      text("continuum.diffusion_integrator", "auto", {"auto", "explicit", "rkl2"},
+           "diffusive terms: explicit in the SSP-RK step, or Strang-split RKL2 super time "
+           "stepping; auto = rkl2 for full transport, explicit for paper"),
+      real("continuum.temperature_floor", 1e-12, positive(1.0),
+           "lowest temperature; every raise to it is counted and reported"),
+      real("continuum.artificial_viscosity", 0.5, at_least(0.0, 100.0),
+           "paper transport: mu_art = coefficient * n h c / (1 + (nu / nu_art)^4)"),
+      real("continuum.artificial_conductivity", 0.5, at_least(0.0, 100.0),
+           "paper transport: kappa_art = coefficient * n h c / (1 + (nu / nu_art)^4)"),
+      real("continuum.artificial_volume_fraction", 0.01, positive(0.65),
+           "paper transport: nu_art, the volume fraction below which artificial dissipation acts"),
+      real_list("continuum.field_phases", {}, closed(0.0, 1.0),
+                "3D: phases f t of the last sampled cycle whose full fields are written (HDF5 + XDMF)"),
+      text("continuum.checkpoint", "", {}, "file for the final state (empty: none)"),
+      text("continuum.restart", "", {}, "checkpoint to start from (empty: the flat layer)"),
   };
 }
 

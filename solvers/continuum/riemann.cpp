@@ -6,6 +6,7 @@
 // reconstruct T itself. At wall faces only the normal momentum flux
 // (the wall pressure) survives; mass, energy and tangential momentum fluxes are exactly zero,
 // so mass is conserved to round-off.
+#include <algorithm>
 #include <utility>
 
 #include "continuum/reconstruct.hpp"
@@ -37,6 +38,12 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
                              w[2].data(),  w[3].data(),
                              pressure ? closure.p.data() : w[4].data(),
                              closure.chi.data(), closure.c.data()};
+  // First-order face state: n, u, T, p, c of the cell itself.
+  const auto cell_state = [&](std::ptrdiff_t c, double* state) {
+    for (int v = 0; v < 5; ++v) state[v] = w[v][c];
+    state[5] = closure.p[c];
+    state[6] = closure.c[c];
+  };
   for (int d = g.first_direction(); d < 3; ++d) {
     const std::ptrdiff_t s = g.stride(d);
     const Pencils P = pencils_of(g, d);
@@ -60,6 +67,16 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
           std::swap(right[4], right[5]);
           left[4] = left[5] / (left[0] * left[4]);
           right[4] = right[5] / (right[0] * right[4]);
+          // Near vacuum the independently limited n, p and chi can combine into a face
+          // temperature outside the neighbouring cells' range; such a side falls back to its
+          // cell average (first order there), which keeps the flux positivity preserving.
+          const double* T = w[4].data();
+          if (!(left[4] >= std::min({T[cL - s], T[cL], T[cR]}) &&
+                left[4] <= std::max({T[cL - s], T[cL], T[cR]})))
+            cell_state(cL, left);
+          if (!(right[4] >= std::min({T[cL], T[cR], T[cR + s]}) &&
+                right[4] <= std::max({T[cL], T[cR], T[cR + s]})))
+            cell_state(cR, right);
         } else {
           left[5] = right[5] = 0.0;
         }

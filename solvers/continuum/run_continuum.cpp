@@ -1,10 +1,171 @@
+// `shaker continuum CASE.toml`: the run protocols of the MD solver on the continuum model.
+//  periodic:     transient cycles, then sampled cycles; profiles at phases k / K averaged over
+//                the sampled cycles; the periodicity check compares each phase's centre of
+//                mass with the same phase one cycle earlier.
+//  single_shock: transient cycles, e switched at run.switch_phase before the recorded cycle,
+//                then one recorded cycle.
 #include "continuum/run_continuum.hpp"
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <limits>
+
+#include "common/errors.hpp"
+#include "common/run_file.hpp"
+#include "continuum/checkpoint.hpp"
+#include "continuum/output.hpp"
+#include "continuum/setup.hpp"
+
 namespace shaker::continuum {
-int run(const config::Config&) {
-  fmt::print(stderr, "shaker continuum: the continuum solver is not implemented yet (issue 4)\n");
-  return 3;
+
+namespace {
+
+struct Recorder {
+  std::vector<double> time, phase, com, mass, kinetic, thermal, potential, loss_rate, com_change,
+      floor_uses, steps;
+  void add(const TimeIntegrator& solver, const ShakerKinematics& shaker, std::size_t phases) {
+    const Diagnostics d = diagnostics(solver, shaker);
+    time.push_back(solver.time());
+    phase.push_back(shaker.phase(solver.time()));
+    com.push_back(d.center_of_mass);
+    mass.push_back(d.mass);
+    kinetic.push_back(d.kinetic);
+    thermal.push_back(d.thermal);
+    potential.push_back(d.potential);
+    loss_rate.push_back(d.loss_rate);
+    com_change.push_back(com.size() > phases ? d.center_of_mass - com[com.size() - 1 - phases]
+                                             : std::numeric_limits<double>::quiet_NaN());
+    floor_uses.push_back(static_cast<double>(solver.counters().temperature_floor_uses));
+    steps.push_back(static_cast<double>(solver.counters().steps));
+  }
+  TimeSeries series() const {
+    TimeSeries s;
+    s.add("time", time);
+    s.add("phase", phase);
+    s.add("center_of_mass", com);
+    s.add("total_mass", mass);
+    s.add("kinetic_energy", kinetic);
+    s.add("thermal_energy", thermal);
+    s.add("potential_energy", potential);
+    s.add("collisional_loss_rate", loss_rate);
+    s.add("center_of_mass_change_from_previous_cycle", com_change);
+    s.add("temperature_floor_uses", floor_uses);
+    s.add("steps", steps);
+    return s;
+  }
+  /// RMS over the last cycle's phases of the change from the previous cycle, / RMS height.
+  double periodicity(std::size_t phases) const {
+    if (com.size() < 2 * phases) return std::numeric_limits<double>::quiet_NaN();
+    double d2 = 0, h2 = 0;
+    for (std::size_t i = com.size() - phases; i < com.size(); ++i) {
+      d2 += com_change[i] * com_change[i];
+      h2 += com[i] * com[i];
+    }
+    return std::sqrt(d2 / h2);
+  }
+};
+
+void accumulate(Profile& sum, const Profile& p, bool first) {
+  if (first) {
+    sum = p;
+    return;
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    sum.n[i] += p.n[i];
+    sum.nu[i] += p.nu[i];
+    sum.uz[i] += p.uz[i];
+    sum.T[i] += p.T[i];
+  }
 }
+
+void finish_average(Profile& p, double count) {
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.n[i] /= count;
+    p.nu[i] /= count;
+    p.uz[i] /= count;
+    p.T[i] /= count;
+  }
+}
+
+int execute(const config::Config& config) {
+  const ContinuumCase c = continuum_case(config);
+  const RunProtocol& run = c.parameters.run;
+  const ShakerKinematics& shaker = c.parameters.shaker;
+  TimeIntegrator solver = make_solver(c);
+  if (!c.restart.empty()) read_checkpoint(c.restart, solver);
+  const std::filesystem::path output = run.output;
+  const double period = shaker.period();
+  const std::size_t K = static_cast<std::size_t>(run.phases_per_cycle);
+  const bool single = run.kind == RunProtocol::Kind::single_shock;
+  const std::int64_t sampled = single ? 1 : run.sampled_cycles;
+  const std::int64_t cycles = run.transient_cycles + sampled;
+  const double start = solver.time();
+  const double switch_time = start + (static_cast<double>(run.transient_cycles) + run.switch_phase) * period;
+  bool switched = false;
+
+  Recorder recorder;
+  std::vector<Profile> profiles(K);
+  std::vector<FieldSnapshot> fields;
+  try {
+    for (std::int64_t cycle = 0; cycle < cycles; ++cycle) {
+      const bool sampling = cycle >= run.transient_cycles;
+      for (std::size_t k = 0; k < K; ++k) {
+        const double target = start + (static_cast<double>(cycle) + static_cast<double>(k) / static_cast<double>(K)) * period;
+        if (single && !switched && target >= switch_time) {
+          solver.advance_to(switch_time);
+          solver.op().settings().e = run.after_switch.e;
+          switched = true;
+        }
+        solver.advance_to(target);
+        recorder.add(solver, shaker, K);
+        if (!sampling) continue;
+        accumulate(profiles[k], horizontal_profile(solver, shaker), cycle == run.transient_cycles);
+        if (c.grid.dimension == 3 && cycle == cycles - 1)
+          for (double phase : c.field_phases)
+            if (static_cast<std::size_t>(std::lround(phase * static_cast<double>(K))) % K == k)
+              fields.push_back(snapshot(solver, shaker));
+      }
+    }
+    solver.advance_to(start + static_cast<double>(cycles) * period);
+  } catch (const StepFailure& failure) {
+    std::filesystem::path last_good = output;
+    last_good.replace_extension(".last_good.h5");
+    write_checkpoint(last_good, solver, config.to_toml());
+    fmt::print(stderr, "shaker continuum: {}\nThe last good state is in {}\n", failure.what(),
+               last_good.string());
+    return 1;
+  }
+  for (auto& p : profiles) finish_average(p, static_cast<double>(sampled));
+
+  RunRecord record;
+  record.solver = "continuum";
+  record.model_variant = fmt::format("{} transport, {}D", model::to_string(c.physics.transport),
+                                     c.grid.dimension);
+  record.configuration = config.to_toml();
+  record.e = c.parameters.restitution.e;
+  record.profiles = std::move(profiles);
+  record.series = recorder.series();
+  if (!fields.empty()) {
+    std::filesystem::path fields_path = output;
+    fields_path.replace_extension(".fields.h5");
+    write_fields(fields_path, c.grid, fields);
+  }
+  if (!c.checkpoint.empty()) write_checkpoint(c.checkpoint, solver, config.to_toml());
+  write_run_file(output, record);
+  const Counters& counters = solver.counters();
+  fmt::print("shaker continuum: {} cycles to t = {:.6g}, {} steps ({} rejected), temperature floor "
+             "used {} times; mass drift {:.3e}; periodicity (centre of mass, last two cycles) {:.3e}\n"
+             "wrote {}\n",
+             cycles, solver.time(), counters.steps, counters.rejected_steps,
+             counters.temperature_floor_uses,
+             (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
+             recorder.periodicity(K), output.string());
+  return 0;
+}
+
+}  // namespace
+
+int run(const config::Config& config) { return execute(config); }
+
 }  // namespace shaker::continuum

@@ -1,6 +1,7 @@
 #pragma once
 // Conserved variables per cell (structure of arrays): number density n (= mass density,
 // particle mass 1), momentum n u, and total energy E = (3/2) n T + (1/2) n |u|^2.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -30,7 +31,8 @@ inline Primitive to_primitive(const State& s, std::size_t c) {
   w.uz = s.q[momentum_z][c] * inv;
   const double kinetic = 0.5 * (s.q[momentum_x][c] * w.ux + s.q[momentum_y][c] * w.uy +
                                 s.q[momentum_z][c] * w.uz);
-  w.T = (s.q[energy][c] - kinetic) * inv / 1.5;
+  // E - kinetic loses digits in fast, cold, dilute cells: a round-off negative is zero.
+  w.T = std::max(0.0, (s.q[energy][c] - kinetic) * inv / 1.5);
   return w;
 }
 

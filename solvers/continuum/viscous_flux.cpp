@@ -1,13 +1,23 @@
 // Viscous stress and heat flux through each face, centred and second order:
 //   P = -p I + tau,  tau = (lambda - 2 mu / 3) (div u) I + 2 mu E,   q = -kappa grad T.
 // Normal derivatives at a face are the difference of the two cells; tangential ones the mean
-// of the two cells' central differences; coefficients the mean of the two cells. In 1D the
+// of the two cells' central differences; coefficients the harmonic mean of the two cells: at the edge of the layer (a dense
+// cell beside a near-vacuum one) an arithmetic mean would drive the dilute cell with the
+// dense cell's diffusivity, far beyond the per-cell stability limit; the harmonic mean stays
+// below twice the smaller coefficient and is second order all the same. In 1D the
 // tangential derivatives are zero, which is exactly what the 3D kernel computes for a
 // horizontally uniform state. At walls the heat, energy and tangential momentum fluxes are
 // zero (no heat through the walls, zero normal gradient of the tangential velocity).
 #include "continuum/operator.hpp"
 
 namespace shaker::continuum {
+
+namespace {
+inline double harmonic_mean(double a, double b) {
+  const double sum = a + b;
+  return sum > 0.0 ? 2.0 * a * b / sum : 0.0;
+}
+}  // namespace
 
 void Operator::add_diffusive_fluxes(State& dUdt) {
   const Grid& g = grid_;
@@ -41,9 +51,9 @@ void Operator::add_diffusive_fluxes(State& dUdt) {
             grad[i][t] = 0.25 * inv_h * (u[i][cL + st] - u[i][cL - st] + u[i][cR + st] - u[i][cR - st]);
           }
         }
-        const double mu_f = 0.5 * (mu[cL] + mu[cR]);
-        const double lambda_f = 0.5 * (lambda[cL] + lambda[cR]);
-        const double kappa_f = 0.5 * (kappa[cL] + kappa[cR]);
+        const double mu_f = harmonic_mean(mu[cL], mu[cR]);
+        const double lambda_f = harmonic_mean(lambda[cL], lambda[cR]);
+        const double kappa_f = harmonic_mean(kappa[cL], kappa[cR]);
         const double divergence = grad[0][0] + grad[1][1] + grad[2][2];
         double flux[variable_count] = {0, 0, 0, 0, 0};
         double work = 0.0;

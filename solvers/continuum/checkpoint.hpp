@@ -1,0 +1,17 @@
+#pragma once
+// Checkpoints: the interior state, the time and the step counters in HDF5 (written
+// atomically). Restarting from one continues bit for bit like the uninterrupted run, since
+// the step sequence depends only on the state and the target times.
+#include <filesystem>
+#include <string>
+
+#include "continuum/time_integrator.hpp"
+
+namespace shaker::continuum {
+
+void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
+                      const std::string& configuration_toml);
+/// Loads a checkpoint into the solver; throws InputError if it does not match the grid.
+void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver);
+
+}  // namespace shaker::continuum

@@ -1,0 +1,128 @@
+// Exact solutions of verification.md for the granular model: homogeneous cooling (Haff's
+// law, and the integrator's temporal order) and the hydrostatic rest state (spurious
+// velocities converge at the scheme's order).
+#include <cmath>
+
+#include "support.hpp"
+
+namespace shaker::continuum::testing {
+namespace {
+
+double haff_error(int order, double dt, double t_end, double& T_end) {
+  PhysicsSettings physics;
+  physics.e = 0.9;
+  physics.terms.gravity = physics.terms.frame_force = false;
+  IntegratorSettings integration;
+  integration.order = order;
+  integration.fixed_dt = dt;
+  const Grid g = column(8, 8.0);
+  TimeIntegrator solver(g, physics, integration);
+  const double nu = 0.3, T0 = 1.0;
+  for (int k = 0; k < g.nz; ++k)
+    store_primitive(solver.state(), g.index(0, 0, k), Primitive{number_density(nu), 0, 0, 0, T0});
+  solver.advance_to(t_end);
+  const double exact = model::haff_temperature(t_end, T0, model::G(nu), physics.e);
+  double worst = 0.0;
+  for (int k = 0; k < g.nz; ++k) {
+    T_end = to_primitive(solver.state(), g.index(0, 0, k)).T;
+    worst = std::max(worst, std::abs(T_end - exact) / exact);
+  }
+  return worst;
+}
+
+class Haff : public ::testing::TestWithParam<int> {};
+
+TEST_P(Haff, MatchesTheExactCoolingAtTheIntegratorsOrder) {
+  const int order = GetParam();
+  const double nu = 0.3, e = 0.9;
+  const double t0 = 1.0 / (4.0 / std::sqrt(pi) * (1 - e * e) * model::G(nu));
+  const double t_end = 3.0 * t0;  // T falls to T0 / 16
+  std::vector<double> dts, errors, temperatures;
+  for (int steps : {25, 50, 100, 200}) {
+    double T_end = 0;
+    dts.push_back(t_end / steps);
+    errors.push_back(haff_error(order, t_end / steps, t_end, T_end));
+    temperatures.push_back(T_end);
+    std::printf("SSP-RK%d dt = %.4g: relative error of T %.3e\n", order, dts.back(), errors.back());
+  }
+  const double observed = fitted_order(dts, errors);
+  std::printf("observed temporal order %.3f (design %d)\n", observed, order);
+  EXPECT_NEAR(observed, order, 0.1);
+  // The limit dt -> 0 is Haff's law itself: the Richardson extrapolation of the two finest
+  // steps removes the leading error term and must leave far less than the finest error.
+  const double fine = temperatures[3], coarse = temperatures[2];
+  const double extrapolated = fine + (fine - coarse) / (std::pow(2.0, order) - 1.0);
+  const double exact = model::haff_temperature(t_end, 1.0, model::G(nu), e);
+  const double residual = std::abs(extrapolated - exact) / exact;
+  std::printf("Richardson-extrapolated relative error %.3e (finest %.3e)\n", residual, errors.back());
+  EXPECT_LT(residual, 0.05 * errors.back());
+}
+INSTANTIATE_TEST_SUITE_P(Integrators, Haff, ::testing::Values(2, 3));
+
+// Isothermal hydrostatic profile of the model's equation of state: d p / dz = -n g with
+// p = n T chi(nu), i.e. dn/dz = -n g / (T (chi + nu dchi/dnu)); integrated with RK4.
+struct Hydrostatic {
+  double n0, T, e;
+  double slope(double n) const {
+    const double nu = volume_fraction(n);
+    return -n * gravity / (T * (model::chi(nu, e) + nu * model::dchi_dnu(nu, e)));
+  }
+  /// Average of n over [a, b] by integrating the ODE from z = 0 with fine steps.
+  std::vector<double> cell_averages(int cells, double height) const {
+    const int sub = 64;
+    const double dz = height / (cells * sub);
+    std::vector<double> averages(cells, 0.0);
+    double n = n0;
+    for (int k = 0; k < cells; ++k) {
+      double integral = 0.0;
+      for (int s = 0; s < sub; ++s) {
+        const double k1 = slope(n), k2 = slope(n + 0.5 * dz * k1), k3 = slope(n + 0.5 * dz * k2),
+                     k4 = slope(n + dz * k3);
+        const double next = n + dz / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+        // Simpson on the substep with the RK4 midpoint estimate
+        integral += dz / 6 * (n + 4 * (n + 0.5 * dz * k2) + next);
+        n = next;
+      }
+      averages[k] = integral / (height / cells);
+    }
+    return averages;
+  }
+};
+
+TEST(HydrostaticRest, SpuriousVelocitiesConvergeAtSecondOrder) {
+  const Hydrostatic profile{number_density(0.3), 1.0, 1.0};
+  const double height = 10.0, t_end = 4.0;
+  PhysicsSettings physics;
+  physics.e = 1.0;
+  physics.terms.frame_force = false;
+  physics.terms.artificial_dissipation = false;
+  std::vector<double> h, l1, linf;
+  for (int cells : {20, 40, 80, 160, 320}) {
+    const Grid g = column(cells, height);
+    TimeIntegrator solver(g, physics, IntegratorSettings{});
+    const auto n = profile.cell_averages(cells, height);
+    for (int k = 0; k < cells; ++k)
+      store_primitive(solver.state(), g.index(0, 0, k), Primitive{n[k], 0, 0, 0, profile.T});
+    solver.advance_to(t_end);
+    double sum = 0, worst = 0;
+    for (int k = 0; k < cells; ++k) {
+      const double u = std::abs(to_primitive(solver.state(), g.index(0, 0, k)).uz);
+      sum += u * g.h;
+      worst = std::max(worst, u);
+    }
+    h.push_back(g.h);
+    l1.push_back(sum / height);
+    linf.push_back(worst);
+    std::printf("hydrostatic h = %.4g: mean |u| %.3e, max |u| %.3e\n", g.h, l1.back(), worst);
+  }
+  const std::vector<double> hf(h.end() - 3, h.end());
+  const double order_l1 = fitted_order(hf, {l1.end() - 3, l1.end()});
+  const double order_linf = fitted_order(hf, {linf.end() - 3, linf.end()});
+  std::printf("observed orders: L1 %.3f, Linf %.3f (design 2)\n", order_l1, order_linf);
+  // At least the design order (the L1 norm converges faster while the transient decays).
+  EXPECT_GE(order_l1, 2.0 - 0.1);
+  EXPECT_GE(order_linf, 2.0 - 0.1);
+}
+
+}  // namespace
+}  // namespace shaker::continuum::testing
