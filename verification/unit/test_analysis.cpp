@@ -48,7 +48,9 @@ Profile shock_profile(double zs, double w, double plate_v = 1.0) {
   const auto layer_top = [zs](double z) { return step_down(z, zs + 14.0, 1.5); };
   Profile p = make_profile(
       [=](double z) { return (0.2 + 0.3 * step_down(z, zs, w)) * layer_top(z); },
-      [=](double z) { return 0.5 + temperature_slope * z + temperature_jump * step_down(z, zs, w); },
+      [=](double z) {
+        return 0.5 + temperature_slope * z + temperature_jump * step_down(z, zs, w);
+      },
       [=](double z) { return plate_v * step_down(z, zs, w) - 2.0 * (1.0 - step_down(z, zs, w)); });
   p.plate_v = plate_v;
   return p;
@@ -105,35 +107,37 @@ TEST(FindShock, CountsAShockWhoseCompressedRegionIsThinnerThanABin) {
 }
 
 TEST(FindShock, ReportsNoneForAMonotoneTemperature) {
-  const Profile p = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
-                                 [](double z) { return 0.2 + 0.1 * z; }, [](double) { return 0.0; });
+  const Profile p =
+      make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                   [](double z) { return 0.2 + 0.1 * z; }, [](double) { return 0.0; });
   EXPECT_FALSE(find_shock(p).has_value());
   // Also when it falls monotonically with height (a layer heated from above is not a shock).
-  const Profile falling = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
-                                       [](double z) { return 8.0 - 0.1 * z; },
-                                       [](double) { return 0.0; });
+  const Profile falling =
+      make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                   [](double z) { return 8.0 - 0.1 * z; }, [](double) { return 0.0; });
   EXPECT_FALSE(find_shock(falling).has_value());
 }
 
 double gaussian_layer(double z) { return 0.4 * std::exp(-0.5 * std::pow((z - 25.0) / 4.0, 2)); }
 
 TEST(FindShock, ReportsNoneForAUniformlyHotFlyingLayer) {
-  EXPECT_FALSE(find_shock(make_profile(gaussian_layer, [](double) { return 3.0; },
-                                       [](double) { return 1.5; }))
-                   .has_value());
+  EXPECT_FALSE(
+      find_shock(make_profile(
+                     gaussian_layer, [](double) { return 3.0; }, [](double) { return 1.5; }))
+          .has_value());
   // MD style: the empty bins above and below the layer report T = 0.
-  const Profile md = make_profile(gaussian_layer,
-                                  [](double z) { return gaussian_layer(z) > 1e-3 ? 3.0 : 0.0; },
-                                  [](double) { return 1.5; });
+  const Profile md = make_profile(
+      gaussian_layer, [](double z) { return gaussian_layer(z) > 1e-3 ? 3.0 : 0.0; },
+      [](double) { return 1.5; });
   EXPECT_FALSE(find_shock(md).has_value());
 }
 
 TEST(FindShock, ReportsNoneForTheHotDiluteLowerEdgeOfAFallingLayer) {
   // T is high where the layer is dilute (both edges) and lowest in its dense middle; the fall
   // from the hot lower edge into the dense middle is not a shock.
-  const Profile p = make_profile(gaussian_layer,
-                                 [](double z) { return 0.5 + 2.0 * (1.0 - gaussian_layer(z) / 0.4); },
-                                 [](double) { return -3.0; });
+  const Profile p = make_profile(
+      gaussian_layer, [](double z) { return 0.5 + 2.0 * (1.0 - gaussian_layer(z) / 0.4); },
+      [](double) { return -3.0; });
   EXPECT_FALSE(find_shock(p).has_value());
 }
 
@@ -178,11 +182,11 @@ Profile with_md_noise(const Profile& clean, std::uint64_t seed) {
 }
 
 TEST(FindShock, MdLikeNoiseDoesNotProduceAShock) {
-  const Profile resting = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
-                                       [](double z) { return 0.2 + 0.1 * z; },
-                                       [](double) { return 0.0; });
-  const Profile flying = make_profile(gaussian_layer, [](double) { return 3.0; },
-                                      [](double) { return -1.0; });
+  const Profile resting =
+      make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                   [](double z) { return 0.2 + 0.1 * z; }, [](double) { return 0.0; });
+  const Profile flying = make_profile(
+      gaussian_layer, [](double) { return 3.0; }, [](double) { return -1.0; });
   const Profile falling = make_profile(
       gaussian_layer, [](double z) { return 0.5 + 2.0 * (1.0 - gaussian_layer(z) / 0.4); },
       [](double) { return -3.0; });
@@ -214,8 +218,10 @@ TEST(FindShock, FindsARealShockThroughMdLikeNoise) {
   EXPECT_EQ(found, 100);
   EXPECT_LT(worst, 1.0);
   EXPECT_GE(within_half_bin, 90);
-  std::printf("[measured] noisy tanh shock: found %d / 100, %d within half a bin, worst location "
-              "error %.2f\n", found, within_half_bin, worst);
+  std::printf(
+      "[measured] noisy tanh shock: found %d / 100, %d within half a bin, worst location "
+      "error %.2f\n",
+      found, within_half_bin, worst);
 }
 
 // ---- layer, centre of mass, Mach number --------------------------------------------------------
@@ -223,8 +229,9 @@ TEST(FindShock, FindsARealShockThroughMdLikeNoise) {
 TEST(FindLayer, InterpolatesTheThresholdCrossings) {
   // A tent nu = 0.4 - 0.05 |z - 15|, linear between bin centres around both crossings of
   // 0.026: |z - 15| = (0.4 - 0.026) / 0.05 = 7.48.
-  const Profile p = make_profile([](double z) { return std::max(0.0, 0.4 - 0.05 * std::abs(z - 15.0)); },
-                                 [](double) { return 1.0; }, [](double) { return 0.0; }, 40);
+  const Profile p =
+      make_profile([](double z) { return std::max(0.0, 0.4 - 0.05 * std::abs(z - 15.0)); },
+                   [](double) { return 1.0; }, [](double) { return 0.0; }, 40);
   const auto layer = find_layer(p);
   ASSERT_TRUE(layer.has_value());
   EXPECT_NEAR(layer->bottom, 15.0 - 7.48, 1e-12);
@@ -315,13 +322,13 @@ TEST(ShockSpeed, RecoversAKnownSpeedInThePlateFrame) {
   // The shock sits on bin edges z = 10 + k at t = k / 2 while the plate rises by k / 4: the
   // speed relative to the plate is (1 - 1/4) / (1/2) = 1.5 exactly.
   std::vector<Profile> profiles;
-  const Profile calm = make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
-                                    [](double z) { return 0.2 + 0.1 * z; },
-                                    [](double) { return 0.0; });
+  const Profile calm =
+      make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                   [](double z) { return 0.2 + 0.1 * z; }, [](double) { return 0.0; });
   profiles.push_back(at(-0.5, 0.0, calm));  // before the shock forms
   for (int k = 0; k < 9; ++k)
     profiles.push_back(at(0.5 * k, 0.25 * k, shock_profile(10.0 + k, 0.6)));
-  profiles.push_back(at(5.0, 2.5, calm));  // the shock has left the layer
+  profiles.push_back(at(5.0, 2.5, calm));                       // the shock has left the layer
   profiles.push_back(at(5.5, 2.75, shock_profile(30.0, 0.6)));  // a later one is not averaged
   const auto speed = shock_speed(profiles);
   ASSERT_TRUE(speed.has_value());
@@ -356,9 +363,9 @@ TEST(SeriesDifference, KnownInputs) {
 
 TEST(ProfileDifference, KnownInputs) {
   // b is linear in z on a shifted grid, so interpolating it at a's heights is exact.
-  const Profile b = make_profile([](double z) { return 0.1 + 0.01 * z; },
-                                 [](double z) { return 2.0 - 0.03 * z; }, [](double) { return 0.0; },
-                                 20, 1.0, 0.25);
+  const Profile b =
+      make_profile([](double z) { return 0.1 + 0.01 * z; }, [](double z) { return 2.0 - 0.03 * z; },
+                   [](double) { return 0.0; }, 20, 1.0, 0.25);
   const Profile a = make_profile([](double z) { return 0.12 + 0.01 * z; },
                                  [](double z) { return 2.0 - 0.03 * z + (z < 10.0 ? 0.5 : -1.0); },
                                  [](double) { return 0.0; }, 22, 1.0, 0.0);
@@ -385,10 +392,10 @@ RunRecord run_of(const std::vector<Profile>& profiles) {
 std::vector<Profile> shock_run(double shift) {
   std::vector<Profile> profiles;
   for (int k = 0; k < 8; ++k) {
-    Profile p = k < 6 ? shock_profile(10.0 + k + shift, 0.8)
-                      : make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
-                                     [](double z) { return 0.2 + 0.1 * z; },
-                                     [](double) { return 0.0; });
+    Profile p =
+        k < 6 ? shock_profile(10.0 + k + shift, 0.8)
+              : make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
+                             [](double z) { return 0.2 + 0.1 * z; }, [](double) { return 0.0; });
     p.phase = 0.125 * k;
     p.time = 10.0 + p.phase;
     profiles.push_back(p);

@@ -128,13 +128,15 @@ TEST(Config, RejectsOutOfRangeValuesNamingTheRange) {
   // A box narrower than a particle (sigma = 1).
   expect_bad_document("[md]\nbox_width = 0.5\n", {"md.box_width", "0.5", "1 < value"});
   expect_bad_document("[md]\nbox_width = 1.0\n", {"md.box_width", "1.0", "1 < value"});
-  expect_bad_document("[continuum]\nbox_width = 0.5\n", {"continuum.box_width", "0.5", "1 < value"});
+  expect_bad_document("[continuum]\nbox_width = 0.5\n",
+                      {"continuum.box_width", "0.5", "1 < value"});
   expect_bad_document("[continuum]\ninitial_volume_fraction = 0.65\n",
                       {"continuum.initial_volume_fraction", "0.65", "value < 0.65"});
   // The ends of closed ranges are accepted.
   EXPECT_NO_THROW(Config::from_toml("[material]\ne = 1.0\n", "case.toml"));
   EXPECT_NO_THROW(Config::from_toml("[material]\ne = 0.0\n", "case.toml"));
-  EXPECT_EQ(Config::from_toml("[layer]\nparticles = 1\n", "case.toml").integer("layer.particles"), 1);
+  EXPECT_EQ(Config::from_toml("[layer]\nparticles = 1\n", "case.toml").integer("layer.particles"),
+            1);
 }
 
 TEST(Config, RejectsChoicesThatAreNotAllowed) {
@@ -172,7 +174,8 @@ TEST(Config, RejectsMalformedOverrides) {
   expect_input_error([] { Config().set("layer.particles=12.5"); },
                      {"layer.particles", "12.5", "an integer"});
   expect_input_error([] { Config().set("material.e=2"); }, {"material.e", "2", "0 <= value <= 1"});
-  expect_input_error([] { Config().set("md.box_width=0.5"); }, {"md.box_width", "0.5", "1 < value"});
+  expect_input_error([] { Config().set("md.box_width=0.5"); },
+                     {"md.box_width", "0.5", "1 < value"});
   expect_input_error([] { Config().set("material.restitution=elastic"); },
                      {"material.restitution", "elastic", "constant, velocity_dependent"});
 }
@@ -185,9 +188,9 @@ TEST(Config, OverridesApplyInOrderAfterTheFile) {
   EXPECT_EQ(from_file.integer("layer.particles"), 1969);
   EXPECT_EQ(from_file.real("shaker.gamma"), 3.0);  // untouched keys keep their defaults
 
-  const Config c = Config::load(dir / "case.toml",
-                                {"material.e=0.7", "shaker.gamma=4", "material.e=0.75",
-                                 "case.name=a=b", "material.restitution=velocity_dependent"});
+  const Config c =
+      Config::load(dir / "case.toml", {"material.e=0.7", "shaker.gamma=4", "material.e=0.75",
+                                       "case.name=a=b", "material.restitution=velocity_dependent"});
   EXPECT_EQ(c.real("material.e"), 0.75);   // the last override wins over the file
   EXPECT_EQ(c.real("shaker.gamma"), 4.0);  // an integer literal is read as a real
   EXPECT_EQ(c.text("case.name"), "a=b");   // only the first '=' separates key and value
@@ -209,9 +212,15 @@ void expect_identical_values(const Config& a, const Config& b) {
         EXPECT_EQ(std::bit_cast<std::uint64_t>(a.real(spec.key)),
                   std::bit_cast<std::uint64_t>(b.real(spec.key)));
         break;
-      case shaker::config::Kind::integer: EXPECT_EQ(a.integer(spec.key), b.integer(spec.key)); break;
-      case shaker::config::Kind::boolean: EXPECT_EQ(a.boolean(spec.key), b.boolean(spec.key)); break;
-      case shaker::config::Kind::text: EXPECT_EQ(a.text(spec.key), b.text(spec.key)); break;
+      case shaker::config::Kind::integer:
+        EXPECT_EQ(a.integer(spec.key), b.integer(spec.key));
+        break;
+      case shaker::config::Kind::boolean:
+        EXPECT_EQ(a.boolean(spec.key), b.boolean(spec.key));
+        break;
+      case shaker::config::Kind::text:
+        EXPECT_EQ(a.text(spec.key), b.text(spec.key));
+        break;
       case shaker::config::Kind::real_list:
         EXPECT_EQ(a.real_list(spec.key), b.real_list(spec.key));
         break;

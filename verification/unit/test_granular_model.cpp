@@ -12,11 +12,11 @@
 // acceleration are derivatives of z_p by mp.diff. Every comparison is to 1e-12 relative.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
-#include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
 #include "common/errors.hpp"
@@ -63,8 +63,9 @@ class ErrorLog {
   ~ErrorLog() { std::printf("[measured] %s: max relative error %.3g\n", name_.c_str(), worst_); }
   ErrorLog(const ErrorLog&) = delete;
   ErrorLog& operator=(const ErrorLog&) = delete;
-  template <class T> void check(const T& actual, double expected, const char* what, double at,
-                                double limit = tolerance) {
+  template <class T>
+  void check(const T& actual, double expected, const char* what, double at,
+             double limit = tolerance) {
     const double error = relative_error(static_cast<double>(actual), expected);
     worst_ = std::max(worst_, error);
     EXPECT_LE(error, limit) << what << " at " << at << ": got " << static_cast<double>(actual)
@@ -78,7 +79,8 @@ class ErrorLog {
 
 // ---- values against the 50-digit references ------------------------------------------------
 
-template <class S> void check_contact_values(ErrorLog& log) {
+template <class S>
+void check_contact_values(ErrorLog& log) {
   for (const auto& r : nu_references) {
     const S nu = static_cast<S>(r.nu);
     log.check(g0(nu), r.g0, "g0", r.nu);
@@ -92,7 +94,8 @@ template <class S> void check_contact_values(ErrorLog& log) {
   }
 }
 
-template <class S> void check_state_functions(ErrorLog& log) {
+template <class S>
+void check_state_functions(ErrorLog& log) {
   for (const auto& r : state_references) {
     const S n = static_cast<S>(r.n), T = static_cast<S>(r.T);
     log.check(pressure(n, T, r.e), r.pressure, "pressure", r.n);
@@ -109,7 +112,8 @@ template <class S> void check_state_functions(ErrorLog& log) {
   }
 }
 
-template <class S> void check_sound_and_haff(ErrorLog& log) {
+template <class S>
+void check_sound_and_haff(ErrorLog& log) {
   for (const auto& r : sound_references)
     log.check(sound_speed(static_cast<S>(r.nu), static_cast<S>(r.T), r.e), r.c, "sound_speed",
               r.nu);
@@ -186,19 +190,18 @@ TEST(GranularModel, AutoDiffInstantiationGivesValuesAndExactDerivatives) {
     // p = n T chi(nu): dp/dn = T chi + n T (pi/6) dchi/dnu, dp/dT = p / T.
     const double dp_dn = r.T * chi(nu, r.e) + r.n * r.T * (pi / 6.0) * dchi_dnu(nu, r.e);
     log.check(derivative(pressure(variable(r.n), constant(r.T), r.e)), dp_dn, "AD dp/dn", r.n);
-    log.check(derivative(pressure(constant(r.n), variable(r.T), r.e)), r.pressure / r.T,
-              "AD dp/dT", r.n);
+    log.check(derivative(pressure(constant(r.n), variable(r.T), r.e)), r.pressure / r.T, "AD dp/dT",
+              r.n);
     // gamma ~ T^(3/2), lambda, mu, kappa ~ T^(1/2).
-    log.check(derivative(collisional_loss(constant(r.n), variable(r.T), r.e)),
-              1.5 * r.loss / r.T, "AD dgamma/dT", r.n);
+    log.check(derivative(collisional_loss(constant(r.n), variable(r.T), r.e)), 1.5 * r.loss / r.T,
+              "AD dgamma/dT", r.n);
     log.check(derivative(shear_viscosity(constant(r.n), variable(r.T), Transport::full)),
               0.5 * r.mu_full / r.T, "AD dmu/dT", r.n);
     log.check(derivative(thermal_conductivity(constant(r.n), variable(r.T), Transport::paper)),
               0.5 * r.kappa_paper / r.T, "AD dkappa/dT", r.n);
     log.check(derivative(bulk_viscosity(constant(r.n), variable(r.T))), 0.5 * r.lambda / r.T,
               "AD dlambda/dT", r.n);
-    log.check(derivative(mean_free_path(variable(r.n))), -r.mean_free_path / r.n, "AD dxi/dn",
-              r.n);
+    log.check(derivative(mean_free_path(variable(r.n))), -r.mean_free_path / r.n, "AD dxi/dn", r.n);
   }
   for (const auto& r : sound_references) {
     log.check(sound_speed(variable(r.nu), constant(r.T), r.e).value(), r.c, "AD c value", r.nu);
@@ -257,14 +260,15 @@ TEST(GranularModel, SoundSpeedTendsToIdealGasValueWhenDilute) {
 
 // ---- domain errors --------------------------------------------------------------------------
 
-template <class F> void expect_domain_error(F&& f, const std::string& name, const std::string& what) {
+template <class F>
+void expect_domain_error(F&& f, const std::string& name, const std::string& what) {
   try {
     const double value = static_cast<double>(f());
     ADD_FAILURE() << name << " returned " << value << " instead of throwing DomainError";
   } catch (const DomainError& error) {
     const std::string message = error.what();
-    EXPECT_NE(message.find(what), std::string::npos) << name << ": message '" << message
-                                                     << "' does not name " << what;
+    EXPECT_NE(message.find(what), std::string::npos)
+        << name << ": message '" << message << "' does not name " << what;
   } catch (const std::exception& error) {
     ADD_FAILURE() << name << " threw something other than DomainError: " << error.what();
   }
@@ -377,9 +381,8 @@ TEST(ShakerKinematics, BaseCaseAndPhaseConventions) {
 TEST(Restitution, MatchesReferenceAndIsContinuousAtUnitSpeed) {
   ErrorLog log("Restitution e(|v_n|)");
   for (const auto& r : restitution_references) {
-    const Restitution model{r.constant ? Restitution::Kind::constant
-                                       : Restitution::Kind::velocity_dependent,
-                            r.e};
+    const Restitution model{
+        r.constant ? Restitution::Kind::constant : Restitution::Kind::velocity_dependent, r.e};
     log.check(model(r.speed), r.value, "restitution", r.speed);
   }
   const Restitution velocity_dependent{Restitution::Kind::velocity_dependent, 0.9};

@@ -178,7 +178,8 @@ TEST(AtomicOutput, RemovesTheTemporaryFileUnlessCommitted) {
 
 // ---- reading foreign or damaged files ------------------------------------------------------
 
-void expect_read_error(const std::filesystem::path& path, const std::vector<std::string>& fragments) {
+void expect_read_error(const std::filesystem::path& path,
+                       const std::vector<std::string>& fragments) {
   try {
     shaker::read_run_file(path);
     ADD_FAILURE() << "no InputError for " << path;
@@ -212,27 +213,26 @@ TEST(RunFile, ReadingForeignOrDamagedFilesThrowsInputError) {
   std::ofstream(dir / "empty.h5").close();
   expect_read_error(dir / "empty.h5", {"empty.h5"});
 
-  expect_read_error(damaged_copy(dir, "no-profiles.h5",
-                                 [](hid_t f) { H5Ldelete(f, "profiles", H5P_DEFAULT); }),
-                    {"no-profiles.h5", "profiles", "missing"});
-  expect_read_error(damaged_copy(dir, "no-series.h5",
-                                 [](hid_t f) { H5Ldelete(f, "timeseries", H5P_DEFAULT); }),
-                    {"no-series.h5", "timeseries", "missing"});
-  expect_read_error(damaged_copy(dir, "no-T.h5",
-                                 [](hid_t f) { H5Ldelete(f, "profiles/T", H5P_DEFAULT); }),
-                    {"no-T.h5", "'T'", "missing"});
+  expect_read_error(
+      damaged_copy(dir, "no-profiles.h5", [](hid_t f) { H5Ldelete(f, "profiles", H5P_DEFAULT); }),
+      {"no-profiles.h5", "profiles", "missing"});
+  expect_read_error(
+      damaged_copy(dir, "no-series.h5", [](hid_t f) { H5Ldelete(f, "timeseries", H5P_DEFAULT); }),
+      {"no-series.h5", "timeseries", "missing"});
+  expect_read_error(
+      damaged_copy(dir, "no-T.h5", [](hid_t f) { H5Ldelete(f, "profiles/T", H5P_DEFAULT); }),
+      {"no-T.h5", "'T'", "missing"});
   expect_read_error(damaged_copy(dir, "no-column.h5",
                                  [](hid_t f) { H5Ldelete(f, "timeseries/com_z", H5P_DEFAULT); }),
                     {"no-column.h5", "com_z", "missing"});
-  expect_read_error(damaged_copy(dir, "no-configuration.h5",
-                                 [](hid_t f) { H5Adelete(f, "configuration"); }),
-                    {"no-configuration.h5", "configuration", "missing"});
-  expect_read_error(damaged_copy(dir, "future.h5",
-                                 [](hid_t f) {
-                                   shaker::h5::write_attribute(f, "schema_version",
-                                                               std::int64_t{99});
-                                 }),
-                    {"future.h5", "schema version 99"});
+  expect_read_error(
+      damaged_copy(dir, "no-configuration.h5", [](hid_t f) { H5Adelete(f, "configuration"); }),
+      {"no-configuration.h5", "configuration", "missing"});
+  expect_read_error(
+      damaged_copy(
+          dir, "future.h5",
+          [](hid_t f) { shaker::h5::write_attribute(f, "schema_version", std::int64_t{99}); }),
+      {"future.h5", "schema version 99"});
   expect_read_error(damaged_copy(dir, "flat-T.h5",
                                  [](hid_t f) {
                                    H5Ldelete(f, "profiles/T", H5P_DEFAULT);

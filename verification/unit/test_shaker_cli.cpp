@@ -28,7 +28,8 @@ Result run_shaker(const std::vector<std::string>& args) {
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return r;
   char buffer[4096];
-  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) r.output.append(buffer, n);
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+    r.output.append(buffer, n);
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
@@ -54,9 +55,14 @@ TEST(ShakerProgram, HelpExitsZeroForTheProgramAndEverySubcommand) {
 }
 
 TEST(ShakerProgram, MissingArgumentsExitTwo) {
-  const std::vector<std::vector<std::string>> calls = {
-      {}, {"md"}, {"continuum"}, {"analyze"}, {"compare"}, {"compare", "only-one.h5"},
-      {"no-such-subcommand"}, {"config", "--set"}};
+  const std::vector<std::vector<std::string>> calls = {{},
+                                                       {"md"},
+                                                       {"continuum"},
+                                                       {"analyze"},
+                                                       {"compare"},
+                                                       {"compare", "only-one.h5"},
+                                                       {"no-such-subcommand"},
+                                                       {"config", "--set"}};
   for (const auto& args : calls) {
     const Result r = run_shaker(args);
     std::string shown;
@@ -77,18 +83,18 @@ TEST(ShakerProgram, BadInputExitsTwoNamingTheKeyAndWritesNothing) {
   const BadCase cases[] = {
       {"[material]\nee = 0.8\n", nullptr, "material.ee"},           // unknown key
       {"[materials]\ne = 0.8\n", nullptr, "materials.e"},           // unknown section
-      {"[shaker]\ngamma = \"3\"\n", nullptr, "shaker.gamma"},      // string for a number
+      {"[shaker]\ngamma = \"3\"\n", nullptr, "shaker.gamma"},       // string for a number
       {"[layer]\nparticles = 10.5\n", nullptr, "layer.particles"},  // float for an integer
       {"[material]\ne = 1.5\n", nullptr, "material.e"},             // out of range
       {"[layer]\nparticles = -3\n", nullptr, "layer.particles"},    // negative N
       {"[shaker]\ngamma = -1.0\n", nullptr, "shaker.gamma"},        // Gamma < 0
       {"[md]\nbox_width = 0.5\n", nullptr, "md.box_width"},         // narrower than a particle
       {"[material]\nrestitution = \"elastic\"\n", nullptr, "material.restitution"},  // choice
-      {"[shaker\ngamma = 3.0\n", nullptr, "bad.toml"},              // malformed TOML
-      {nullptr, "shaker.gamma=abc", "shaker.gamma"},                // malformed --set value
-      {nullptr, "shaker.gamma", "shaker.gamma"},                    // --set without '='
-      {nullptr, "material.e=2", "material.e"},                      // --set out of range
-      {nullptr, "nosuch.key=1", "nosuch.key"},                      // --set unknown key
+      {"[shaker\ngamma = 3.0\n", nullptr, "bad.toml"},  // malformed TOML
+      {nullptr, "shaker.gamma=abc", "shaker.gamma"},    // malformed --set value
+      {nullptr, "shaker.gamma", "shaker.gamma"},        // --set without '='
+      {nullptr, "material.e=2", "material.e"},          // --set out of range
+      {nullptr, "nosuch.key=1", "nosuch.key"},          // --set unknown key
   };
   for (const char* sub : {"md", "continuum", "config"})
     for (const auto& c : cases) {
@@ -107,7 +113,8 @@ TEST(ShakerProgram, BadInputExitsTwoNamingTheKeyAndWritesNothing) {
       EXPECT_EQ(r.exit_code, 2) << r.output;
       EXPECT_NE(r.output.find(c.key), std::string::npos)
           << "the message does not name '" << c.key << "': " << r.output;
-      EXPECT_FALSE(std::filesystem::exists(output)) << "something was written under the output name";
+      EXPECT_FALSE(std::filesystem::exists(output))
+          << "something was written under the output name";
     }
   // Every file in the directory is one the test wrote.
   for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
@@ -135,7 +142,8 @@ TEST(ShakerProgram, MissingOrForeignFilesExitTwo) {
 TEST(ShakerProgram, ConfigPrintsTheEffectiveConfiguration) {
   const shaker::testing::TemporaryDirectory dir;
   write_file(dir / "case.toml", "[material]\ne = 0.8\n");
-  const Result r = run_shaker({"config", (dir / "case.toml").string(), "--set", "shaker.gamma=4.5"});
+  const Result r =
+      run_shaker({"config", (dir / "case.toml").string(), "--set", "shaker.gamma=4.5"});
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("e = 0.8\n"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("gamma = 4.5\n"), std::string::npos) << r.output;
