@@ -3,7 +3,7 @@
 
 Usage:
     make_benchmark_report.py --history DIR [--output reports/benchmarks.md]
-                             [--threshold 0.10] [--alpha 0.05]
+                             [--threshold 0.10] [--alpha 0.05] [--metric real_time|cpu_time]
 
 History layout (ci/nightly appends to it): DIR/<run-id>/<program>.json, one directory per
 nightly run, run ids sorting in time order (ci/nightly uses YYYYmmddTHHMMSSZ-<commit>). Each
@@ -16,7 +16,8 @@ those containing "cell_update" (or "cell update", "cellupdate") as cell updates 
 benchmark::Counter::kIsRate).
 
 Comparison with the previous run: for every benchmark present in both runs, the real-time
-samples of the repetitions are compared by a two-sided Mann-Whitney U test, as Google
+samples (or CPU-time samples with --metric cpu_time; real time is what users wait for, CPU
+time is less sensitive to other load on the machine) of the repetitions are compared by a two-sided Mann-Whitney U test, as Google
 Benchmark's tools/compare.py does (implemented here with numpy and the standard library:
 the exact distribution when a sample has at most 8 values and there are no ties, otherwise the normal
 approximation with tie and continuity corrections, as scipy's default). A benchmark whose
@@ -117,8 +118,8 @@ def mann_whitney_u(x, y):
 # ---- Reading the history --------------------------------------------------------------------
 
 def read_run(run_dir):
-    """{'id', 'commit', 'date', 'host', 'benchmarks': {run_name: {'time_ns': [...],
-    'counters': {name: [...]}}}} of one run directory."""
+    """One run directory as {'id', 'commit', 'date', 'host', 'benchmarks': {run_name:
+    {'real_time': [ns per repetition], 'cpu_time': [ns...], 'counters': {name: [...]}}}}."""
     run = {"id": os.path.basename(run_dir), "commit": "unknown", "date": "", "host": "",
            "benchmarks": {}}
     files = sorted(glob.glob(os.path.join(run_dir, "*.json")))
@@ -141,8 +142,10 @@ def read_run(run_dir):
             unit = TIME_UNIT_NS.get(entry.get("time_unit", "ns"))
             if name is None or unit is None or "real_time" not in entry:
                 raise InputProblem(f"{path}: benchmark entry without name, time or known unit")
-            record = run["benchmarks"].setdefault(name, {"time_ns": [], "counters": {}})
-            record["time_ns"].append(float(entry["real_time"]) * unit)
+            record = run["benchmarks"].setdefault(name, {"real_time": [], "cpu_time": [],
+                                                         "counters": {}})
+            record["real_time"].append(float(entry["real_time"]) * unit)
+            record["cpu_time"].append(float(entry.get("cpu_time", float("nan"))) * unit)
             for key, value in entry.items():
                 if key not in STANDARD_KEYS and isinstance(value, (int, float)):
                     record["counters"].setdefault(key, []).append(float(value))
@@ -178,16 +181,18 @@ def short(commit):
     return commit[:10] if commit else "unknown"
 
 
-def compare(previous, latest, threshold, alpha):
+def compare(previous, latest, threshold, alpha, metric):
     rows, slowdowns = [], []
     for name in sorted(set(previous["benchmarks"]) | set(latest["benchmarks"])):
         old = previous["benchmarks"].get(name)
         new = latest["benchmarks"].get(name)
         if old is None or new is None:
-            rows.append(f"| {name} | | | | | {'new' if old is None else 'removed'} |")
+            rows.append(f"| {name} | | | | | | {'new' if old is None else 'removed'} |")
             continue
-        old_t, new_t = np.array(old["time_ns"]), np.array(new["time_ns"])
+        old_t, new_t = np.array(old[metric]), np.array(new[metric])
         change = float(np.median(new_t) / np.median(old_t) - 1.0)
+        other = "cpu_time" if metric == "real_time" else "real_time"
+        other_change = float(np.median(new[other]) / np.median(old[other]) - 1.0)
         if min(len(old_t), len(new_t)) < 2:
             verdict = f"not judged: {len(old_t)} and {len(new_t)} repetitions"
             p = float("nan")
@@ -196,7 +201,7 @@ def compare(previous, latest, threshold, alpha):
             significant = p < alpha
             if change > threshold and significant:
                 verdict = f"**SLOWDOWN** (> {threshold:.0%}, p < {alpha:g})"
-                slowdowns.append(f"{name}: median time {change:+.1%} (p = {p:.2g}, "
+                slowdowns.append(f"{name}: median {metric} {change:+.1%} (p = {p:.2g}, "
                                  f"{len(old_t)} vs {len(new_t)} repetitions)")
             elif change < -threshold and significant:
                 verdict = "faster"
@@ -206,7 +211,7 @@ def compare(previous, latest, threshold, alpha):
                 verdict = "no significant change"
             verdict += f" [{method}]"
         rows.append(f"| {name} | {rc.fmt(np.median(old_t), 5)} | {rc.fmt(np.median(new_t), 5)} | "
-                    f"{change:+.1%} | {rc.fmt(p, 3)} | {verdict} |")
+                    f"{change:+.1%} | {other_change:+.1%} | {rc.fmt(p, 3)} | {verdict} |")
     return rows, slowdowns
 
 
@@ -218,7 +223,7 @@ def plot_history(runs, series, path):
     for ax, (kind, data) in zip(axes[:, 0], panels):
         if data is None:
             names = sorted({n for r in runs for n in r["benchmarks"]})
-            data = {(n, "time"): [float(np.median(r["benchmarks"][n]["time_ns"]))
+            data = {(n, "time"): [float(np.median(r["benchmarks"][n]["real_time"]))
                                   if n in r["benchmarks"] else float("nan") for r in runs]
                     for n in names}
         for (bench, counter), values in data.items():
@@ -243,6 +248,8 @@ def main(argv=None):
     parser.add_argument("--threshold", type=float, default=0.10,
                         help="relative slowdown that fails (fraction, default 0.10)")
     parser.add_argument("--alpha", type=float, default=0.05)
+    parser.add_argument("--metric", choices=("real_time", "cpu_time"), default="real_time",
+                        help="the time judged for slowdowns (both are shown)")
     args = parser.parse_args(argv)
     if not (args.threshold > 0 and 0 < args.alpha < 1):
         print("make_benchmark_report: need --threshold > 0 and 0 < --alpha < 1", file=sys.stderr)
@@ -264,7 +271,8 @@ def main(argv=None):
              f"- date: {rc.utc_now()}",
              f"- machine: {rc.machine_description()}",
              f"- history: {os.path.abspath(args.history)} ({len(runs)} runs)",
-             f"- slowdown threshold: {args.threshold:.0%} with Mann-Whitney p < {args.alpha:g}", ""]
+             f"- slowdown threshold: {args.threshold:.0%} in {args.metric} with Mann-Whitney "
+             f"p < {args.alpha:g}", ""]
     slowdowns = []
     if not runs:
         lines += ["No benchmark runs found in the history.", ""]
@@ -287,13 +295,16 @@ def main(argv=None):
         lines += [f"![benchmark history]({plot_name})", ""]
         if len(runs) >= 2:
             previous = runs[-2]
-            rows, slowdowns = compare(previous, latest, args.threshold, args.alpha)
+            rows, slowdowns = compare(previous, latest, args.threshold, args.alpha, args.metric)
             lines += [f"## Latest run against the previous one", "",
                       f"{previous['id']} ({short(previous['commit'])}) → {latest['id']} "
-                      f"({short(latest['commit'])}); real time per iteration in ns, medians "
-                      "over repetitions.", "",
-                      "| benchmark | previous | latest | change | p (Mann-Whitney U) | verdict |",
-                      "|---|---|---|---|---|---|"] + rows + [""]
+                      f"({short(latest['commit'])}); {args.metric.replace('_', ' ')} per "
+                      "iteration in ns (medians over repetitions) judged; the other time's "
+                      "change is shown beside it.", "",
+                      f"| benchmark | previous | latest | change | "
+                      f"{'cpu' if args.metric == 'real_time' else 'real'} time change | "
+                      "p (Mann-Whitney U) | verdict |",
+                      "|---|---|---|---|---|---|---|"] + rows + [""]
         else:
             lines += ["Only one run in the history: nothing to compare with.", ""]
     if slowdowns:

@@ -144,7 +144,7 @@ try:
     check("faster" in fast and -23 < change_of(fast) < -17 and "SLOWDOWN" not in fast,
           f"faster row: '{fast}'")
     check("SLOWDOWN" not in same and "faster" not in same, f"unchanged row: '{same}'")
-    check("- BM_md_collisions: median time +" in text, "slowdown list missing")
+    check("- BM_md_collisions: median real_time +" in text, "slowdown list missing")
     png = os.path.join(work, "out", "benchmark-history.png")
     check(os.path.exists(png) and open(png, "rb").read(4) == b"\x89PNG", "history plot missing")
 
@@ -153,6 +153,10 @@ try:
     check(relaxed.returncode == 0, f"--threshold 0.25 must accept a 20% slowdown, got {relaxed.returncode}")
     relaxed_row = line_with(open(os.path.join(work, "relaxed.md")).read(), "| BM_md_collisions |", "%")
     check("significant change within 25%" in relaxed_row, f"relaxed row: '{relaxed_row}'")
+
+    cpu = run("--history", history, "--output", os.path.join(work, "cpu.md"), "--metric", "cpu_time")
+    check(cpu.returncode == 1 and "median cpu_time +" in cpu.stderr,
+          f"--metric cpu_time must judge CPU time: exit {cpu.returncode}, {cpu.stderr.strip()}")
 
     single = os.path.join(work, "single")
     write_run(single, "20261120T030000Z-aaaaaaaaaaaa", "a" * 40, before, seed=3)
