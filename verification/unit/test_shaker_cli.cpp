@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "common/run_file.hpp"
+#include "sample_run.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -148,6 +150,17 @@ TEST(ShakerProgram, ConfigPrintsTheEffectiveConfiguration) {
   EXPECT_NE(r.output.find("e = 0.8\n"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("gamma = 4.5\n"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("particles = 3937\n"), std::string::npos) << r.output;
+}
+
+TEST(ShakerProgram, AnalyzeAndCompareAcceptAValidRunFile) {
+  const shaker::testing::TemporaryDirectory dir;
+  shaker::write_run_file(dir / "sample.h5", shaker::testing::make_sample_record(true));
+  const Result analyze = run_shaker({"analyze", (dir / "sample.h5").string()});
+  EXPECT_EQ(analyze.exit_code, 0) << analyze.output;
+  EXPECT_NE(analyze.output.find("synthetic"), std::string::npos) << analyze.output;
+  const Result compare =
+      run_shaker({"compare", (dir / "sample.h5").string(), (dir / "sample.h5").string()});
+  EXPECT_EQ(compare.exit_code, 0) << compare.output;
 }
 
 }  // namespace
