@@ -111,7 +111,9 @@ int execute(const config::Config& config) {
     for (std::int64_t cycle = 0; cycle < cycles; ++cycle) {
       const bool sampling = cycle >= run.transient_cycles;
       for (std::size_t k = 0; k < K; ++k) {
-        const double target = start + (static_cast<double>(cycle) + static_cast<double>(k) / static_cast<double>(K)) * period;
+        // Absolute cycle counts, so that a restarted run meets the same target times.
+        const double target = (start / period + static_cast<double>(cycle) +
+                               static_cast<double>(k) / static_cast<double>(K)) * period;
         if (single && !switched && target >= switch_time) {
           solver.advance_to(switch_time);
           solver.op().settings().e = run.after_switch.e;
@@ -127,7 +129,7 @@ int execute(const config::Config& config) {
               fields.push_back(snapshot(solver, shaker));
       }
     }
-    solver.advance_to(start + static_cast<double>(cycles) * period);
+    solver.advance_to((start / period + static_cast<double>(cycles)) * period);
   } catch (const StepFailure& failure) {
     std::filesystem::path last_good = output;
     last_good.replace_extension(".last_good.h5");

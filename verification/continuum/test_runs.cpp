@@ -1,0 +1,168 @@
+// Whole-run checks: mass conservation (1D and 3D), a horizontally uniform 3D run equals the
+// 1D run, restart continues identically, and the base-case smoke test (H = 9, e = 0.9, 1D).
+#include <cmath>
+
+#include "analysis/analysis.hpp"
+#include "common/run_file.hpp"
+#include "continuum/checkpoint.hpp"
+#include "continuum/run_continuum.hpp"
+#include "continuum/setup.hpp"
+#include "support.hpp"
+
+namespace shaker::continuum::testing {
+namespace {
+
+config::Config base_config(const std::filesystem::path& dir) {
+  config::Config c;
+  c.set("run.output=" + (dir / "run.h5").string());
+  return c;
+}
+
+double relative_mass_drift(config::Config config, double cycles) {
+  const ContinuumCase c = continuum_case(config);
+  TimeIntegrator solver = make_solver(c);
+  const double m0 = total(c.grid, solver.state(), density);
+  solver.advance_to(cycles * c.parameters.shaker.period());
+  const double m1 = total(c.grid, solver.state(), density);
+  std::printf("dimension %d: %lld steps, relative mass change %.3e\n", c.grid.dimension,
+              static_cast<long long>(solver.counters().steps), (m1 - m0) / m0);
+  return std::abs(m1 - m0) / m0;
+}
+
+TEST(MassConservation, OneDimensionalToRoundOff) {
+  config::Config c = base_config(test_directory());
+  c.set("continuum.cell_size=0.5");
+  EXPECT_LT(relative_mass_drift(c, 1.0), 1e-13);
+}
+
+TEST(MassConservation, ThreeDimensionalToRoundOff) {
+  config::Config c = base_config(test_directory());
+  c.set("continuum.dimension=3");
+  c.set("continuum.cell_size=0.5");
+  c.set("continuum.box_width=2");
+  c.set("continuum.ceiling=10");
+  c.set("layer.particles=1000");  // a 2.6 high layer keeps the 3D test short
+  c.set("continuum.perturbation=0.05");
+  EXPECT_LT(relative_mass_drift(c, 0.3), 1e-13);
+}
+
+TEST(Uniform3D, MatchesOneDimensionalRunToRoundOff) {
+  config::Config c = base_config(test_directory());
+  c.set("continuum.cell_size=0.5");
+  c.set("continuum.ceiling=20");
+  c.set("continuum.perturbation=0");
+  ContinuumCase one = continuum_case(c);
+  c.set("continuum.dimension=3");
+  c.set("continuum.box_width=2");
+  ContinuumCase three = continuum_case(c);
+  one.integration.fixed_dt = three.integration.fixed_dt = 2e-4;
+  TimeIntegrator a = make_solver(one), b = make_solver(three);
+  const double t_end = 0.1 * one.parameters.shaker.period();
+  a.advance_to(t_end);
+  b.advance_to(t_end);
+  double worst = 0.0;
+  for (int k = 0; k < one.grid.nz; ++k)
+    for (int j = 0; j < three.grid.ny; ++j)
+      for (int i = 0; i < three.grid.nx; ++i)
+        for (int v : {density, momentum_z, energy}) {
+          const double x = a.state().q[v][one.grid.index(0, 0, k)];
+          const double y = b.state().q[v][three.grid.index(i, j, k)];
+          worst = std::max(worst, std::abs(x - y) / std::max(1e-300, std::abs(x)));
+        }
+  double horizontal = 0.0;
+  for (int k = 0; k < three.grid.nz; ++k)
+    horizontal = std::max(horizontal, std::abs(b.state().q[momentum_x][three.grid.index(1, 1, k)]));
+  std::printf("largest relative difference 3D - 1D: %.3e; largest |n u_x| %.3e (%lld steps)\n",
+              worst, horizontal, static_cast<long long>(a.counters().steps));
+  EXPECT_EQ(worst, 0.0);
+  EXPECT_EQ(horizontal, 0.0);
+}
+
+TEST(Restart, ContinuesIdentically) {
+  const auto dir = test_directory();
+  config::Config c = base_config(dir);
+  c.set("continuum.cell_size=0.5");
+  const ContinuumCase cc = continuum_case(c);
+  const double half = 0.5 * cc.parameters.shaker.period();
+  TimeIntegrator straight = make_solver(cc);
+  straight.advance_to(half);
+  straight.advance_to(2 * half);
+  TimeIntegrator first = make_solver(cc);
+  first.advance_to(half);
+  write_checkpoint(dir / "checkpoint.h5", first, c.to_toml());
+  TimeIntegrator second = make_solver(cc);
+  read_checkpoint(dir / "checkpoint.h5", second);
+  second.advance_to(2 * half);
+  std::size_t differing = 0;
+  for (int v = 0; v < variable_count; ++v)
+    for (int k = 0; k < cc.grid.nz; ++k) {
+      const auto i = cc.grid.index(0, 0, k);
+      differing += straight.state().q[v][i] != second.state().q[v][i];
+    }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(straight.counters().steps, second.counters().steps);
+  EXPECT_EQ(straight.time(), second.time());
+}
+
+TEST(Restart, ThroughTheProgramGivesTheSameProfiles) {
+  const auto dir = test_directory();
+  config::Config c = base_config(dir);
+  c.set("continuum.cell_size=0.5");
+  c.set("run.phases_per_cycle=10");
+  c.set("run.sampled_cycles=1");
+  c.set("run.transient_cycles=1");
+  c.set("run.output=" + (dir / "straight.h5").string());
+  ASSERT_EQ(run(c), 0);
+  c.set("run.transient_cycles=0");
+  c.set("run.output=" + (dir / "first.h5").string());
+  c.set("continuum.checkpoint=" + (dir / "checkpoint.h5").string());
+  ASSERT_EQ(run(c), 0);
+  c.set("continuum.checkpoint=");
+  c.set("continuum.restart=" + (dir / "checkpoint.h5").string());
+  c.set("run.output=" + (dir / "second.h5").string());
+  ASSERT_EQ(run(c), 0);
+  const RunRecord a = read_run_file(dir / "straight.h5"), b = read_run_file(dir / "second.h5");
+  ASSERT_EQ(a.profiles.size(), b.profiles.size());
+  std::size_t differing = 0;
+  for (std::size_t p = 0; p < a.profiles.size(); ++p)
+    for (std::size_t i = 0; i < a.profiles[p].size(); ++i)
+      differing += (a.profiles[p].n[i] != b.profiles[p].n[i]) + (a.profiles[p].T[i] != b.profiles[p].T[i]) +
+                   (a.profiles[p].uz[i] != b.profiles[p].uz[i]);
+  EXPECT_EQ(differing, 0u);
+}
+
+// The paper's base case in 1D: after the transient the state is periodic (centre of mass
+// repeats from cycle to cycle) and a shock is found between f t = 0.1 and 0.4.
+TEST(BaseCase, PeriodicStateAndShock) {
+  const auto dir = test_directory();
+  config::Config c = base_config(dir);
+  c.set("continuum.cell_size=0.25");
+  c.set("run.transient_cycles=10");
+  c.set("run.sampled_cycles=2");
+  ASSERT_EQ(run(c), 0);
+  const RunRecord r = read_run_file(dir / "run.h5");
+  const auto& change = r.series.column("center_of_mass_change_from_previous_cycle");
+  const auto& com = r.series.column("center_of_mass");
+  const std::size_t K = r.profiles.size();
+  double d2 = 0, h2 = 0;
+  for (std::size_t i = com.size() - K; i < com.size(); ++i) {
+    d2 += change[i] * change[i];
+    h2 += com[i] * com[i];
+  }
+  const double periodicity = std::sqrt(d2 / h2);
+  int shocks = 0;
+  for (const Profile& p : r.profiles) {
+    const auto shock = analysis::find_shock(p);
+    if (shock && p.phase >= 0.1 && p.phase <= 0.4) ++shocks;
+    if (shock) std::printf("phase %.2f: shock at %.3f, width %.3f\n", p.phase, shock->location, shock->width);
+  }
+  std::printf("periodicity (fractional RMS change of the centre of mass, last two cycles) %.3e; "
+              "phases with a shock in [0.1, 0.4]: %d\n", periodicity, shocks);
+  EXPECT_LT(periodicity, 0.01);
+  EXPECT_GE(shocks, 3);
+  const auto& mass = r.series.column("total_mass");
+  EXPECT_LT(std::abs(mass.back() - mass.front()) / mass.front(), 1e-12);
+}
+
+}  // namespace
+}  // namespace shaker::continuum::testing
