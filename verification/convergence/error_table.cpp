@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -221,6 +222,31 @@ std::string gci_to_csv(std::span<const GciRow> rows) {
 
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows) {
   write_text_atomically(path, gci_to_csv(rows));
+}
+
+std::vector<std::filesystem::path> write_study(const std::filesystem::path& directory,
+                                               const std::string& name, const ErrorTable& table,
+                                               std::span<const OrderCheck> checks,
+                                               std::span<const GciRow> gci) {
+  if (checked_name(name).find('/') != std::string::npos)
+    throw std::invalid_argument("study file name may not contain '/': " + name);
+  std::vector<std::filesystem::path> targets{directory};
+  if (const char* collected = std::getenv(study_directory_variable);
+      collected != nullptr && *collected != '\0')
+    targets.emplace_back(collected);
+  std::vector<std::filesystem::path> written;
+  for (const auto& target : targets) {
+    std::filesystem::create_directories(target);
+    table.write_csv(target / (name + ".errors.csv"));
+    write_orders_csv(target / (name + ".orders.csv"), checks);
+    written.push_back(target / (name + ".errors.csv"));
+    written.push_back(target / (name + ".orders.csv"));
+    if (!gci.empty()) {
+      write_gci_csv(target / (name + ".gci.csv"), gci);
+      written.push_back(target / (name + ".gci.csv"));
+    }
+  }
+  return written;
 }
 
 }  // namespace shaker::convergence

@@ -89,4 +89,17 @@ GciRow make_gci_row(const std::string& study, const std::string& quantity, doubl
 std::string gci_to_csv(std::span<const GciRow> rows);
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows);
 
+/// Environment variable naming the directory that collects study tables for the nightly
+/// convergence report (ci/nightly sets it; unset in ordinary ctest runs).
+inline constexpr const char* study_directory_variable = "SHAKER_CONVERGENCE_DIR";
+
+/// Writes <directory>/<name>.errors.csv and <name>.orders.csv (and <name>.gci.csv when GCI
+/// rows are given), atomically; when SHAKER_CONVERGENCE_DIR is set, writes the same files there
+/// too. `name` must be unique per test (the test name) and may not contain '/'.
+/// Returns every file written.
+std::vector<std::filesystem::path> write_study(const std::filesystem::path& directory,
+                                               const std::string& name, const ErrorTable& table,
+                                               std::span<const OrderCheck> checks,
+                                               std::span<const GciRow> gci = {});
+
 }  // namespace shaker::convergence

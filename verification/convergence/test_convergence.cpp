@@ -7,7 +7,11 @@
 
 #include <cmath>
 #include <filesystem>
+#include <stdlib.h>  // unsetenv
+
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -256,5 +260,40 @@ TEST(OrderChecks, PassAndFailAgainstTheBand) {
   cv::write_gci_csv(dir / "s.gci.csv", rows);
   EXPECT_TRUE(std::filesystem::exists(dir / "s.gci.csv"));
   EXPECT_NE(cv::gci_to_csv(rows).find(",monotonic,"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// The C++ writer and the Python report agree on the schema: a study written by write_study is
+// read by reports/make_convergence_report.py, which marks the passing and failing series.
+TEST(ReportPipeline, StudyWrittenHereIsReadByTheReportGenerator) {
+  // A synthetic study must not reach the nightly report (each test runs in its own process).
+  ::unsetenv(cv::study_directory_variable);
+  const auto dir = fresh_directory("ReportPipeline");
+  cv::ErrorTable table;
+  const auto h = halving(0.1, 4);
+  for (int k = 0; k < 4; ++k) {
+    const double x = h[static_cast<std::size_t>(k)];
+    table.add_norms("pipeline", "n", k, x, {0.2 * x * x, 0.3 * x * x, 0.5 * x * x});
+    table.add_norms("pipeline", "T", k, x, {0.2 * x, 0.3 * x, 0.5 * x});
+  }
+  const auto checks = cv::check_orders(table, 2.0, 0.1);
+  const std::vector<cv::GciRow> gci{cv::make_gci_row("pipeline", "com_height", 0.025, 0.05, 0.1,
+                                                     3.0 + 0.025 * 0.025, 3.0 + 0.05 * 0.05,
+                                                     3.0 + 0.1 * 0.1)};
+  const auto written = cv::write_study(dir / "tables", "ReportPipeline", table, checks, gci);
+  ASSERT_GE(written.size(), 3u);
+  const auto report = dir / "out" / "convergence.md";
+  const std::string command = std::string(SHAKER_REPORT_PYTHON) + " " + SHAKER_REPORTS_DIR +
+                              "/make_convergence_report.py --input " + (dir / "tables").string() +
+                              " --output " + report.string() + " --commit test > " +
+                              (dir / "log.txt").string() + " 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream in(report);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("7 checks: 4 pass, 3 fail."), std::string::npos) << text.substr(0, 600);
+  EXPECT_NE(text.find("| pipeline | n | L2 | 2 ± "), std::string::npos);
+  EXPECT_NE(text.find("- order pipeline / T / L1: fitted 1,"), std::string::npos);
+  EXPECT_NE(text.find("| pipeline | com_height |"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "convergence-pipeline.png"));
   std::filesystem::remove_all(dir);
 }
