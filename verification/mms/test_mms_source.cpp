@@ -13,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "cell_average.hpp"
 #include "mms_source.hpp"
 
 namespace mms = shaker::mms;
@@ -283,4 +284,56 @@ TEST(MmsSource, TransportVariantsDiffer) {
   const auto b = mms::primitive_residual(solution, full, mms::Terms{}, 2.0, x);
   EXPECT_GT(std::abs(a.energy - b.energy), 1e-3);
   EXPECT_GT(std::abs(a.momentum[2] - b.momentum[2]), 1e-4);
+}
+
+// ---- Cell averages (cell_average.hpp) -------------------------------------------------------
+
+TEST(CellAverage, ThreePointGaussIsExactForQuinticsAndSixthOrderForSines) {
+  const auto quintic = [](const std::array<double, 3>& x) {
+    return 1.0 + x[2] - 2.0 * std::pow(x[2], 3) + 0.5 * std::pow(x[2], 5);
+  };
+  // Average over [0.5, 1.5] (width 1) from the antiderivative.
+  const auto antiderivative = [](double z) {
+    return z + z * z / 2.0 - std::pow(z, 4) / 2.0 + std::pow(z, 6) / 12.0;
+  };
+  const double exact = antiderivative(1.5) - antiderivative(0.5);
+  EXPECT_NEAR(mms::cell_average(quintic, {0.0, 0.0, 1.0}, {1.0, 1.0, 1.0}, 1), exact, 1e-14);
+
+  // 3D: average of sin(x) cos(y) sin(z) over a box is a product of 1D averages.
+  const auto wave = [](const std::array<double, 3>& x) {
+    return std::sin(x[0]) * std::cos(x[1]) * std::sin(x[2]);
+  };
+  const std::array<double, 3> centre{0.7, -0.4, 1.9};
+  std::vector<double> errors;
+  for (double h : {0.4, 0.2}) {
+    const double ax = (std::cos(centre[0] - h / 2) - std::cos(centre[0] + h / 2)) / h;
+    const double ay = (std::sin(centre[1] + h / 2) - std::sin(centre[1] - h / 2)) / h;
+    const double az = (std::cos(centre[2] - h / 2) - std::cos(centre[2] + h / 2)) / h;
+    errors.push_back(std::abs(mms::cell_average(wave, centre, {h, h, h}, 3) - ax * ay * az));
+  }
+  EXPECT_LT(errors[0], 1e-8);
+  const double order = std::log(errors[0] / errors[1]) / std::log(2.0);
+  EXPECT_NEAR(order, 6.0, 0.2) << "errors " << errors[0] << ", " << errors[1];
+}
+
+TEST(CellAverage, AveragedSourceApproachesThePointSourceAtSecondOrder) {
+  for (int dimension : {1, 3}) {
+    const auto solution = solution_of(dimension);
+    const mms::Physics physics;
+    const std::array<double, 3> centre{3.1, 7.2, 4.4};
+    const double t = 2.5;
+    const auto point = mms::conservative_source(solution, physics, mms::Terms{}, t, centre);
+    std::vector<double> differences;
+    for (double h : {0.2, 0.1}) {
+      const auto average = mms::average_conservative_source(solution, physics, mms::Terms{}, t,
+                                                            centre, {h, h, h});
+      differences.push_back(std::abs(average.energy - point.energy));
+    }
+    EXPECT_NEAR(std::log(differences[0] / differences[1]) / std::log(2.0), 2.0, 0.05)
+        << "d" << dimension << ": " << differences[0] << ", " << differences[1];
+    const auto fields = mms::average_fields(solution, t, centre, {0.1, 0.1, 0.1});
+    const auto exact = solution(t, centre[0], centre[1], centre[2]);
+    EXPECT_NEAR(fields.n, exact.n, 1e-3);
+    EXPECT_GT(std::abs(fields.n - exact.n), 0.0);
+  }
 }
