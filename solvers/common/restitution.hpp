@@ -10,11 +10,12 @@ struct Restitution {
   Kind kind = Kind::constant;
   double e = 0.9;  ///< the constant value; for velocity_dependent, the value the continuum uses
 
-  /// e as a function of the normal impact speed |v_n| (units sqrt(g sigma)):
+  /// e as a function of the normal impact velocity v_n (either sign) (units sqrt(g sigma)):
   /// velocity_dependent is e = 1 - 0.1 |v_n|^(3/4) below |v_n| = 1 and 0.9 above (physics.md).
-  double operator()(double normal_speed) const {
+  double operator()(double normal_velocity) const {
     if (kind == Kind::constant) return e;
-    return normal_speed < 1.0 ? 1.0 - 0.1 * std::pow(normal_speed, 0.75) : 0.9;
+    const double speed = std::abs(normal_velocity);
+    return speed < 1.0 ? 1.0 - 0.1 * std::pow(speed, 0.75) : 0.9;
   }
 };
 
