@@ -28,7 +28,7 @@ struct SeriesRows {
   static constexpr const char* names[] = {
       "t", "phase", "plate_z", "com_z", "kinetic", "potential", "plate_work",
       "collisional_loss", "energy_closure", "pair_collisions", "plate_collisions",
-      "ceiling_collisions", "cell_crossings", "guard_activations", "overlaps"};
+      "ceiling_collisions", "cell_crossings", "guard_activations", "overlaps", "near_plate"};
   std::vector<std::vector<double>> columns = std::vector<std::vector<double>>(std::size(names));
   void add(std::initializer_list<double> row) {
     std::size_t k = 0;
@@ -79,8 +79,12 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
   std::vector<Vec3> r, v;
   auto record = [&](double t) {
     sim.positions_at(t, r, v);
-    double com = 0.0;
-    for (const Vec3& x : r) com += x.z;
+    double com = 0.0, near_plate = 0.0;
+    const double plate_z = shaker.position(t);
+    for (const Vec3& x : r) {
+      com += x.z;
+      near_plate += x.z - 0.5 - plate_z < 0.5 ? 1.0 : 0.0;  // within half a diameter
+    }
     const EnergyBudget b = budget_now(t);
     const Tally& tally = sim.tally();
     rows.add({t, shaker.phase(t), shaker.position(t), com / n, sim.kinetic_energy(t),
@@ -88,7 +92,7 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
               static_cast<double>(tally.pair), static_cast<double>(tally.plate),
               static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
               static_cast<double>(tally.guard_activations),
-              static_cast<double>(sim.count_overlaps(t, 1e-9))});
+              static_cast<double>(sim.count_overlaps(t, 1e-9)), near_plate});
   };
 
   const auto start = std::chrono::steady_clock::now();

@@ -1,0 +1,92 @@
+// Bad input through the `shaker` program: exit code 2, a message naming the value and the
+// allowed range, and nothing written under the output name.
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "md/checkpoint.hpp"
+#include "md/initial_states.hpp"
+#include "md_test_support.hpp"
+
+namespace shaker::md {
+namespace {
+
+struct Outcome {
+  int exit_code;
+  std::string errors;
+};
+
+Outcome run_shaker(const std::filesystem::path& dir, const std::string& arguments) {
+  const auto err = dir / "stderr.txt";
+  std::ofstream(dir / "case.toml") << "[case]\nname = \"bad-input\"\n";
+  const std::string command = std::string(SHAKER_BINARY) + " md " + (dir / "case.toml").string() +
+                              " --set run.output=" + (dir / "out.h5").string() + " " + arguments +
+                              " > /dev/null 2> " + err.string();
+  const int status = std::system(command.c_str());
+  std::stringstream text;
+  text << std::ifstream(err).rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, text.str()};
+}
+
+void expect_rejected(const std::string& arguments, const std::string& names) {
+  const auto dir = testing::test_directory();
+  const Outcome outcome = run_shaker(dir, arguments);
+  EXPECT_EQ(outcome.exit_code, 2) << arguments << ": " << outcome.errors;
+  EXPECT_NE(outcome.errors.find(names), std::string::npos) << outcome.errors;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.h5"));
+  for (const auto& entry : std::filesystem::directory_iterator(dir))  // no temporary left either
+    EXPECT_EQ(entry.path().string().find("out.h5"), std::string::npos) << entry.path();
+}
+
+TEST(MdBadInput, RestitutionOutsideZeroOne) { expect_rejected("--set material.e=1.5", "material.e"); }
+TEST(MdBadInput, NegativeRestitution) { expect_rejected("--set material.e=-0.1", "material.e"); }
+TEST(MdBadInput, GammaNotPositive) { expect_rejected("--set shaker.gamma=0", "shaker.gamma"); }
+TEST(MdBadInput, FrequencyNotPositive) { expect_rejected("--set shaker.frequency=-1", "shaker.frequency"); }
+TEST(MdBadInput, CeilingBelowPlateTop) { expect_rejected("--set md.ceiling=15", "md.ceiling = 15"); }
+TEST(MdBadInput, TooManyParticlesForTheBox) {
+  expect_rejected("--set layer.particles=100000", "layer.particles = 100000 does not fit");
+}
+TEST(MdBadInput, BoxNarrowerThanThreeCells) { expect_rejected("--set md.box_width=2.5 --set layer.particles=10", "md.box_width"); }
+TEST(MdBadInput, MissingCheckpoint) {
+  expect_rejected("--set md.initial_state=checkpoint --set md.checkpoint=/nonexistent.h5", "md.checkpoint");
+}
+
+/// A checkpoint of the base case with one particle moved.
+std::string checkpoint_with(const std::filesystem::path& dir, Vec3 moved_to) {
+  Geometry g;
+  g.plate = PlateMotion::from(ShakerKinematics{3.0, 0.095});
+  CollisionRules rules;
+  Simulation sim(g, rules, flat_layer(g, 3937, 1));
+  SimulationData data = sim.save();
+  data.particles[5].r = moved_to;
+  const auto path = dir / "bad-checkpoint.h5";
+  write_checkpoint(path, data, g, "test");
+  return "--set md.initial_state=checkpoint --set md.checkpoint=" + path.string();
+}
+
+TEST(MdBadInput, OverlappingParticlesInCheckpoint) {
+  const auto dir = testing::test_directory();
+  Simulation probe(Geometry{}, CollisionRules{}, flat_layer(Geometry{}, 3937, 1));
+  Vec3 onto = probe.particles()[6].r;
+  onto.x += 0.3;  // 0.3 from particle 6's centre
+  const std::string arguments = checkpoint_with(dir, onto);
+  const Outcome outcome = run_shaker(dir, arguments);
+  EXPECT_EQ(outcome.exit_code, 2) << outcome.errors;
+  EXPECT_NE(outcome.errors.find("overlap"), std::string::npos) << outcome.errors;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.h5"));
+}
+
+TEST(MdBadInput, ParticleOutsideTheBoxInCheckpoint) {
+  const auto dir = testing::test_directory();
+  const std::string arguments = checkpoint_with(dir, {5.0, 5.0, 250.0});  // above the ceiling
+  const Outcome outcome = run_shaker(dir, arguments);
+  EXPECT_EQ(outcome.exit_code, 2) << outcome.errors;
+  EXPECT_NE(outcome.errors.find("particle 5"), std::string::npos) << outcome.errors;
+  EXPECT_NE(outcome.errors.find("outside the box"), std::string::npos) << outcome.errors;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.h5"));
+}
+
+}  // namespace
+}  // namespace shaker::md
