@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <stdlib.h>  // unsetenv
+#include <unistd.h>  // getpid
 
 #include <cstdlib>
 #include <fstream>
@@ -30,7 +31,9 @@ std::vector<double> halving(double h0, int levels) {
 }
 
 std::filesystem::path fresh_directory(const std::string& test_name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("shaker-convergence-" + test_name);
+  // The process id keeps concurrent runs from different build directories apart.
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("shaker-convergence-" + test_name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
