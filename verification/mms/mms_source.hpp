@@ -20,6 +20,16 @@
 // A solver that integrates dU/dt = L(U) adds S (or R for a primitive-variable scheme) to L.
 // Each physical term can be switched off (Terms); the same switch acts on both forms, and on
 // both the momentum and the energy equation (a pressure switched off also drops -p div u).
+//
+// Plugging into the continuum solver (solvers/continuum/operator.hpp): its conserved variables
+// are exactly (n, n u, E) above, so Operator::external_source adds conservative_source (or,
+// better for a finite-volume scheme, average_conservative_source of cell_average.hpp) to
+// out[density], out[momentum_x..z], out[energy]. Its term switches map one to one, except
+// that its `advection` is the whole inviscid flux (pressure included): solver advection off
+// means mms advection and pressure off. time_derivative = false exists only for checking
+// this file (a solver always has dU/dt). The artificial dissipation of the `paper` variant is
+// a numerical term with no counterpart here: switch it off in MMS runs (the manufactured
+// nu >= 0.13 keeps its density switch below 4e-5 anyway, but it is first order in h).
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
