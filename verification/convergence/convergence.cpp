@@ -64,6 +64,7 @@ std::string to_string(ConvergenceKind kind) {
     case ConvergenceKind::monotonic: return "monotonic";
     case ConvergenceKind::oscillatory: return "oscillatory";
     case ConvergenceKind::stagnant: return "stagnant";
+    case ConvergenceKind::two_grids: return "two-grids";
   }
   return "unknown";
 }

@@ -31,8 +31,9 @@ OrderFit fit_order(std::span<const double> h, std::span<const double> error,
 double richardson_extrapolate(double phi_fine, double phi_coarse, double refinement_ratio,
                               double order);
 
-/// Sign pattern of eps32 / eps21 (eps21 = phi2 - phi1, eps32 = phi3 - phi2).
-enum class ConvergenceKind { monotonic, oscillatory, stagnant };
+/// Sign pattern of eps32 / eps21 (eps21 = phi2 - phi1, eps32 = phi3 - phi2); two_grids: only
+/// two levels, so the order is assumed and nothing about the pattern is known.
+enum class ConvergenceKind { monotonic, oscillatory, stagnant, two_grids };
 std::string to_string(ConvergenceKind kind);
 
 inline constexpr double safety_factor_three_grids = 1.25;

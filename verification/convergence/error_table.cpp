@@ -203,6 +203,24 @@ GciRow make_gci_row(const std::string& study, const std::string& quantity, doubl
                 three_grid_gci(h1, h2, h3, phi1, phi2, phi3), asymptotic_tolerance};
 }
 
+GciRow make_two_grid_gci_row(const std::string& study, const std::string& quantity, double h1,
+                             double h2, double phi1, double phi2, double assumed_order) {
+  const TwoGridGci two = two_grid_gci(h1, h2, phi1, phi2, assumed_order);
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  GciResult result;
+  result.r21 = two.r21;
+  result.r32 = nan;
+  result.order = two.order;
+  result.phi_extrapolated = two.phi_extrapolated;
+  result.relative_difference21 = two.relative_difference21;
+  result.relative_difference32 = nan;
+  result.extrapolated_error21 = std::abs((two.phi_extrapolated - phi1) / two.phi_extrapolated);
+  result.gci21 = two.gci21;
+  result.gci32 = result.asymptotic_ratio = nan;
+  result.kind = ConvergenceKind::two_grids;
+  return GciRow{study, quantity, h1, h2, nan, phi1, phi2, nan, result, nan};
+}
+
 std::string gci_to_csv(std::span<const GciRow> rows) {
   std::string text =
       "study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,relative_difference21,"
@@ -215,7 +233,8 @@ std::string gci_to_csv(std::span<const GciRow> rows) {
                         number(row.phi3), number(r.order), number(r.phi_extrapolated),
                         number(r.relative_difference21), number(r.extrapolated_error21),
                         number(r.gci21), number(r.gci32), number(r.asymptotic_ratio),
-                        to_string(r.kind), number(row.asymptotic_tolerance), row.pass() ? 1 : 0);
+                        to_string(r.kind), number(row.asymptotic_tolerance),
+                        row.checked() ? (row.pass() ? "1" : "0") : "nan");
   }
   return text;
 }

@@ -8,6 +8,8 @@
 //   <name>.gci.csv     study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,
 //                      relative_difference21,extrapolated_error21,gci21,gci32,
 //                      asymptotic_ratio,convergence,asymptotic_tolerance,pass
+//                      (two-grid rows: h3, phi3, gci32, asymptotic_ratio, pass are nan and
+//                      convergence is "two-grids")
 //
 // Numbers are written with 17 significant digits (exact round trip); names may not contain
 // commas, quotes or line breaks. Files are written atomically (temp file + rename).
@@ -75,17 +77,21 @@ std::vector<OrderCheck> check_orders(const ErrorTable& table, double design_orde
 std::string orders_to_csv(std::span<const OrderCheck> checks);
 void write_orders_csv(const std::filesystem::path& path, std::span<const OrderCheck> checks);
 
-/// A quantity of interest on three grids with its GCI analysis.
+/// A quantity of interest on three grids with its GCI analysis (or on two grids: h3, phi3 and
+/// the asymptotic ratio are NaN, the order is assumed, Fs = 3 and there is nothing to check).
 struct GciRow {
   std::string study, quantity;
   double h1 = 0.0, h2 = 0.0, h3 = 0.0, phi1 = 0.0, phi2 = 0.0, phi3 = 0.0;
   GciResult result;
   double asymptotic_tolerance = 0.1;  ///< pass: |asymptotic_ratio - 1| <= tolerance
+  bool checked() const { return result.kind != ConvergenceKind::two_grids; }
   bool pass() const;
 };
 GciRow make_gci_row(const std::string& study, const std::string& quantity, double h1, double h2,
                     double h3, double phi1, double phi2, double phi3,
                     double asymptotic_tolerance = 0.1);
+GciRow make_two_grid_gci_row(const std::string& study, const std::string& quantity, double h1,
+                             double h2, double phi1, double phi2, double assumed_order);
 std::string gci_to_csv(std::span<const GciRow> rows);
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows);
 

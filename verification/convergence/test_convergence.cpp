@@ -262,6 +262,12 @@ TEST(OrderChecks, PassAndFailAgainstTheBand) {
   const std::vector<cv::GciRow> rows{row};
   cv::write_gci_csv(dir / "s.gci.csv", rows);
   EXPECT_TRUE(std::filesystem::exists(dir / "s.gci.csv"));
+  // Two grids: GCI with the assumed order and Fs = 3, nothing to check.
+  const cv::GciRow two = cv::make_two_grid_gci_row("s", "shock3d", 0.5, 1.0, 1.01, 1.04, 2.0);
+  EXPECT_FALSE(two.checked());
+  EXPECT_NEAR(two.result.gci21, 3.0 * (0.03 / 1.01) / 3.0, 1e-15);
+  EXPECT_NE(cv::gci_to_csv(std::vector<cv::GciRow>{two}).find(",two-grids,nan,nan\n"),
+            std::string::npos);
   EXPECT_NE(cv::gci_to_csv(rows).find(",monotonic,"), std::string::npos);
   std::filesystem::remove_all(dir);
 }

@@ -68,7 +68,9 @@ def synthetic_study(directory):
         ("base-1d", "shock_location", 0.025, 0.05, 0.1, *phi, 2.0, 2.0, e21, 0.0, gci21, gci32,
          ratio, "monotonic", 0.1, 1),
         ("base-1d", "max_mach", 0.025, 0.05, 0.1, 3.1, 3.0, 3.3, 1.5, 3.2, 0.032, 0.03, 0.05,
-         0.4, 2.8, "oscillatory", 0.1, 0)])
+         0.4, 2.8, "oscillatory", 0.1, 0),
+        ("base-3d", "shock_location", 0.5, 1.0, "nan", 1.01, 1.04, "nan", 2.0, 1.0, 0.0297, 0.01,
+         0.0297, "nan", "nan", "two-grids", "nan", "nan")])
 
 
 def run(*args):
@@ -121,6 +123,10 @@ try:
           f"GCI row should fail with ratio 2.8: '{mach}'")
     check(line_with(text, "GCI base-1d / max_mach: asymptotic ratio 2.8") != "",
           "GCI failure missing from the summary")
+
+    two_grid = line_with(text, "| base-3d | shock_location |")
+    check("not checked (two grids" in two_grid and "FAIL" not in two_grid,
+          f"two-grid row must be shown but not checked: '{two_grid}'")
 
     errors_header = line_with(text, "| field | norm | h = 0.1 |")
     check("p(0-1)" in errors_header and "p(2-3)" in errors_header, "error table lacks pair orders")
