@@ -42,7 +42,7 @@ double parse_number(const std::string& text, std::size_t line_number) {
     if (used != text.size()) throw std::invalid_argument(text);
     return x;
   } catch (const std::exception&) {
-    // stod rejects nothing it can read; NaN written by fmt is "nan", which stod accepts.
+    // Also reached for trailing characters; "nan" and "inf" (as fmt writes them) are accepted.
     throw std::runtime_error(fmt::format("error table line {}: '{}' is not a number",
                                          line_number, text));
   }
@@ -130,6 +130,7 @@ ErrorTable ErrorTable::read_csv(const std::filesystem::path& path) {
 }
 
 bool OrderCheck::pass() const {
+  // The next pair is missing (NaN) only in a two-level study; otherwise NaN fails.
   const bool next_ok = std::isnan(pair_order_next) && fit_points < 3
                            ? true
                            : within(pair_order_next, design_order, tolerance);
