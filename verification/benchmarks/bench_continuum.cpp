@@ -1,0 +1,74 @@
+// Continuum solver throughput: cell updates per second (cells x steps / wall time), one cycle
+// of the 1D base case at 0.1 sigma (paper transport), a slice of a cycle of the 3D base case
+// (11 x 11 x 80 at 0.5 sigma) with its per-cycle estimate, and memory per 3D cell measured
+// from the heap (mallinfo2) around the solver's construction.
+#include <benchmark/benchmark.h>
+#include <malloc.h>
+
+#include <chrono>
+
+#include "continuum/setup.hpp"
+
+namespace {
+
+using namespace shaker;
+
+continuum::ContinuumCase base_case(int dimension, double h, const char* transport) {
+  config::Config c;
+  c.set("continuum.dimension=" + std::to_string(dimension));
+  c.set("continuum.cell_size=" + std::to_string(h));
+  c.set(std::string("continuum.transport=") + transport);
+  return continuum::continuum_case(c);
+}
+
+void run_fraction(benchmark::State& state, const continuum::ContinuumCase& c, double fraction) {
+  const double period = c.parameters.shaker.period();
+  double seconds = 0, steps = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    continuum::TimeIntegrator solver = continuum::make_solver(c);
+    state.ResumeTiming();
+    const auto start = std::chrono::steady_clock::now();
+    solver.advance_to(fraction * period);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    steps += static_cast<double>(solver.counters().steps);
+  }
+  const double cells = static_cast<double>(c.grid.interior_cells());
+  state.counters["cell_updates_per_second"] = benchmark::Counter(cells * steps / seconds);
+  state.counters["steps_per_cycle"] = steps / static_cast<double>(state.iterations()) / fraction;
+  state.counters["seconds_per_cycle"] = seconds / static_cast<double>(state.iterations()) / fraction;
+  state.counters["cells"] = cells;
+}
+
+void BM_Continuum1D_BaseCase_Paper(benchmark::State& state) {
+  run_fraction(state, base_case(1, 0.1, "paper"), 1.0);
+}
+BENCHMARK(BM_Continuum1D_BaseCase_Paper)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+void BM_Continuum1D_BaseCase_Full(benchmark::State& state) {
+  run_fraction(state, base_case(1, 0.1, "full"), 0.1);
+}
+BENCHMARK(BM_Continuum1D_BaseCase_Full)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+void BM_Continuum3D_BaseCase_Paper(benchmark::State& state) {
+  run_fraction(state, base_case(3, 0.5, "paper"), 0.01);
+}
+BENCHMARK(BM_Continuum3D_BaseCase_Paper)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+void BM_Continuum3D_MemoryPerCell(benchmark::State& state) {
+  const continuum::ContinuumCase c = base_case(3, 0.5, "paper");
+  double bytes = 0;
+  for (auto _ : state) {
+    const auto before = mallinfo2().uordblks;
+    continuum::TimeIntegrator solver(c.grid, c.physics, c.integration);
+    const auto after = mallinfo2().uordblks;
+    bytes = static_cast<double>(after - before);
+    benchmark::DoNotOptimize(solver.state().q[0].data());
+  }
+  state.counters["bytes_per_cell"] = bytes / static_cast<double>(c.grid.interior_cells());
+}
+BENCHMARK(BM_Continuum3D_MemoryPerCell)->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();
