@@ -26,9 +26,10 @@ std::vector<ParameterSpec> continuum_parameters() {
       integer("continuum.integrator_order", 2, closed(2, 3), "SSP Runge-Kutta order (2 or 3)"),
       real("continuum.diffusion_number", 0.8, positive(1.0),
            "time step as a fraction of the forward-Euler diffusive limit h^2 / (2 dim D)"),
-      text("continuum.diffusion_integrator", "auto", {"auto", "explicit", "rkl2"},
+      text("continuum.diffusion_integrator", "auto", {"auto", "explicit", "rkl2", "implicit"},
            "diffusive terms: explicit in the SSP-RK step, or Strang-split RKL2 super time "
-           "stepping; auto = rkl2 for full transport, explicit for paper"),
+           "stepping, or Strang-split backward Euler (Eigen sparse); auto = implicit for full "
+           "transport, explicit for paper"),
       real("continuum.temperature_floor", 1e-12, positive(1.0),
            "lowest temperature; every raise to it is counted and reported"),
       real("continuum.artificial_viscosity", 0.5, at_least(0.0, 100.0),

@@ -70,6 +70,12 @@ class Operator {
   double advective_step(double cfl) const;
   double diffusive_step() const;
 
+  /// Fills ghosts and evaluates primitives and the full closure at U, without fluxes.
+  void prepare(State& U) {
+    fill_ghosts(U);
+    update_primitives_and_closure(U, true);
+  }
+
   void fill_ghosts(State& U) const;  ///< walls (mirror) or periodic, x, y periodic
   /// Gravity plus frame force per unit mass at time t (z component).
   double body_force(double t) const;

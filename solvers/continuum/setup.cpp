@@ -28,8 +28,12 @@ ContinuumCase continuum_case(const config::Config& config) {
   i.diffusion_number = config.real("continuum.diffusion_number");
   i.temperature_floor = config.real("continuum.temperature_floor");
   const std::string diffusion = config.text("continuum.diffusion_integrator");
-  const bool rkl2 = diffusion == "rkl2" || (diffusion == "auto" && p.transport == model::Transport::full);
-  i.diffusion = rkl2 ? DiffusionIntegrator::rkl2 : DiffusionIntegrator::explicit_rk;
+  if (diffusion == "rkl2")
+    i.diffusion = DiffusionIntegrator::rkl2;
+  else if (diffusion == "implicit" || (diffusion == "auto" && p.transport == model::Transport::full))
+    i.diffusion = DiffusionIntegrator::implicit;
+  else
+    i.diffusion = DiffusionIntegrator::explicit_rk;
   LayerSpecification& l = c.layer;
   l.mass_per_area = c.parameters.mass_per_area();
   l.volume_fraction = config.real("continuum.initial_volume_fraction");

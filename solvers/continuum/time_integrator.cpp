@@ -10,7 +10,7 @@ namespace shaker::continuum {
 
 TimeIntegrator::TimeIntegrator(const Grid& grid, const PhysicsSettings& physics,
                                const IntegratorSettings& settings)
-    : op_(grid, physics), settings_(settings) {
+    : op_(grid, physics), implicit_(grid), settings_(settings) {
   for (State* s : {&U_, &U0_, &U1_, &U2_, &K_, &K0_, &start_}) s->resize(grid.size());
 }
 
@@ -124,12 +124,17 @@ bool TimeIntegrator::try_step(double dt, std::string& failure) {
   try {
     if (settings_.diffusion == DiffusionIntegrator::explicit_rk)
       return ssp_runge_kutta(dt, Part::all, failure);
+    const auto diffuse = [&](double tau) {
+      if (settings_.diffusion == DiffusionIntegrator::rkl2) return rkl2(tau, failure);
+      implicit_.advance(op_, U_, tau);
+      return admissible(U_, t_, failure);
+    };
     U_.q = U0_.q;
-    if (!rkl2(0.5 * dt, failure)) return false;
+    if (!diffuse(0.5 * dt)) return false;
     U0_.q = U_.q;
     op_.rhs(t_, U0_, K0_, Part::hyperbolic_and_sources);
     if (!ssp_runge_kutta(dt, Part::hyperbolic_and_sources, failure)) return false;
-    return rkl2(0.5 * dt, failure);
+    return diffuse(0.5 * dt);
   } catch (const std::domain_error& error) {
     failure = fmt::format("t = {:.10g}: {}", t_, error.what());
     return false;

@@ -5,6 +5,9 @@
 // Runge–Kutta–Legendre super-time-stepping scheme RKL2 (Meyer, Balsara & Aslam 2014) and the
 // rest by SSP-RK with the advective step only.
 //
+// A third choice, `implicit`, replaces RKL2 by a backward-Euler step of the diffusive terms
+// (implicit_diffusion.hpp): unconditionally stable, first order in time.
+//
 // Positivity: after every stage n must be positive and finite (otherwise the step is
 // rejected and retried with half the step); T below temperature_floor is raised to the floor,
 // and every such use is counted. A step that still fails after max_retries halvings stops the
@@ -13,11 +16,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "continuum/implicit_diffusion.hpp"
 #include "continuum/operator.hpp"
 
 namespace shaker::continuum {
 
-enum class DiffusionIntegrator { explicit_rk, rkl2 };
+enum class DiffusionIntegrator { explicit_rk, rkl2, implicit };
 
 struct IntegratorSettings {
   int order = 2;                  ///< 2: SSP-RK2 (Heun), 3: SSP-RK3 (Shu–Osher)
@@ -67,6 +71,7 @@ class TimeIntegrator {
             const State& k) const;  ///< out = a x + b y + c k on interior cells
 
   Operator op_;
+  ImplicitDiffusion implicit_;
   IntegratorSettings settings_;
   State U_, U0_, U1_, U2_, K_, K0_, start_;
   double t_ = 0.0;
