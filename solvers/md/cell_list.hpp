@@ -34,7 +34,19 @@ class CellList {
 
   /// Calls f(j, shift) for every particle j in the 27 cells around cell c; shift is the
   /// periodic image offset to add to j's position.
-  template <class F> void for_each_neighbor(int c, F&& f) const;
+  template <class F> void for_each_neighbor(int c, F&& f) const {
+    for_each_in_block(c, -1, 1, -1, 1, -1, 1, f);
+  }
+  /// The same for the 9 cells that became neighbours when a particle entered cell c by a
+  /// crossing along `axis` (0, 1, 2) in direction `step` (+1 or -1).
+  template <class F> void for_each_in_new_face(int c, int axis, int step, F&& f) const {
+    const int lo[3] = {axis == 0 ? step : -1, axis == 1 ? step : -1, axis == 2 ? step : -1};
+    const int hi[3] = {axis == 0 ? step : 1, axis == 1 ? step : 1, axis == 2 ? step : 1};
+    for_each_in_block(c, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], f);
+  }
+  /// Visits the particles of cells c + (dx, dy, dz) for offsets in the given ranges.
+  template <class F>
+  void for_each_in_block(int c, int x0, int x1, int y0, int y1, int z0, int z1, F&& f) const;
 
   // Raw lists, stored in checkpoints so that a restart visits neighbours in the same order.
   std::vector<std::int32_t> head_, next_, prev_, cell_;
@@ -46,9 +58,10 @@ class CellList {
   bool periodic_z_ = false;
 };
 
-template <class F> void CellList::for_each_neighbor(int c, F&& f) const {
+template <class F>
+void CellList::for_each_in_block(int c, int x0, int x1, int y0, int y1, int z0, int z1, F&& f) const {
   const int cx = ix(c), cy = iy(c), cz = iz(c);
-  for (int dz = -1; dz <= 1; ++dz) {
+  for (int dz = z0; dz <= z1; ++dz) {
     int z = cz + dz;
     double sz = 0.0;
     if (z < 0 || z >= nz_) {
@@ -56,12 +69,12 @@ template <class F> void CellList::for_each_neighbor(int c, F&& f) const {
       sz = z < 0 ? -height_ : height_;
       z = z < 0 ? z + nz_ : z - nz_;
     }
-    for (int dy = -1; dy <= 1; ++dy) {
+    for (int dy = y0; dy <= y1; ++dy) {
       int y = cy + dy;
       double sy = 0.0;
       if (y < 0) { y += ny_; sy = -width_; }
       else if (y >= ny_) { y -= ny_; sy = width_; }
-      for (int dx = -1; dx <= 1; ++dx) {
+      for (int dx = x0; dx <= x1; ++dx) {
         int x = cx + dx;
         double sx = 0.0;
         if (x < 0) { x += nx_; sx = -width_; }

@@ -36,19 +36,21 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
     const std::size_t n = d.particles.size();
     std::vector<double> table;
     table.reserve(n * particle_columns);
-    std::vector<double> event_time;
+    std::vector<double> event_time, cell_time;
     std::vector<std::int64_t> partner, partner_counter, kind;
     for (std::size_t i = 0; i < n; ++i) {
       const Particle& p = d.particles[i];
       for (double x : {p.r.x, p.r.y, p.r.z, p.v.x, p.v.y, p.v.z, p.t, p.last_collision})
         table.push_back(x);
       event_time.push_back(d.events[i].time);
+      cell_time.push_back(d.events[i].cell_time);
       partner.push_back(d.events[i].partner);
       partner_counter.push_back(d.events[i].partner_counter);
-      kind.push_back(static_cast<std::int64_t>(d.events[i].kind));
+      kind.push_back(static_cast<std::int64_t>(d.events[i].kind) + 256 * d.events[i].cell_direction);
     }
     h5::write(f, "particles", table, n, particle_columns);
     h5::write(f, "event_time", event_time);
+    h5::write(f, "event_cell_time", cell_time);
     h5::write(f, "event_partner", partner);
     h5::write(f, "event_partner_counter", partner_counter);
     h5::write(f, "event_kind", kind);
@@ -91,6 +93,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
       p.last_collision = x[7];
     }
     const auto event_time = h5::read_doubles(f, "event_time");
+    const auto cell_time = h5::read_doubles(f, "event_cell_time");
     const auto partner = h5::read_integers(f, "event_partner");
     const auto partner_counter = h5::read_integers(f, "event_partner_counter");
     const auto kind = h5::read_integers(f, "event_kind");
@@ -99,7 +102,9 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
       d.events[i].time = event_time.at(i);
       d.events[i].partner = static_cast<std::int32_t>(partner.at(i));
       d.events[i].partner_counter = static_cast<std::uint32_t>(partner_counter.at(i));
-      d.events[i].kind = static_cast<EventKind>(kind.at(i));
+      d.events[i].cell_time = cell_time.at(i);
+      d.events[i].kind = static_cast<EventKind>(kind.at(i) % 256);
+      d.events[i].cell_direction = static_cast<std::int8_t>(kind.at(i) / 256);
     }
     d.counters = narrow<std::uint32_t>(h5::read_integers(f, "counters"));
     d.streaks = narrow<std::uint32_t>(h5::read_integers(f, "streaks"));

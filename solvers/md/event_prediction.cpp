@@ -37,7 +37,9 @@ double polish(gsl_root_fsolver* solver, PlateGap& gap, double a, double b) {
 PlateContactFinder::PlateContactFinder() : solver_(gsl_root_fsolver_alloc(gsl_root_fsolver_brent)) {
   gsl_set_error_handler_off();  // failures are reported through return codes below
 }
-PlateContactFinder::~PlateContactFinder() { gsl_root_fsolver_free(solver_); }
+PlateContactFinder::~PlateContactFinder() {
+  if (solver_) gsl_root_fsolver_free(solver_);
+}
 
 // Conservative advancement: with |h''| <= M, h(s + tau) >= h + h' tau - M tau^2 / 2, so no
 // contact can occur before the positive root tau of that bound. Stepping by tau approaches the

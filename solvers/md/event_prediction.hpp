@@ -13,13 +13,14 @@ namespace shaker::md {
 
 inline constexpr double never = std::numeric_limits<double>::infinity();
 
-/// Time until two spheres at relative position r and relative velocity v touch, or `never`.
-/// Approaching spheres that already overlap (by rounding) touch now.
-inline double pair_contact_delay(const Vec3& r, const Vec3& v) {
+/// Time until two spheres at relative position r and relative velocity v touch, if earlier
+/// than `bound`, else `never`. Approaching spheres that already overlap (by rounding) touch now.
+inline double pair_contact_delay(const Vec3& r, const Vec3& v, double bound = never) {
   const double b = dot(r, v);
   if (b >= 0.0) return never;
   const double c = dot(r, r) - 1.0;
   if (c <= 0.0) return 0.0;
+  if (c >= -2.0 * b * bound) return never;  // the root is at least c / (-2 b): skip the sqrt
   const double v2 = dot(v, v);
   const double discriminant = b * b - v2 * c;
   if (discriminant < 0.0) return never;
@@ -51,6 +52,10 @@ class PlateContactFinder {
   ~PlateContactFinder();
   PlateContactFinder(const PlateContactFinder&) = delete;
   PlateContactFinder& operator=(const PlateContactFinder&) = delete;
+  PlateContactFinder(PlateContactFinder&& other) noexcept : solver_(other.solver_) {
+    other.solver_ = nullptr;
+  }
+  PlateContactFinder& operator=(PlateContactFinder&&) = delete;
 
   /// Absolute time of the first contact at or after `now` of a particle at height z with
   /// vertical velocity vz at `now`, or `never` if there is none before `horizon`.

@@ -38,7 +38,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
   data_.cell_of.clear();
   queue_.reset(n);
   for (std::size_t i = 0; i < n; ++i)
-    queue_.update(static_cast<std::int32_t>(i), data_.events[i].time);
+    queue_.update(static_cast<std::int32_t>(i), data_.events[i].next());
 }
 
 SimulationData Simulation::save() const {
@@ -58,11 +58,18 @@ void Simulation::advance_to(double t) {
 void Simulation::step() {
   const std::int32_t i = queue_.top();
   const Event event = data_.events[i];
-  data_.time = event.time;
+  const bool crossing = event.cell_time < event.time;
+  data_.time = crossing ? event.cell_time : event.time;
   const double now = data_.time, g = geometry_.gravity;
   Particle& p = data_.particles[i];
   advance(p, now, g);
   Tally& tally = data_.tally;
+  if (crossing) {
+    ++tally.cell;
+    cross_cell(i, event.cell_direction);
+    predict_after_crossing(i, event.cell_direction);
+    return;
+  }
   switch (event.kind) {
     case EventKind::pair: {
       const std::int32_t j = event.partner;
@@ -105,8 +112,6 @@ void Simulation::step() {
       break;
     }
     case EventKind::cell:
-      ++tally.cell;
-      cross_cell(i, event.partner);
       break;
   }
   predict(i);
@@ -186,35 +191,75 @@ void Simulation::predict(std::int32_t i) {
   const double now = data_.time, g = geometry_.gravity;
   const int c = cells_.cell(i);
   Event event;
-  event.kind = EventKind::cell;
-  double best = cell_crossing_delay(p, c, event.partner);
+  std::int32_t direction = 0;
+  const double cell_delay = cell_crossing_delay(p, c, direction);
+  event.cell_direction = static_cast<std::int8_t>(direction);
+  double best = never;
   cells_.for_each_neighbor(c, [&](std::int32_t j, const Vec3& shift) {
     if (j == i) return;
     Vec3 rj, vj;
     state_at(data_.particles[j], now, g, rj, vj);
-    const double dt = pair_contact_delay(p.r - rj - shift, p.v - vj);
+    const double dt = pair_contact_delay(p.r - rj - shift, p.v - vj, best);
+    if (dt < best) {
+      best = dt;
+      event.partner = j;
+    }
+  });
+  if (best < never) event.partner_counter = data_.counters[event.partner];
+  predict_walls(i, event, best, cell_delay);
+  event.time = now + best;
+  event.cell_time = now + cell_delay;
+  data_.events[i] = event;
+  queue_.update(i, event.next());
+}
+
+void Simulation::predict_walls(std::int32_t i, Event& event, double& best, double cell_delay) {
+  if (geometry_.periodic_z) return;
+  const Particle& p = data_.particles[i];
+  const double now = data_.time;
+  const int c = cells_.cell(i);
+  const int iz = cells_.iz(c);
+  if (iz == cells_.nz() - 1) {
+    const double dt = rise_delay(p.r.z, p.v.z, geometry_.gravity, geometry_.height - 0.5);
+    if (dt < best) { best = dt; event.kind = EventKind::ceiling; }
+  }
+  // Only the rows the plate (and a particle on it) can reach need the plate search, and
+  // only up to the earliest other event.
+  if (iz * cells_.edge_z() < geometry_.plate_top() + 0.5) {
+    const double horizon = now + std::min(best, cell_delay);
+    const double t = plate_finder_.first_contact(p.r.z, p.v.z, now, horizon, geometry_);
+    if (t - now < best) { best = t - now; event.kind = EventKind::plate; }
+  }
+}
+
+// The particle's trajectory did not change, so its known collision stays valid; only the
+// cells that just became neighbours, and the walls near the new cell, can add an earlier one.
+void Simulation::predict_after_crossing(std::int32_t i, int direction) {
+  const Particle& p = data_.particles[i];
+  const double now = data_.time, g = geometry_.gravity;
+  const int c = cells_.cell(i);
+  Event event = data_.events[i];
+  std::int32_t next_direction = 0;
+  const double cell_delay = cell_crossing_delay(p, c, next_direction);
+  event.cell_direction = static_cast<std::int8_t>(next_direction);
+  double best = event.time - now;
+  cells_.for_each_in_new_face(c, direction / 2, (direction & 1) ? 1 : -1,
+                              [&](std::int32_t j, const Vec3& shift) {
+    Vec3 rj, vj;
+    state_at(data_.particles[j], now, g, rj, vj);
+    const double dt = pair_contact_delay(p.r - rj - shift, p.v - vj, best);
     if (dt < best) {
       best = dt;
       event.kind = EventKind::pair;
       event.partner = j;
+      event.partner_counter = data_.counters[j];
     }
   });
-  if (event.kind == EventKind::pair) event.partner_counter = data_.counters[event.partner];
-  if (!geometry_.periodic_z) {
-    const int iz = cells_.iz(c);
-    if (iz == cells_.nz() - 1) {
-      const double dt = rise_delay(p.r.z, p.v.z, g, geometry_.height - 0.5);
-      if (dt < best) { best = dt; event.kind = EventKind::ceiling; }
-    }
-    // Only the rows the plate (and a particle on it) can reach need the plate search.
-    if (iz * cells_.edge_z() < geometry_.plate_top() + 0.5) {
-      const double t = plate_finder_.first_contact(p.r.z, p.v.z, now, now + best, geometry_);
-      if (t - now < best) { best = t - now; event.kind = EventKind::plate; }
-    }
-  }
+  if (!(event.kind == EventKind::plate && event.time < never)) predict_walls(i, event, best, cell_delay);
   event.time = now + best;
+  event.cell_time = now + cell_delay;
   data_.events[i] = event;
-  queue_.update(i, event.time);
+  queue_.update(i, event.next());
 }
 
 void Simulation::positions_at(double t, std::vector<Vec3>& r, std::vector<Vec3>& v) const {
@@ -271,7 +316,7 @@ std::size_t Simulation::count_overlaps(double t, double tolerance) const {
 bool Simulation::queue_consistent() const {
   if (!queue_.consistent() || queue_.size() != data_.particles.size()) return false;
   for (const Event& e : data_.events)
-    if (!(e.time >= data_.time) && e.time != never) return false;
+    if (!(e.next() >= data_.time)) return false;
   return true;
 }
 

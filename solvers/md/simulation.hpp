@@ -18,11 +18,17 @@ namespace shaker::md {
 
 enum class EventKind : std::uint8_t { pair, plate, ceiling, cell };
 
+/// A particle's pending events: its earliest known collision (pair or wall; time = never if
+/// none) and its next cell crossing, kept apart so that a cell crossing only needs to look at
+/// the 9 cells that became neighbours. The queue holds the earlier of the two.
 struct Event {
   double time = never;
-  std::int32_t partner = -1;         ///< pair: the other particle; cell: direction 0..5
+  double cell_time = never;
+  std::int32_t partner = -1;         ///< pair: the other particle
   std::uint32_t partner_counter = 0; ///< pair: partner's collision counter when predicted
-  EventKind kind = EventKind::cell;
+  EventKind kind = EventKind::pair;  ///< pair, plate or ceiling
+  std::int8_t cell_direction = 0;    ///< 2 axis + (1 if upwards)
+  double next() const { return cell_time < time ? cell_time : time; }
 };
 
 /// Running totals of a run (all kept in checkpoints).
@@ -91,6 +97,9 @@ class Simulation {
  private:
   void initialise_queue();
   void predict(std::int32_t i);
+  void predict_after_crossing(std::int32_t i, int direction);
+  /// Finds wall contacts of i earlier than `best` (a delay); updates event and best.
+  void predict_walls(std::int32_t i, Event& event, double& best, double cell_delay);
   double cell_crossing_delay(const Particle& p, int cell, std::int32_t& direction) const;
   void cross_cell(std::int32_t i, std::int32_t direction);
   void note_collision(std::int32_t i, std::int32_t partner);

@@ -1,0 +1,102 @@
+// Collisions per second of the event-driven MD (the project's headline performance figure).
+//   bench_md --benchmark_filter=ElasticGas   homogeneous elastic gas, nu = 0.3
+//   bench_md --benchmark_filter=BaseCase     the paper's base case in its periodic state
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+
+#include "common/config.hpp"
+#include "common/case_parameters.hpp"
+#include "md/initial_states.hpp"
+#include "md/protocol.hpp"
+#include "md/simulation.hpp"
+
+namespace shaker::md {
+namespace {
+
+Geometry periodic_box(std::size_t n, double nu) {
+  Geometry g;
+  g.periodic_z = true;
+  g.gravity = 0.0;
+  g.width = g.height = std::cbrt(static_cast<double>(n) * pi / (6.0 * nu));
+  return g;
+}
+
+void run_pair_collisions(Simulation& sim, std::uint64_t count) {
+  const std::uint64_t target = sim.tally().pair + count;
+  while (sim.tally().pair < target) sim.step();
+}
+
+void ElasticGas(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const Geometry g = periodic_box(n, 0.3);
+  CollisionRules rules;
+  rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
+  Simulation sim(g, rules, homogeneous_gas(g, n, 0.3, 1.0, 1));
+  run_pair_collisions(sim, 5 * n);  // melt the lattice
+  const std::uint64_t batch = 1000000;
+  std::uint64_t done = 0;
+  for (auto _ : state) {
+    run_pair_collisions(sim, batch);
+    done += batch;
+  }
+  state.counters["collisions_per_second"] = benchmark::Counter(static_cast<double>(done), benchmark::Counter::kIsRate);
+  state.counters["bytes_per_particle"] = static_cast<double>(sim.bytes_per_particle());
+  state.counters["particles"] = static_cast<double>(n);
+}
+BENCHMARK(ElasticGas)->Arg(4000)->Arg(40000)->Arg(400000)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+
+/// The base case after `transient` cycles from the flat layer.
+Simulation base_case(Restitution restitution, int transient) {
+  const ShakerKinematics shaker{3.0, 0.095};
+  Geometry g;
+  g.plate = PlateMotion::from(shaker);
+  CollisionRules rules;
+  rules.restitution = restitution;
+  Simulation sim(g, rules, flat_layer(g, 3937, 1));
+  sim.advance_to(transient / shaker.f);
+  return sim;
+}
+
+void BaseCaseCycle(benchmark::State& state, Restitution restitution) {
+  Simulation sim = base_case(restitution, 10);
+  const double period = 1.0 / 0.095;
+  const std::uint64_t start = sim.tally().collisions();
+  for (auto _ : state) sim.advance_to(sim.time() + period);
+  state.counters["collisions_per_second"] =
+      benchmark::Counter(static_cast<double>(sim.tally().collisions() - start), benchmark::Counter::kIsRate);
+  state.counters["collisions_per_cycle"] = benchmark::Counter(
+      static_cast<double>(sim.tally().collisions() - start), benchmark::Counter::kAvgIterations);
+  state.counters["bytes_per_particle"] = static_cast<double>(sim.bytes_per_particle());
+}
+BENCHMARK_CAPTURE(BaseCaseCycle, constant_e, Restitution{Restitution::Kind::constant, 0.9})
+    ->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK_CAPTURE(BaseCaseCycle, velocity_dependent_e, Restitution{Restitution::Kind::velocity_dependent, 0.9})
+    ->Unit(benchmark::kMillisecond)->Iterations(5);
+
+/// The whole base-case run as `shaker md` does it: 10 transient + 10 sampled cycles with
+/// sampling, series and invariant checks (target: under 15 s).
+void BaseCaseFullRun(benchmark::State& state) {
+  const config::Config config;
+  const CaseParameters parameters = CaseParameters::from(config);
+  const MdSettings settings = MdSettings::from(config);
+  double collisions = 0.0;
+  for (auto _ : state) {
+    Geometry g;
+    g.height = settings.ceiling;
+    g.plate = PlateMotion::from(parameters.shaker);
+    CollisionRules rules;
+    rules.restitution = parameters.restitution;
+    Simulation sim(g, rules, flat_layer(g, 3937, parameters.run.seed));
+    const RunOutcome outcome = run_protocol(sim, parameters, settings);
+    collisions += static_cast<double>(outcome.collisions);
+    state.counters["run_seconds"] = outcome.seconds;
+  }
+  state.counters["collisions_per_second"] = benchmark::Counter(collisions, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BaseCaseFullRun)->Unit(benchmark::kSecond)->Iterations(1);
+
+}  // namespace
+}  // namespace shaker::md
+
+BENCHMARK_MAIN();
