@@ -34,6 +34,12 @@ struct EnergyBudget {
 
 struct RunOutcome {
   std::vector<Profile> profiles;
+  /// One row per sampling instant (every phase of every cycle, and the end of the run):
+  /// t, phase, plate_z, com_z (centre of mass), kinetic, potential (g z, lab frame),
+  /// plate_work, collisional_loss (pair + wall, since the start of this run), energy_closure
+  /// (relative, see EnergyBudget), pair/plate/ceiling_collisions and cell_crossings (running
+  /// totals), guard_activations, overlaps (pairs closer than 1 - 1e-9), near_plate (particles
+  /// less than half a diameter above the plate).
   TimeSeries series;
   EnergyBudget budget;
   std::size_t overlaps = 0;  ///< at the end of the run

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 
 #include "common/case_parameters.hpp"
@@ -74,8 +75,11 @@ int run(const config::Config& config) {
   const bool terminal = ::isatty(::fileno(stderr)) != 0;
   Progress progress;
   if (terminal)
-    progress = [](long done, long total, double rate) {
-      fmt::print(stderr, "\rshaker md: cycle {}/{}, {:.3g} collisions/s   ", done, total, rate);
+    progress = [start = std::chrono::steady_clock::now()](long done, long total, double rate) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double left = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
+      fmt::print(stderr, "\rshaker md: cycle {}/{}, {:.3g} collisions/s, about {:.0f} s left   ",
+                 done, total, rate, left);
       if (done == total) fmt::print(stderr, "\n");
     };
   const RunOutcome outcome = run_protocol(simulation, parameters, settings, progress);
