@@ -117,6 +117,31 @@ TEST(MdVibrated, RestartFromCheckpointContinuesBitForBit) {
   EXPECT_TRUE(same_bits(straight.save(), restarted.save()));
 }
 
+TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
+  // shaker md with md.checkpoint_output, then md.initial_state = checkpoint, against one run.
+  const auto dir = testing::test_directory();
+  config::Config first = base_case(dir / "a.h5");
+  first.set("run.transient_cycles=1");
+  first.set("run.sampled_cycles=1");
+  first.set("md.checkpoint_output=" + (dir / "a-end.h5").string());
+  ASSERT_EQ(run(first), 0);
+  config::Config second = base_case(dir / "b.h5");
+  second.set("run.transient_cycles=0");
+  second.set("run.sampled_cycles=1");
+  second.set("md.initial_state=checkpoint");
+  second.set("md.checkpoint=" + (dir / "a-end.h5").string());
+  second.set("md.checkpoint_output=" + (dir / "b-end.h5").string());
+  ASSERT_EQ(run(second), 0);
+  config::Config straight = base_case(dir / "c.h5");
+  straight.set("run.transient_cycles=1");
+  straight.set("run.sampled_cycles=2");
+  straight.set("md.checkpoint_output=" + (dir / "c-end.h5").string());
+  ASSERT_EQ(run(straight), 0);
+  const Checkpoint b = read_checkpoint(dir / "b-end.h5"), c = read_checkpoint(dir / "c-end.h5");
+  EXPECT_NEAR(b.data.time, 3.0 / 0.095, 1e-12);
+  EXPECT_TRUE(same_bits(b.data, c.data));
+}
+
 TEST(MdVibrated, CollapseIsDetectedAndReportedForLowE) {
   const auto dir = testing::test_directory();
   config::Config c = base_case(dir / "collapse.h5");
