@@ -145,7 +145,7 @@ int execute(const config::Config& config) {
   record.model_variant = fmt::format("{} transport, {}D", model::to_string(c.physics.transport),
                                      c.grid.dimension);
   record.configuration = config.to_toml();
-  record.e = c.parameters.restitution.e;
+  record.e = switched ? run.after_switch.e : c.parameters.restitution.e;  // e of the recorded cycle
   record.profiles = std::move(profiles);
   record.series = recorder.series();
   if (!fields.empty()) {

@@ -107,6 +107,7 @@ INSTANTIATE_TEST_SUITE_P(
     EulerMode, RiemannProblems,
     ::testing::Values(std::make_tuple(sod, Limiter::mc, RiemannSolver::hllc),
                       std::make_tuple(sod, Limiter::minmod, RiemannSolver::hll),
+                      std::make_tuple(lax, Limiter::minmod, RiemannSolver::hllc),
                       std::make_tuple(lax, Limiter::mc, RiemannSolver::hllc),
                       std::make_tuple(lax, Limiter::van_leer, RiemannSolver::hllc)),
     [](const auto& param_info) {

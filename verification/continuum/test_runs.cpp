@@ -166,3 +166,41 @@ TEST(BaseCase, PeriodicStateAndShock) {
 
 }  // namespace
 }  // namespace shaker::continuum::testing
+
+namespace shaker::continuum::testing {
+namespace {
+
+// A NaN injected by an external source at one cell stops the run with an error naming the
+// time and the cell, and the solver keeps the last good state.
+TEST(Failure, NamesTimeAndCellAndKeepsTheLastGoodState) {
+  const Grid g = column(50, 10.0);
+  PhysicsSettings physics;
+  physics.terms.frame_force = false;
+  TimeIntegrator solver(g, physics, IntegratorSettings{});
+  for (int k = 0; k < g.nz; ++k)
+    store_primitive(solver.state(), g.index(0, 0, k), Primitive{number_density(0.2), 0, 0, 0, 1.0});
+  solver.op().external_source = [](double t, double, double, double z, double* out) {
+    if (t > 0.05 && z > 3.0 && z < 3.2) out[energy] = std::nan("");
+  };
+  solver.advance_to(0.05);
+  const State good = solver.state();
+  const double t_good = solver.time();
+  std::string message;
+  try {
+    solver.step(1.0);
+  } catch (const StepFailure& failure) {
+    message = failure.what();
+  }
+  std::printf("failure message: %s\n", message.c_str());
+  EXPECT_NE(message.find("t = "), std::string::npos);
+  EXPECT_NE(message.find("(0, 0, 15)"), std::string::npos);
+  EXPECT_EQ(solver.time(), t_good);
+  std::size_t differing = 0;
+  for (int v = 0; v < variable_count; ++v)
+    for (int k = 0; k < g.nz; ++k)
+      differing += good.q[v][g.index(0, 0, k)] != solver.state().q[v][g.index(0, 0, k)];
+  EXPECT_EQ(differing, 0u);
+}
+
+}  // namespace
+}  // namespace shaker::continuum::testing
