@@ -1,6 +1,7 @@
 // Whole-run checks: mass conservation (1D and 3D), a horizontally uniform 3D run equals the
 // 1D run, restart continues identically, and the base-case smoke test (H = 9, e = 0.9, 1D).
 #include <cmath>
+#include <fstream>
 
 #include "analysis/analysis.hpp"
 #include "common/run_file.hpp"
@@ -200,6 +201,44 @@ TEST(Failure, NamesTimeAndCellAndKeepsTheLastGoodState) {
     for (int k = 0; k < g.nz; ++k)
       differing += good.q[v][g.index(0, 0, k)] != solver.state().q[v][g.index(0, 0, k)];
   EXPECT_EQ(differing, 0u);
+}
+
+}  // namespace
+}  // namespace shaker::continuum::testing
+
+namespace shaker::continuum::testing {
+namespace {
+
+// A small 3D run through the program: profiles at every phase, full fields at the chosen
+// phases in HDF5 with an XDMF sidecar naming them.
+TEST(Output3D, ProfilesFieldsAndXdmf) {
+  const auto dir = test_directory();
+  config::Config c;
+  c.set("run.output=" + (dir / "run3d.h5").string());
+  c.set("continuum.dimension=3");
+  c.set("continuum.cell_size=0.5");
+  c.set("continuum.box_width=2");
+  c.set("continuum.ceiling=10");
+  c.set("layer.particles=1000");
+  c.set("run.transient_cycles=0");
+  c.set("run.sampled_cycles=1");
+  c.set("run.phases_per_cycle=4");
+  c.set("continuum.field_phases=[0.0, 0.5]");
+  ASSERT_EQ(run(c), 0);
+  const RunRecord r = read_run_file(dir / "run3d.h5");
+  EXPECT_EQ(r.profiles.size(), 4u);
+  EXPECT_EQ(r.profiles[0].size(), 20u);
+  EXPECT_NE(r.configuration.find("dimension = 3"), std::string::npos);
+  ASSERT_TRUE(std::filesystem::exists(dir / "run3d.fields.h5"));
+  ASSERT_TRUE(std::filesystem::exists(dir / "run3d.fields.xdmf"));
+  std::ifstream xdmf(dir / "run3d.fields.xdmf");
+  const std::string text((std::istreambuf_iterator<char>(xdmf)), std::istreambuf_iterator<char>());
+  std::size_t grids = 0;
+  for (std::size_t at = text.find("GridType=\"Uniform\""); at != std::string::npos;
+       at = text.find("GridType=\"Uniform\"", at + 1))
+    ++grids;
+  EXPECT_EQ(grids, 2u);
+  EXPECT_NE(text.find("run3d.fields.h5:/snapshot_001/T"), std::string::npos);
 }
 
 }  // namespace
