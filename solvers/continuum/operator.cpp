@@ -66,7 +66,8 @@ Limiter limiter_from_string(const std::string& name) {
   if (name == "minmod") return Limiter::minmod;
   if (name == "mc") return Limiter::mc;
   if (name == "van_leer") return Limiter::van_leer;
-  throw InputError(fmt::format("continuum.limiter = \"{}\": allowed values are minmod, mc, van_leer", name));
+  if (name == "none") return Limiter::none;
+  throw InputError(fmt::format("continuum.limiter = \"{}\": allowed values are minmod, mc, van_leer, none", name));
 }
 
 RiemannSolver riemann_from_string(const std::string& name) {

@@ -16,7 +16,9 @@
 namespace shaker::continuum {
 
 enum class EquationOfState { granular, ideal_gas };  ///< ideal_gas: p = n T, gamma = 5/3
-enum class Limiter { minmod, mc, van_leer };
+/// `none`: unlimited central slopes, for verifying smooth solutions (limiters clip smooth
+/// extrema to first order, which caps the Linf order near 1.3).
+enum class Limiter { minmod, mc, van_leer, none };
 enum class RiemannSolver { hllc, hll };              ///< hll is the simple reference
 
 /// Which terms enter the operator. `advection` is the whole inviscid (Riemann) flux;

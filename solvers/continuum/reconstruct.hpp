@@ -1,7 +1,7 @@
 #pragma once
 // Limited MUSCL reconstruction: the face value of a cell is its average plus half a limited
-// slope. Every limiter here keeps face values between the neighbouring averages, so positive
-// fields (n, T, p, c) stay positive at faces.
+// slope. Every limiter here (not `none`) keeps face values between the neighbouring averages,
+// so positive fields (n, T, p, c) stay positive at faces.
 #include <algorithm>
 #include <cmath>
 
@@ -23,6 +23,8 @@ template <Limiter L> inline double limited_slope(double backward, double forward
     const double central = 0.5 * (backward + forward);
     const double bound = 2.0 * std::min(std::abs(backward), std::abs(forward));
     return std::copysign(std::min(std::abs(central), bound), central);
+  } else if constexpr (L == Limiter::none) {
+    return 0.5 * (backward + forward);
   } else {
     const double product = backward * forward;
     return product <= 0.0 ? 0.0 : 2.0 * product / (backward + forward);

@@ -190,6 +190,8 @@ void Operator::add_inviscid_fluxes(State& dUdt) {
       return dispatch_riemann<Limiter::mc>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt);
     case Limiter::van_leer:
       return dispatch_riemann<Limiter::van_leer>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt);
+    case Limiter::none:
+      return dispatch_riemann<Limiter::none>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt);
   }
 }
 
