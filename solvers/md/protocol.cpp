@@ -61,12 +61,11 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
   const double energy0 = sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time());
   const Tally tally0 = sim.tally();
   RunOutcome out;
-  auto budget_now = [&](double t) {
+  auto budget_now = [&](double energy) {
     const Tally& tally = sim.tally();
     EnergyBudget b;
     b.plate_work = tally.plate_work - tally0.plate_work;
     b.collisional_loss = tally.pair_loss + tally.wall_loss - tally0.pair_loss - tally0.wall_loss;
-    const double energy = sim.kinetic_energy(t) + sim.potential_energy(t);
     b.energy_change = energy - energy0;
     const double scale = std::max({std::fabs(b.plate_work), std::fabs(b.collisional_loss), std::fabs(energy), 1e-300});
     b.relative_closure = std::fabs(b.energy_change + b.collisional_loss - b.plate_work) / scale;
@@ -79,20 +78,21 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
   std::vector<Vec3> r, v;
   auto record = [&](double t) {
     sim.positions_at(t, r, v);
-    double com = 0.0, near_plate = 0.0;
+    double com = 0.0, near_plate = 0.0, kinetic = 0.0;
     const double plate_z = shaker.position(t);
-    for (const Vec3& x : r) {
-      com += x.z;
-      near_plate += x.z - 0.5 - plate_z < 0.5 ? 1.0 : 0.0;  // within half a diameter
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      com += r[i].z;
+      kinetic += 0.5 * dot(v[i], v[i]);
+      near_plate += r[i].z - 0.5 - plate_z < 0.5 ? 1.0 : 0.0;  // within half a diameter
     }
-    const EnergyBudget b = budget_now(t);
+    const double potential = sim.geometry().gravity * com;
+    const EnergyBudget b = budget_now(kinetic + potential);
     const Tally& tally = sim.tally();
-    rows.add({t, shaker.phase(t), shaker.position(t), com / n, sim.kinetic_energy(t),
-              sim.potential_energy(t), b.plate_work, b.collisional_loss, b.relative_closure,
+    rows.add({t, shaker.phase(t), plate_z, com / n, kinetic, potential, b.plate_work, b.collisional_loss, b.relative_closure,
               static_cast<double>(tally.pair), static_cast<double>(tally.plate),
               static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
               static_cast<double>(tally.guard_activations),
-              static_cast<double>(sim.count_overlaps(t, 1e-9)), near_plate});
+              static_cast<double>(sim.count_overlaps(r, 1e-9)), near_plate});
   };
 
   const auto start = std::chrono::steady_clock::now();
@@ -120,7 +120,7 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
 
   out.profiles = sampler.profiles(shaker);
   out.series = rows.finish();
-  out.budget = budget_now(end);
+  out.budget = budget_now(sim.kinetic_energy(end) + sim.potential_energy(end));
   out.overlaps = sim.count_overlaps(end, 1e-9);
   out.queue_consistent = sim.queue_consistent();
   const Tally& tally = sim.tally();

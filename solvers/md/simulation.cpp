@@ -297,6 +297,10 @@ double Simulation::potential_energy(double t) const {
 std::size_t Simulation::count_overlaps(double t, double tolerance) const {
   std::vector<Vec3> r, v;
   positions_at(t, r, v);
+  return count_overlaps(r, tolerance);
+}
+
+std::size_t Simulation::count_overlaps(const std::vector<Vec3>& r, double tolerance) const {
   const double limit = (1.0 - tolerance) * (1.0 - tolerance);
   std::size_t overlaps = 0;
   for (std::size_t i = 0; i < r.size(); ++i) {

@@ -90,6 +90,8 @@ class Simulation {
   double potential_energy(double t) const;  ///< g z in the lab frame
   /// Pairs closer than 1 - tolerance at time t (cell-list search).
   std::size_t count_overlaps(double t, double tolerance) const;
+  /// The same for positions already computed by positions_at(time(), ...).
+  std::size_t count_overlaps(const std::vector<Vec3>& r, double tolerance) const;
   /// Heap property, index, and every pending event in the future of time().
   bool queue_consistent() const;
   std::size_t bytes_per_particle() const;
