@@ -66,3 +66,50 @@ TEST(FullTransport, BaseCaseRunsAtTheAdvectiveStep) {
 
 }  // namespace
 }  // namespace shaker::continuum::testing
+
+namespace shaker::continuum::testing {
+namespace {
+
+// Heat conduction alone (nonlinear: kappa grows like sqrt(T)) with steps far above the
+// explicit limit: RKL2 super-time-stepping converges at second order in time, the implicit
+// (backward-Euler, Strang-split) step at first order, both to the explicit reference.
+std::vector<double> conduction(DiffusionIntegrator method, double dt, int order = 2) {
+  const Grid g = column(64, 16.0);
+  PhysicsSettings physics;
+  physics.transport = model::Transport::full;
+  physics.terms = Terms{false, true, false, false, true, false, false, false, false};
+  IntegratorSettings integration;
+  integration.diffusion = method;
+  integration.fixed_dt = dt;
+  integration.order = order;
+  TimeIntegrator solver(g, physics, integration);
+  for (int k = 0; k < g.nz; ++k)
+    store_primitive(solver.state(), g.index(0, 0, k),
+                    Primitive{number_density(0.2), 0, 0, 0, 1.0 + 0.5 * std::cos(pi * g.center(k) / 16.0)});
+  solver.advance_to(2.0);
+  std::vector<double> T;
+  for (int k = 0; k < g.nz; ++k) T.push_back(to_primitive(solver.state(), g.index(0, 0, k)).T);
+  return T;
+}
+
+TEST(DiffusionIntegrators, TemporalOrderOfRkl2AndImplicit) {
+  const auto reference = conduction(DiffusionIntegrator::explicit_rk, 1e-4, 3);  // SSP-RK3
+  for (auto method : {DiffusionIntegrator::rkl2, DiffusionIntegrator::implicit}) {
+    std::vector<double> dts, errors;
+    for (double dt : {0.2, 0.1, 0.05, 0.025}) {
+      const auto T = conduction(method, dt);
+      double worst = 0;
+      for (std::size_t k = 0; k < T.size(); ++k) worst = std::max(worst, std::abs(T[k] - reference[k]));
+      dts.push_back(dt);
+      errors.push_back(worst);
+    }
+    const double order = fitted_order({dts.end() - 3, dts.end()}, {errors.end() - 3, errors.end()});
+    const int design = method == DiffusionIntegrator::rkl2 ? 2 : 1;
+    std::printf("%s: max errors %.3e %.3e %.3e %.3e, observed order %.3f (design %d)\n",
+                design == 2 ? "RKL2" : "implicit", errors[0], errors[1], errors[2], errors[3], order, design);
+    EXPECT_NEAR(order, design, 0.1);
+  }
+}
+
+}  // namespace
+}  // namespace shaker::continuum::testing
