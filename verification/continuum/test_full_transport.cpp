@@ -73,6 +73,10 @@ namespace {
 // Heat conduction alone (nonlinear: kappa grows like sqrt(T)) with steps far above the
 // explicit limit: RKL2 super-time-stepping converges at second order in time, the implicit
 // (backward-Euler, Strang-split) step at first order, both to the explicit reference.
+// Measured: with the stage count at its stability minimum (diffusion_number 0.8, 2 to 4
+// stages at the small steps) RKL2's observed order sinks to 1.77 on these steps (1.3 between
+// the two smallest); with margin in the stage count (diffusion_number 0.1) it is 2.0. The
+// test uses the margin and the report states the effect.
 std::vector<double> conduction(DiffusionIntegrator method, double dt, int order = 2) {
   const Grid g = column(64, 16.0);
   PhysicsSettings physics;
@@ -82,6 +86,7 @@ std::vector<double> conduction(DiffusionIntegrator method, double dt, int order 
   integration.diffusion = method;
   integration.fixed_dt = dt;
   integration.order = order;
+  integration.diffusion_number = 0.1;
   TimeIntegrator solver(g, physics, integration);
   for (int k = 0; k < g.nz; ++k)
     store_primitive(solver.state(), g.index(0, 0, k),
