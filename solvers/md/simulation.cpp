@@ -6,8 +6,9 @@
 
 namespace shaker::md {
 
-Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial)
-    : geometry_(geometry), rules_(rules) {
+Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial,
+                       QueueKind queue)
+    : geometry_(geometry), rules_(rules), use_calendar_(queue == QueueKind::calendar) {
   const std::size_t n = initial.particles.size();
   data_.time = initial.time;
   data_.particles = initial.particles;
@@ -20,12 +21,15 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
     advance(p, data_.time, geometry_.gravity);  // predictions assume p.t == now
     cells_.insert(static_cast<std::int32_t>(i), cells_.cell_of(p.r));
   }
-  queue_.reset(n);
+  heap_.reset(use_calendar_ ? 0 : n);
+  calendar_.reset(use_calendar_ ? n : 0);
   for (std::size_t i = 0; i < n; ++i) predict(static_cast<std::int32_t>(i));
 }
 
-Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, SimulationData saved)
-    : geometry_(geometry), rules_(rules), data_(std::move(saved)) {
+Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, SimulationData saved,
+                       QueueKind queue)
+    : geometry_(geometry), rules_(rules), data_(std::move(saved)),
+      use_calendar_(queue == QueueKind::calendar) {
   const std::size_t n = data_.particles.size();
   cells_.build(geometry_, n);
   cells_.head_ = std::move(data_.cell_head);
@@ -36,9 +40,10 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
   data_.cell_next.clear();
   data_.cell_prev.clear();
   data_.cell_of.clear();
-  queue_.reset(n);
+  heap_.reset(use_calendar_ ? 0 : n);
+  calendar_.reset(use_calendar_ ? n : 0);
   for (std::size_t i = 0; i < n; ++i)
-    queue_.update(static_cast<std::int32_t>(i), data_.events[i].next());
+    schedule(static_cast<std::int32_t>(i), data_.events[i].next());
 }
 
 SimulationData Simulation::save() const {
@@ -51,12 +56,16 @@ SimulationData Simulation::save() const {
 }
 
 void Simulation::advance_to(double t) {
-  while (!queue_.empty() && queue_.top_time() <= t) step();
+  if (use_calendar_) {
+    while (calendar_.top_time() <= t) step();
+  } else {
+    while (heap_.top_time() <= t) step();
+  }
   data_.time = t;
 }
 
 void Simulation::step() {
-  const std::int32_t i = queue_.top();
+  const std::int32_t i = use_calendar_ ? calendar_.top() : heap_.top();
   const Event event = data_.events[i];
   const bool crossing = event.cell_time < event.time;
   data_.time = crossing ? event.cell_time : event.time;
@@ -210,7 +219,7 @@ void Simulation::predict(std::int32_t i) {
   event.time = now + best;
   event.cell_time = now + cell_delay;
   data_.events[i] = event;
-  queue_.update(i, event.next());
+  schedule(i, event.next());
 }
 
 void Simulation::predict_walls(std::int32_t i, Event& event, double& best, double cell_delay) {
@@ -259,7 +268,7 @@ void Simulation::predict_after_crossing(std::int32_t i, int direction) {
   event.time = now + best;
   event.cell_time = now + cell_delay;
   data_.events[i] = event;
-  queue_.update(i, event.next());
+  schedule(i, event.next());
 }
 
 void Simulation::positions_at(double t, std::vector<Vec3>& r, std::vector<Vec3>& v) const {
@@ -318,7 +327,9 @@ std::size_t Simulation::count_overlaps(const std::vector<Vec3>& r, double tolera
 }
 
 bool Simulation::queue_consistent() const {
-  if (!queue_.consistent() || queue_.size() != data_.particles.size()) return false;
+  const bool ok = use_calendar_ ? calendar_.consistent() && calendar_.size() == data_.particles.size()
+                                : heap_.consistent() && heap_.size() == data_.particles.size();
+  if (!ok) return false;
   for (const Event& e : data_.events)
     if (!(e.next() >= data_.time)) return false;
   return true;
@@ -327,8 +338,12 @@ bool Simulation::queue_consistent() const {
 std::size_t Simulation::bytes_per_particle() const {
   const std::size_t n = std::max<std::size_t>(1, data_.particles.size());
   const std::size_t per_particle = sizeof(Particle) + sizeof(Event) + 2 * sizeof(std::uint32_t) +
-                                   3 * sizeof(std::int32_t) + queue_.bytes_per_entry();
-  return per_particle + cells_.head_.size() * sizeof(std::int32_t) / n;
+                                   3 * sizeof(std::int32_t) +
+                                   (use_calendar_ ? calendar_.bytes_per_entry() : heap_.bytes_per_entry());
+  // Grids: cell heads, and the calendar's buckets (at most two per particle).
+  const std::size_t grids = cells_.head_.size() * sizeof(std::int32_t) +
+                            (use_calendar_ ? 2 * n * sizeof(std::int32_t) : 0);
+  return per_particle + grids / n;
 }
 
 }  // namespace shaker::md

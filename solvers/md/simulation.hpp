@@ -10,6 +10,7 @@
 #include "md/cell_list.hpp"
 #include "md/collision_rules.hpp"
 #include "md/event_prediction.hpp"
+#include "md/calendar_queue.hpp"
 #include "md/event_queue.hpp"
 #include "md/geometry.hpp"
 #include "md/particles.hpp"
@@ -62,12 +63,18 @@ class CollapseError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Which future-event list to use: the calendar queue (fast) or the indexed binary heap (the
+/// simple reference). Both pop events in the same order, so a run is identical with either.
+enum class QueueKind { calendar, heap };
+
 class Simulation {
  public:
   /// A fresh run from particle states (cells and events are built here).
-  Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial);
+  Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial,
+             QueueKind queue = QueueKind::calendar);
   /// A continued run: cells, events and counters exactly as saved.
-  Simulation(const Geometry& geometry, const CollisionRules& rules, SimulationData saved);
+  Simulation(const Geometry& geometry, const CollisionRules& rules, SimulationData saved,
+             QueueKind queue = QueueKind::calendar);
 
   /// Processes every event with time <= t, then sets the clock to t.
   void advance_to(double t);
@@ -110,7 +117,13 @@ class Simulation {
   CollisionRules rules_;
   SimulationData data_;
   CellList cells_;
-  IndexedHeap queue_;
+  void schedule(std::int32_t i, double time) {
+    if (use_calendar_) calendar_.update(i, time);
+    else heap_.update(i, time);
+  }
+  bool use_calendar_ = true;
+  IndexedHeap heap_;
+  CalendarQueue calendar_;
   PlateContactFinder plate_finder_;
 };
 

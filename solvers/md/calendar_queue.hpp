@@ -1,0 +1,55 @@
+#pragma once
+// A bounded calendar queue in the style of Paul (J. Comput. Phys. 221, 615, 2007): one
+// pending time per particle, hashed into buckets of width w covering a window of the near
+// future; later times wait in an overflow list. Buckets are scanned for their exact minimum
+// (ties by particle index), so the pop order is the same total order as IndexedHeap's and a
+// run gives the same trajectory with either queue. When the window is used up, every entry is
+// in the overflow list; the width is then re-estimated from the pending times and the window
+// restarts at the earliest one (O(N) once per window, about N events).
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace shaker::md {
+
+class CalendarQueue {
+ public:
+  void reset(std::size_t n);
+  void update(std::int32_t id, double time);
+  std::int32_t top() {
+    if (!cached_valid_) find_minimum();
+    return cached_;
+  }
+  double top_time() {
+    if (!cached_valid_) find_minimum();
+    return cached_ < 0 ? std::numeric_limits<double>::infinity() : time_[cached_];
+  }
+  bool empty() const { return size_ == 0; }
+  std::size_t size() const { return size_; }
+  bool consistent() const;
+  std::size_t bytes_per_entry() const {
+    return sizeof(double) + 4 * sizeof(std::int32_t) + 2 * sizeof(std::int32_t);  // + buckets
+  }
+
+ private:
+  static constexpr std::int32_t in_overflow = -2, absent = -1;
+  bool less(std::int32_t a, std::int32_t b) const {
+    return time_[a] < time_[b] || (time_[a] == time_[b] && a < b);
+  }
+  void unlink(std::int32_t id);
+  void place(std::int32_t id);
+  void find_minimum();
+  void restart_window();
+
+  std::vector<double> time_;
+  std::vector<std::int32_t> where_, next_, prev_, overflow_slot_;
+  std::vector<std::int32_t> head_;      // per bucket
+  std::vector<std::int32_t> overflow_;  // ids
+  std::int32_t current_ = 0;            // bucket holding the earliest times
+  double base_ = 0.0, width_ = 1.0;
+  std::size_t size_ = 0;
+  std::int32_t cached_ = -1;
+  bool cached_valid_ = false;
+};
+
+}  // namespace shaker::md
