@@ -31,6 +31,15 @@ double significant_change(const Profile& p, std::size_t i, std::size_t j, double
   return std::max(fraction * peak_temperature, c.standard_errors * combined);
 }
 
+/// The lowest bin with material whose upper edge is above the plate: while a shock forms, its
+/// compressed region can be thinner than one bin and sit there even if that bin, cut by the
+/// plate, falls below the layer threshold (physics.md).
+std::optional<std::size_t> lowest_bin_above_plate(const Profile& p) {
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.n[i] > 0.0 && p.z[i] + 0.5 * p.bin_height > p.plate_z) return i;
+  return std::nullopt;
+}
+
 double interpolate(const std::vector<double>& z, const std::vector<double>& f, double at) {
   const auto upper = std::upper_bound(z.begin(), z.end(), at);
   if (upper == z.begin()) return f.front();
@@ -92,8 +101,10 @@ std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& c) {
   // after it becomes the bottom of the undisturbed region once T has risen again.
   std::optional<std::size_t> peak, trough;
   std::size_t i = 0;
+  const std::optional<std::size_t> lowest = lowest_bin_above_plate(p);
   for (; i < p.size(); ++i) {
-    if (in_layer(p, i) && (!peak || p.T[i] > p.T[*peak])) peak = i;
+    const bool candidate = in_layer(p, i) || (lowest && i == *lowest);
+    if (candidate && (!peak || p.T[i] > p.T[*peak])) peak = i;
     if (peak && p.T[*peak] - p.T[i] > significant_change(p, *peak, i, c.relative_drop,
                                                          p.T[*peak], c))
       break;
@@ -107,15 +118,24 @@ std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& c) {
       break;
   }
   if (i == p.size()) return std::nullopt;  // no undisturbed region above: no shock in the layer
-  // A shock compresses: the undisturbed material must be in the layer and less dense than
-  // the compressed material (this rejects the hot, dilute lower edge of a falling layer).
-  if (!in_layer(p, *trough) || p.nu[*trough] >= p.nu[*peak]) return std::nullopt;
+  // The shock has stopped the material falling into it: across the region the velocity
+  // relative to the plate must lose a large part of its incoming value. This rejects the hot,
+  // dilute lower edge of a layer that is still falling freely (hot, but not decelerated).
+  const double incoming = p.plate_v - p.uz[*trough];
+  const double deceleration = p.uz[*peak] - p.uz[*trough];
+  const double velocity_noise =
+      c.standard_errors * std::hypot(standard_error(p.uz_se, *peak), standard_error(p.uz_se, *trough));
+  if (!(incoming > 0.0 && deceleration > std::max(c.deceleration * incoming, velocity_noise)))
+    return std::nullopt;
 
   std::size_t steepest = *peak;
   for (std::size_t k = *peak; k < *trough; ++k)
     if (p.T[k] - p.T[k + 1] > p.T[steepest] - p.T[steepest + 1]) steepest = k;
   Shock shock;
   shock.location = 0.5 * (p.z[steepest] + p.z[steepest + 1]);
+  // Once the steepest drop is above the layer's top the shock has left the layer.
+  const auto layer = find_layer(p);
+  if (!layer || shock.location > layer->top) return std::nullopt;
   shock.compressed_top = p.z[*peak];
   shock.undisturbed_bottom = p.z[*trough];
   shock.width = shock.undisturbed_bottom - shock.compressed_top;

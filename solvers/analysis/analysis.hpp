@@ -34,6 +34,9 @@ struct ShockCriteria {
   double relative_drop = 0.25;  ///< minimum (T_max - T_min) / T_max
   double standard_errors = 3.0; ///< minimum drop in combined standard errors
   double relative_rise = 0.05;  ///< the rise above the minimum that confirms it, / T_max
+  /// minimum fraction of the incoming velocity (relative to the plate, at the temperature
+  /// minimum) that the flow has lost at the temperature maximum
+  double deceleration = 0.5;
 };
 
 struct Shock {

@@ -106,6 +106,42 @@ TEST(FindShock, CountsAShockWhoseCompressedRegionIsThinnerThanABin) {
   EXPECT_EQ(shock->location, 1.0);
 }
 
+TEST(FindShock, CountsTheLowestBinAboveThePlateEvenWhenThePlateCutsIt) {
+  // MD bins are fixed in the lab frame: the plate at 2.3 leaves 0.7 of the bin [2, 3] open,
+  // so that bin's density is under-counted below the layer threshold. Its temperature
+  // maximum still marks a forming shock (physics.md).
+  Profile p = shock_profile(4.0, 0.5, 1.0);
+  p.plate_z = 2.3;
+  for (std::size_t i = 0; i < 2; ++i) p.n[i] = p.nu[i] = p.T[i] = p.uz[i] = 0.0;
+  p.nu[2] = 0.02;
+  p.n[2] = number_density(0.02);
+  p.T[2] = 30.0;
+  const auto shock = find_shock(p);
+  ASSERT_TRUE(shock.has_value());
+  EXPECT_EQ(shock->compressed_top, 2.5);
+}
+
+TEST(FindShock, ReportsNoneWhenTheFlowIsNotDeceleratedAcrossTheDrop) {
+  // The temperature structure of a shock, but the material below moves as fast towards the
+  // plate as the material above: nothing has stopped it, so it is not a shock.
+  Profile p = shock_profile(14.0, 1.0);
+  ASSERT_TRUE(find_shock(p).has_value());
+  std::fill(p.uz.begin(), p.uz.end(), -2.0);
+  EXPECT_FALSE(find_shock(p).has_value());
+}
+
+TEST(FindShock, TheShockLeavesTheLayerWhenItsSteepestDropIsAboveTheLayerTop) {
+  // The layer ends 14 above the shock in shock_profile; cut it just above the shock instead.
+  Profile inside = shock_profile(14.0, 1.0);
+  Profile outside = inside;
+  for (std::size_t i = 0; i < inside.size(); ++i) {
+    if (inside.z[i] > 15.0) inside.nu[i] = inside.n[i] = 0.02;
+    if (outside.z[i] > 13.0) outside.nu[i] = outside.n[i] = 0.02;
+  }
+  EXPECT_TRUE(find_shock(inside).has_value());
+  EXPECT_FALSE(find_shock(outside).has_value());
+}
+
 TEST(FindShock, ReportsNoneForAMonotoneTemperature) {
   const Profile p =
       make_profile([](double z) { return 0.55 * step_down(z, 12.0, 2.0); },
