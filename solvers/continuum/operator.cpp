@@ -14,7 +14,7 @@ Operator::Operator(const Grid& grid, const PhysicsSettings& settings)
     : grid_(grid), settings_(settings) {
   const std::size_t cells = grid_.size();
   for (auto& v : w_) v.assign(cells, 0.0);
-  for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa})
+  for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa, &closure_.loss})
     v->assign(cells, 0.0);
 }
 

@@ -89,7 +89,7 @@ class Operator {
 
   // Closure of the last evaluation, per cell (ghosts included).
   struct Closure {
-    std::vector<double> p, c, chi, mu, lambda, kappa;  ///< chi = p / (n T)
+    std::vector<double> p, c, chi, mu, lambda, kappa, loss;  ///< chi = p / (n T), loss: gamma
   };
   const Closure& closure() const { return closure_; }
   const std::array<std::vector<double>, variable_count>& primitives() const { return w_; }

@@ -16,7 +16,6 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
   const Grid& g = grid_;
   const double force = body_force(t);
   const bool loss = settings_.terms.collisional_loss;
-  const double e = settings_.e;
   const bool external = static_cast<bool>(external_source);
   // The external source is a user callback: it stays serial.
 #pragma omp parallel for schedule(static) if (g.nz > 1 && g.interior_cells() > 4096 && !external)
@@ -26,7 +25,7 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
         const std::ptrdiff_t c = g.index(i, j, k);
         dUdt.q[momentum_z][c] += U.q[density][c] * force;
         dUdt.q[energy][c] += U.q[momentum_z][c] * force;
-        if (loss) dUdt.q[energy][c] -= model::collisional_loss(w_[0][c], w_[4][c], e);
+        if (loss) dUdt.q[energy][c] -= closure_.loss[c];
         if (external) {
           double extra[variable_count] = {0, 0, 0, 0, 0};
           const double x = g.dimension == 3 ? g.center(i) : 0.0;

@@ -14,29 +14,34 @@ namespace shaker::continuum {
 
 namespace {
 struct CellClosure {
-  double p, c, mu, lambda, kappa;
+  double p, c, mu, lambda, kappa, loss;
 };
 
+// One fused evaluation of the model per cell (model::constitutive_values: G once), and only
+// when some enabled term needs it.
 CellClosure evaluate(const PhysicsSettings& s, double n, double T, double h, bool need_transport) {
-  CellClosure r{0, 0, 0, 0, 0};
+  CellClosure r{0, 0, 0, 0, 0, 0};
   const Terms& terms = s.terms;
-  const double nu = volume_fraction(n);
-  if (terms.pressure) {
-    if (s.eos == EquationOfState::ideal_gas) {
-      if (!(T >= 0.0)) model::detail::domain_failure("ideal gas", "T", T, "T >= 0");
-      r.p = n * T;
-      r.c = std::sqrt(5.0 / 3.0 * T);
-    } else {
-      r.p = model::pressure(n, T, s.e);
-      r.c = model::sound_speed(nu, T, s.e);
-    }
+  const bool ideal = s.eos == EquationOfState::ideal_gas;
+  if (ideal && terms.pressure) {
+    if (!(T >= 0.0)) model::detail::domain_failure("ideal gas", "T", T, "T >= 0");
+    r.p = n * T;
+    r.c = std::sqrt(5.0 / 3.0 * T);
   }
+  const bool transport = need_transport && (terms.shear_viscosity || terms.bulk_viscosity || terms.conduction);
+  if (!((terms.pressure && !ideal) || terms.collisional_loss || transport)) return r;
+  const model::ConstitutiveValues<double> m = model::constitutive_values(n, T, s.e, s.transport);
+  if (terms.pressure && !ideal) {
+    r.p = m.pressure;
+    r.c = m.sound_speed;
+  }
+  if (terms.collisional_loss) r.loss = m.collisional_loss;
   if (!need_transport) return r;
-  if (terms.shear_viscosity) r.mu = model::shear_viscosity(n, T, s.transport);
-  if (terms.bulk_viscosity) r.lambda = model::bulk_viscosity(n, T);
-  if (terms.conduction) r.kappa = model::thermal_conductivity(n, T, s.transport);
+  if (terms.shear_viscosity) r.mu = m.shear_viscosity;
+  if (terms.bulk_viscosity) r.lambda = m.bulk_viscosity;
+  if (terms.conduction) r.kappa = m.thermal_conductivity;
   if (s.transport == model::Transport::paper && terms.artificial_dissipation) {
-    const double x = nu / s.artificial.volume_fraction;
+    const double x = volume_fraction(n) / s.artificial.volume_fraction;
     const double x2 = x * x;
     const double weight = n * h * r.c / (1.0 + x2 * x2);
     if (terms.shear_viscosity) r.mu += s.artificial.viscosity * weight;
@@ -68,6 +73,7 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
     closure_.mu[c] = r.mu;
     closure_.lambda[c] = r.lambda;
     closure_.kappa[c] = r.kappa;
+    closure_.loss[c] = r.loss;
     } catch (...) {
 #pragma omp critical(shaker_closure_failure)
       if (!failure) failure = std::current_exception();
