@@ -18,6 +18,7 @@ MdSettings MdSettings::from(const config::Config& c) {
   s.checkpoint_output = c.text("md.checkpoint_output");
   s.tc_guard = c.text("md.collapse_guard") == "tc";
   s.tc = c.real("md.tc");
+  s.queue = c.text("md.event_queue") == "calendar" ? QueueKind::calendar : QueueKind::heap;
   return s;
 }
 

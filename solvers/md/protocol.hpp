@@ -23,6 +23,7 @@ struct MdSettings {
   std::string checkpoint, checkpoint_output;
   bool tc_guard = false;
   double tc = 1e-5;
+  QueueKind queue = QueueKind::heap;
   static MdSettings from(const config::Config& config);
 };
 

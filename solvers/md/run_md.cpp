@@ -43,9 +43,10 @@ std::string variant_name(const Restitution& r, const MdSettings& s) {
 Simulation make_simulation(const CaseParameters& c, const MdSettings& s, const Geometry& g,
                            const CollisionRules& rules) {
   const auto n = static_cast<std::size_t>(c.particles);
-  if (s.initial_state == "flat_layer") return Simulation(g, rules, flat_layer(g, n, c.run.seed));
+  if (s.initial_state == "flat_layer") return Simulation(g, rules, flat_layer(g, n, c.run.seed), s.queue);
   if (s.initial_state == "gas")
-    return Simulation(g, rules, homogeneous_gas(g, n, s.gas_volume_fraction, s.gas_temperature, c.run.seed));
+    return Simulation(g, rules, homogeneous_gas(g, n, s.gas_volume_fraction, s.gas_temperature, c.run.seed),
+                      s.queue);
   if (s.checkpoint.empty())
     throw InputError("md.initial_state = \"checkpoint\" needs md.checkpoint = the file to start from");
   Checkpoint saved = read_checkpoint(s.checkpoint);
@@ -54,10 +55,10 @@ Simulation make_simulation(const CaseParameters& c, const MdSettings& s, const G
                                  "allowed: {}", n, s.checkpoint, saved.data.particles.size(),
                                  saved.data.particles.size()));
   validate_state(g, saved.data);
-  if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data));
+  if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
   State state{saved.data.time, std::move(saved.data.particles)};
-  return Simulation(g, rules, state);
+  return Simulation(g, rules, state, s.queue);
 }
 
 }  // namespace

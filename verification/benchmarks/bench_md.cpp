@@ -32,7 +32,8 @@ void ElasticGas(benchmark::State& state) {
   const Geometry g = periodic_box(n, 0.3);
   CollisionRules rules;
   rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
-  Simulation sim(g, rules, homogeneous_gas(g, n, 0.3, 1.0, 1));
+  const QueueKind queue = state.range(1) == 0 ? QueueKind::heap : QueueKind::calendar;
+  Simulation sim(g, rules, homogeneous_gas(g, n, 0.3, 1.0, 1), queue);
   run_pair_collisions(sim, 5 * n);  // melt the lattice
   const std::uint64_t batch = 1000000;
   std::uint64_t done = 0;
@@ -44,7 +45,11 @@ void ElasticGas(benchmark::State& state) {
   state.counters["bytes_per_particle"] = static_cast<double>(sim.bytes_per_particle());
   state.counters["particles"] = static_cast<double>(n);
 }
-BENCHMARK(ElasticGas)->Arg(4000)->Arg(40000)->Arg(400000)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+// Second argument: 0 indexed heap (default queue), 1 calendar queue.
+BENCHMARK(ElasticGas)
+    ->ArgsProduct({{4000, 40000, 400000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(3.0);
 
 /// The base case after `transient` cycles from the flat layer.
 Simulation base_case(Restitution restitution, int transient) {
