@@ -24,7 +24,11 @@ void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& s
     h5::write_attribute(file.id(), "ny", std::int64_t{g.ny});
     h5::write_attribute(file.id(), "nz", std::int64_t{g.nz});
     h5::write_attribute(file.id(), "cell_size", g.h);
+    // The e in effect (after a single-shock switch, the switched one): a restart uses it.
     h5::write_attribute(file.id(), "e", solver.op().settings().e);
+    const EnergyBudget& b = solver.budget();
+    h5::write(file.id(), "energy_budget",
+              std::vector<double>{b.body_work, b.collisional_loss, b.floor_energy});
     h5::write_attribute(file.id(), "configuration", configuration_toml);
     const Counters& k = solver.counters();
     h5::write(file.id(), "counters",
@@ -69,6 +73,12 @@ void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver) 
         for (int i = 0; i < g.nx; ++i) solver.state().q[v][g.index(i, j, kz)] = data[m++];
   }
   solver.set_time(h5::read_double_attribute(file.id(), "time"));
+  solver.op().settings().e = h5::read_double_attribute(file.id(), "e");
+  const std::vector<double> budget = h5::read_doubles(file.id(), "energy_budget");
+  if (budget.size() != 3)
+    throw InputError(fmt::format("continuum.restart = \"{}\": energy_budget has {} entries, not 3",
+                                 path.string(), budget.size()));
+  solver.budget() = EnergyBudget{budget[0], budget[1], budget[2]};
   const auto counters = h5::read_integers(file.id(), "counters");
   solver.counters() = Counters{counters[0], counters[1], counters[2], counters[3]};
 }

@@ -92,6 +92,13 @@ class Operator {
     std::vector<double> p, c, chi, mu, lambda, kappa, loss;  ///< chi = p / (n T), loss: gamma
   };
   const Closure& closure() const { return closure_; }
+
+  /// Energy sources of the last rhs that included them, integrated over the domain per unit
+  /// plate area: power of the body force (gravity + frame force) and the collisional loss rate.
+  struct SourcePower {
+    double body = 0, loss = 0;
+  };
+  const SourcePower& source_power() const { return source_power_; }
   const std::array<std::vector<double>, variable_count>& primitives() const { return w_; }
 
  private:
@@ -105,6 +112,7 @@ class Operator {
   std::array<std::vector<double>, variable_count> w_;  ///< n, ux, uy, uz, T
   Closure closure_;
   bool transport_evaluated_ = false;
+  SourcePower source_power_;
 };
 
 Limiter limiter_from_string(const std::string& name);          ///< throws InputError

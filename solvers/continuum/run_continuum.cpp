@@ -23,7 +23,9 @@ namespace {
 
 struct Recorder {
   std::vector<double> time, phase, com, mass, kinetic, thermal, potential, loss_rate, com_change,
-      floor_uses, steps;
+      floor_uses, steps, frame_energy, body_work, collisional_loss, floor_energy, budget_residual,
+      periodicity_column, restitution;
+  double initial_energy = 0, initial_body_work = 0, initial_loss = 0, initial_floor = 0;
   void add(const TimeIntegrator& solver, const ShakerKinematics& shaker, std::size_t phases) {
     const Diagnostics d = diagnostics(solver, shaker);
     time.push_back(solver.time());
@@ -38,6 +40,23 @@ struct Recorder {
                                              : std::numeric_limits<double>::quiet_NaN());
     floor_uses.push_back(static_cast<double>(solver.counters().temperature_floor_uses));
     steps.push_back(static_cast<double>(solver.counters().steps));
+    // Energy budget relative to the first row (a restart continues the accumulated terms).
+    const EnergyBudget& b = solver.budget();
+    const double energy = solver.total_energy();
+    if (time.size() == 1) {
+      initial_energy = energy;
+      initial_body_work = b.body_work;
+      initial_loss = b.collisional_loss;
+      initial_floor = b.floor_energy;
+    }
+    frame_energy.push_back(energy);
+    body_work.push_back(b.body_work);
+    collisional_loss.push_back(b.collisional_loss);
+    floor_energy.push_back(b.floor_energy);
+    budget_residual.push_back((energy - initial_energy) - (b.body_work - initial_body_work) +
+                              (b.collisional_loss - initial_loss) - (b.floor_energy - initial_floor));
+    periodicity_column.push_back(periodicity(phases));
+    restitution.push_back(solver.op().settings().e);
   }
   TimeSeries series() const {
     TimeSeries s;
@@ -52,9 +71,17 @@ struct Recorder {
     s.add("center_of_mass_change_from_previous_cycle", com_change);
     s.add("temperature_floor_uses", floor_uses);
     s.add("steps", steps);
+    s.add("frame_energy", frame_energy);
+    s.add("accumulated_body_work", body_work);
+    s.add("accumulated_collisional_loss", collisional_loss);
+    s.add("accumulated_floor_energy", floor_energy);
+    s.add("energy_budget_residual", budget_residual);
+    s.add("periodicity_last_two_cycles", periodicity_column);
+    s.add("restitution", restitution);
     return s;
   }
-  /// RMS over the last cycle's phases of the change from the previous cycle, / RMS height.
+  /// RMS over the last cycle's phases of the change from the previous cycle, / RMS height
+  /// (NaN until two whole cycles are recorded).
   double periodicity(std::size_t phases) const {
     if (com.size() < 2 * phases) return std::numeric_limits<double>::quiet_NaN();
     double d2 = 0, h2 = 0;
@@ -157,12 +184,14 @@ int execute(const config::Config& config) {
   write_run_file(output, record);
   const Counters& counters = solver.counters();
   fmt::print("shaker continuum: {} cycles to t = {:.6g}, {} steps ({} rejected), temperature floor "
-             "used {} times; mass drift {:.3e}; periodicity (centre of mass, last two cycles) {:.3e}\n"
-             "wrote {}\n",
+             "used {} times; mass drift {:.3e}; periodicity (centre of mass, last two cycles) {:.3e}"
+             " (series column periodicity_last_two_cycles); energy budget residual {:.3e} of the "
+             "accumulated loss {:.6g}\nwrote {}\n",
              cycles, solver.time(), counters.steps, counters.rejected_steps,
              counters.temperature_floor_uses,
              (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
-             recorder.periodicity(K), output.string());
+             recorder.periodicity(K), recorder.budget_residual.back(),
+             recorder.collisional_loss.back() - recorder.initial_loss, output.string());
   return 0;
 }
 

@@ -18,14 +18,19 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
   const bool loss = settings_.terms.collisional_loss;
   const bool external = static_cast<bool>(external_source);
   // The external source is a user callback: it stays serial.
-#pragma omp parallel for schedule(static) if (g.nz > 1 && g.interior_cells() > 4096 && !external)
+  double body = 0.0, lost = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : body, lost) if (g.nz > 1 && g.interior_cells() > 4096 && !external)
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i) {
         const std::ptrdiff_t c = g.index(i, j, k);
         dUdt.q[momentum_z][c] += U.q[density][c] * force;
         dUdt.q[energy][c] += U.q[momentum_z][c] * force;
-        if (loss) dUdt.q[energy][c] -= closure_.loss[c];
+        body += U.q[momentum_z][c] * force;
+        if (loss) {
+          dUdt.q[energy][c] -= closure_.loss[c];
+          lost += closure_.loss[c];
+        }
         if (external) {
           double extra[variable_count] = {0, 0, 0, 0, 0};
           const double x = g.dimension == 3 ? g.center(i) : 0.0;
@@ -34,6 +39,9 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
           for (int v = 0; v < variable_count; ++v) dUdt.q[v][c] += extra[v];
         }
       }
+  // Per unit plate area: a cell holds h / (nx ny) of the column (1D: nx = ny = 1).
+  const double per_area = g.h / (static_cast<double>(g.nx) * g.ny);
+  source_power_ = SourcePower{body * per_area, lost * per_area};
 }
 
 }  // namespace shaker::continuum

@@ -31,10 +31,20 @@ void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const 
     }
 }
 
-bool TimeIntegrator::admissible(State& s, double t, std::string& failure) {
+double TimeIntegrator::total_energy() const {
+  const Grid& g = op_.grid();
+  double sum = 0.0;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) sum += U_.q[energy][g.index(i, j, k)];
+  return sum * g.h / (static_cast<double>(g.nx) * g.ny);
+}
+
+bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double* added) {
   const Grid& g = op_.grid();
   const double floor = settings_.temperature_floor;
   std::int64_t floors = 0;
+  double raised = 0.0;
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i) {
@@ -52,11 +62,13 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure) {
                                       s.q[momentum_y][c] * s.q[momentum_y][c] +
                                       s.q[momentum_z][c] * s.q[momentum_z][c]) / n;
         if (s.q[energy][c] - kinetic < 1.5 * n * floor) {
+          raised += kinetic + 1.5 * n * floor - s.q[energy][c];
           s.q[energy][c] = kinetic + 1.5 * n * floor;
           ++floors;
         }
       }
   counters_.temperature_floor_uses += floors;
+  if (added) *added = raised * g.h / (static_cast<double>(g.nx) * g.ny);
   return true;
 }
 
@@ -72,19 +84,37 @@ double TimeIntegrator::choose_step(double t_limit) {
 }
 
 bool TimeIntegrator::ssp_runge_kutta(double dt, Part part, std::string& failure) {
-  // U0_ holds the state at t_, K0_ its right-hand side (already evaluated).
+  // U0_ holds the state at t_, K0_ its right-hand side (already evaluated, sources in power0_).
+  // The budget weights are those of the stages in the final combination:
+  // RK2 U = U0 + dt (K0 + K1) / 2; RK3 U = U0 + dt (K0 / 6 + K1 / 6 + 2 K2 / 3).
+  double floor1 = 0, floor2 = 0, floor3 = 0;
+  const auto book = [&](double weight, const Operator::SourcePower& p) {
+    pending_.body_work += weight * dt * p.body;
+    pending_.collisional_loss += weight * dt * p.loss;
+  };
   axpy(U1_, 1.0, U0_, 0.0, U0_, dt, K0_);
-  if (!admissible(U1_, t_ + dt, failure)) return false;
+  if (!admissible(U1_, t_ + dt, failure, &floor1)) return false;
   op_.rhs(t_ + dt, U1_, K_, part);
+  const Operator::SourcePower power1 = op_.source_power();
   if (settings_.order == 2) {
     axpy(U_, 0.5, U0_, 0.5, U1_, 0.5 * dt, K_);
-    return admissible(U_, t_ + dt, failure);
+    if (!admissible(U_, t_ + dt, failure, &floor3)) return false;
+    book(0.5, power0_);
+    book(0.5, power1);
+    pending_.floor_energy += 0.5 * floor1 + floor3;
+    return true;
   }
   axpy(U2_, 0.75, U0_, 0.25, U1_, 0.25 * dt, K_);
-  if (!admissible(U2_, t_ + 0.5 * dt, failure)) return false;
+  if (!admissible(U2_, t_ + 0.5 * dt, failure, &floor2)) return false;
   op_.rhs(t_ + 0.5 * dt, U2_, K_, part);
+  const Operator::SourcePower power2 = op_.source_power();
   axpy(U_, 1.0 / 3.0, U0_, 2.0 / 3.0, U2_, 2.0 / 3.0 * dt, K_);
-  return admissible(U_, t_ + dt, failure);
+  if (!admissible(U_, t_ + dt, failure, &floor3)) return false;
+  book(1.0 / 6.0, power0_);
+  book(1.0 / 6.0, power1);
+  book(2.0 / 3.0, power2);
+  pending_.floor_energy += floor1 / 6.0 + 2.0 / 3.0 * floor2 + floor3;
+  return true;
 }
 
 // RKL2 over dt for the diffusive part, from U_ into U_ (U0_ keeps the step's start state).
@@ -121,18 +151,29 @@ bool TimeIntegrator::rkl2(double dt, std::string& failure) {
 }
 
 bool TimeIntegrator::try_step(double dt, std::string& failure) {
+  pending_ = EnergyBudget{};
   try {
     if (settings_.diffusion == DiffusionIntegrator::explicit_rk)
       return ssp_runge_kutta(dt, Part::all, failure);
+    // The diffusive terms conserve energy, so whatever the split step changes in the total
+    // energy is what the floor added in its stages.
     const auto diffuse = [&](double tau) {
-      if (settings_.diffusion == DiffusionIntegrator::rkl2) return rkl2(tau, failure);
-      implicit_.advance(op_, U_, tau);
-      return admissible(U_, t_, failure);
+      const double before = total_energy();
+      bool ok = true;
+      if (settings_.diffusion == DiffusionIntegrator::rkl2) {
+        ok = rkl2(tau, failure);
+      } else {
+        implicit_.advance(op_, U_, tau);
+        ok = admissible(U_, t_, failure);
+      }
+      pending_.floor_energy += total_energy() - before;
+      return ok;
     };
     U_.q = U0_.q;
     if (!diffuse(0.5 * dt)) return false;
     U0_.q = U_.q;
     op_.rhs(t_, U0_, K0_, Part::hyperbolic_and_sources);
+    power0_ = op_.source_power();
     if (!ssp_runge_kutta(dt, Part::hyperbolic_and_sources, failure)) return false;
     return diffuse(0.5 * dt);
   } catch (const std::domain_error& error) {
@@ -148,6 +189,7 @@ double TimeIntegrator::step(double t_limit) {
                          : Part::hyperbolic_and_sources;
   try {
     op_.rhs(t_, U0_, K0_, first);
+    power0_ = op_.source_power();
   } catch (const std::domain_error& error) {
     throw StepFailure(fmt::format("continuum: the state at t = {:.10g} is outside the model's "
                                   "domain: {}", t_, error.what()));
@@ -161,12 +203,16 @@ double TimeIntegrator::step(double t_limit) {
     if (try_step(dt, failure)) {
       t_ = (t_limit - t_ <= dt) ? t_limit : t_ + dt;
       ++counters_.steps;
+      budget_.body_work += pending_.body_work;
+      budget_.collisional_loss += pending_.collisional_loss;
+      budget_.floor_energy += pending_.floor_energy;
       return dt;
     }
     ++counters_.rejected_steps;
     if (split) {
       U0_.q = start_.q;
       op_.rhs(t_, U0_, K0_, first);
+      power0_ = op_.source_power();
     }
     U_.q = U0_.q;
     dt *= 0.5;

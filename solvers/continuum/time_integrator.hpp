@@ -37,6 +37,16 @@ struct Counters {
   std::int64_t steps = 0, rejected_steps = 0, temperature_floor_uses = 0, diffusion_stages = 0;
 };
 
+/// Energy budget in the container frame, per unit plate area, accumulated over accepted steps
+/// with the Runge–Kutta weights of the stages (so it is the scheme's own discrete budget):
+///   E(t) - E(0) = body_work - collisional_loss + floor_energy   (to round-off),
+/// E = sum of (1/2 n |u|^2 + 3/2 n T) in the container frame. Fluxes cancel between cells and
+/// vanish at the walls; the body force (gravity + frame force) does body_work; the
+/// temperature floor adds floor_energy. External (manufactured) sources are not counted.
+struct EnergyBudget {
+  double body_work = 0, collisional_loss = 0, floor_energy = 0;
+};
+
 /// A step that cannot be completed even with the smallest retried step.
 class StepFailure : public std::runtime_error {
  public:
@@ -55,6 +65,10 @@ class TimeIntegrator {
   void set_time(double t) { t_ = t; }
   const Counters& counters() const { return counters_; }
   Counters& counters() { return counters_; }
+  const EnergyBudget& budget() const { return budget_; }
+  EnergyBudget& budget() { return budget_; }
+  /// Container-frame energy (kinetic + thermal) of the state per unit plate area.
+  double total_energy() const;
   const IntegratorSettings& settings() const { return settings_; }
 
   /// One step, never beyond t_limit (lands on it exactly). Returns the step taken.
@@ -66,7 +80,8 @@ class TimeIntegrator {
   bool try_step(double dt, std::string& failure);
   bool ssp_runge_kutta(double dt, Part part, std::string& failure);
   bool rkl2(double dt, std::string& failure);
-  bool admissible(State& s, double t, std::string& failure);
+  /// `added` (if given) receives the energy per unit plate area the temperature floor added.
+  bool admissible(State& s, double t, std::string& failure, double* added = nullptr);
   void axpy(State& out, double a, const State& x, double b, const State& y, double c,
             const State& k) const;  ///< out = a x + b y + c k on interior cells
 
@@ -76,6 +91,8 @@ class TimeIntegrator {
   State U_, U0_, U1_, U2_, K_, K0_, start_;
   double t_ = 0.0;
   Counters counters_;
+  EnergyBudget budget_, pending_;     ///< pending_: the step being tried
+  Operator::SourcePower power0_;      ///< source power at the step's start state U0_
 };
 
 }  // namespace shaker::continuum

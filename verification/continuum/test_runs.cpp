@@ -160,6 +160,8 @@ TEST(BaseCase, PeriodicStateAndShock) {
   std::printf("periodicity (fractional RMS change of the centre of mass, last two cycles) %.3e; "
               "phases with a shock in [0.1, 0.4]: %d\n", periodicity, shocks);
   EXPECT_LT(periodicity, 0.01);
+  // The run stores the same number (last row of its periodicity column).
+  EXPECT_NEAR(r.series.column("periodicity_last_two_cycles").back(), periodicity, 1e-12 * periodicity);
   EXPECT_GE(shocks, 3);
   const auto& mass = r.series.column("total_mass");
   EXPECT_LT(std::abs(mass.back() - mass.front()) / mass.front(), 1e-12);
