@@ -78,9 +78,13 @@ void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
 
 Eigen::VectorXd ImplicitDiffusion::solve(const Eigen::VectorXd& rhs) {
   if (grid_.dimension == 1) {
-    Eigen::SimplicialLDLT<Matrix> solver(matrix_);
-    if (solver.info() != Eigen::Success) throw DomainError("implicit diffusion: factorisation failed");
-    return solver.solve(rhs);
+    if (!tridiagonal_) {
+      tridiagonal_ = std::make_unique<Tridiagonal>();
+      tridiagonal_->analyzePattern(matrix_);
+    }
+    tridiagonal_->factorize(matrix_);
+    if (tridiagonal_->info() != Eigen::Success) throw DomainError("implicit diffusion: factorisation failed");
+    return tridiagonal_->solve(rhs);
   }
   Eigen::ConjugateGradient<Matrix, Eigen::Lower | Eigen::Upper> solver;
   solver.setTolerance(1e-13);
@@ -102,6 +106,11 @@ void ImplicitDiffusion::advance(Operator& op, State& U, double dt) {
   for (int component = 0; component < 3; ++component) {
     Eigen::VectorXd rhs(M);
     for (std::size_t m = 0; m < cells; ++m) rhs[m] = w[0][storage_[m]] * w[1 + component][storage_[m]] / dt;
+    // A component that vanishes everywhere stays zero exactly (e.g. u_x, u_y of a 1D column).
+    if (rhs.isZero(0.0)) {
+      velocity[component].setZero();
+      continue;
+    }
     assemble(op, component, dt);
     velocity[component] = solve(rhs);
     const Eigen::VectorXd& u = velocity[component];

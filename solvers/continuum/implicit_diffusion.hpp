@@ -11,6 +11,8 @@
 // viscous terms of 3D (d_i (mu d_j u_i), i != j) are not part of this operator; in 3D the full
 // variant keeps only the terms above (stated in the report).
 #include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <memory>
 #include <vector>
 
 #include "continuum/operator.hpp"
@@ -32,6 +34,11 @@ class ImplicitDiffusion {
   std::vector<std::ptrdiff_t> storage_;  ///< interior cell m -> storage index
   std::vector<Eigen::Triplet<double>> triplets_;
   Matrix matrix_;
+  // 1D: the matrix is tridiagonal in the natural order (no fill, no reordering needed), and
+  // its pattern never changes: analysed once, only factorised per solve.
+  // (Held by pointer: Eigen's factorisations cannot be moved, the integrator must be.)
+  using Tridiagonal = Eigen::SimplicialLDLT<Matrix, Eigen::Lower, Eigen::NaturalOrdering<int>>;
+  std::unique_ptr<Tridiagonal> tridiagonal_;
 };
 
 }  // namespace shaker::continuum

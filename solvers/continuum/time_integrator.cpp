@@ -119,8 +119,15 @@ bool TimeIntegrator::ssp_runge_kutta(double dt, Part part, std::string& failure)
 
 // RKL2 over dt for the diffusive part, from U_ into U_ (U0_ keeps the step's start state).
 bool TimeIntegrator::rkl2(double dt, std::string& failure) {
-  State Y0 = U_;  // the stage recursion needs Y0, Y_{j-1}, Y_{j-2} and M0 = L(Y0)
-  State M0(Y0);
+  // The stage recursion needs Y0, Y_{j-1}, Y_{j-2}, Y_j, M0 = L(Y0) and L(Y_{j-1}). The
+  // SSP stages U1_, U2_, K_ are free during the split diffusion step; three more scratch
+  // states are allocated once, on the first RKL2 step, not per step.
+  for (State* scratch : {&Yjm2_, &Yjm1_, &Yj_})
+    if (scratch->size() != U_.size()) scratch->resize(U_.size());
+  State& Y0 = U1_;
+  State& M0 = K_;
+  State& L = U2_;
+  Y0.q = U_.q;
   op_.rhs(t_, Y0, M0, Part::diffusive);
   const double dt_fe = op_.diffusive_step();
   if (!std::isfinite(dt_fe)) return true;
@@ -131,7 +138,12 @@ bool TimeIntegrator::rkl2(double dt, std::string& failure) {
   counters_.diffusion_stages += s;
   auto b = [](int j) { return j <= 2 ? 1.0 / 3.0 : (j * j + j - 2.0) / (2.0 * j * (j + 1.0)); };
   const double w1 = 4.0 / (s * s + s - 2.0);
-  State Yjm2 = Y0, Yjm1 = Y0, Yj = Y0, L = M0;
+  State& Yjm2 = Yjm2_;
+  State& Yjm1 = Yjm1_;
+  State& Yj = Yj_;
+  Yjm2.q = Y0.q;
+  Yjm1.q = Y0.q;  // ghosts included: rhs fills them, axpy writes interiors only
+  Yj.q = Y0.q;
   axpy(Yjm1, 1.0, Y0, 0.0, Y0, b(1) * w1 * dt, M0);
   if (!admissible(Yjm1, t_, failure)) return false;
   for (int j = 2; j <= s; ++j) {

@@ -89,6 +89,7 @@ class TimeIntegrator {
   ImplicitDiffusion implicit_;
   IntegratorSettings settings_;
   State U_, U0_, U1_, U2_, K_, K0_, start_;
+  State Yjm2_, Yjm1_, Yj_;  ///< RKL2 stages (sized on first use)
   double t_ = 0.0;
   Counters counters_;
   EnergyBudget budget_, pending_;     ///< pending_: the step being tried
