@@ -1,6 +1,7 @@
 #pragma once
-// Checkpoints: the interior state, the time and the step counters in HDF5 (written
-// atomically). Restarting from one continues bit for bit like the uninterrupted run, since
+// Checkpoints: the interior state, the time, the step counters, the e in effect (after a
+// single-shock switch the switched e, which a restart takes over instead of the configured
+// one) and the accumulated energy budget, in HDF5 (written atomically). Restarting from one continues bit for bit like the uninterrupted run, since
 // the step sequence depends only on the state and the target times.
 #include <filesystem>
 #include <string>

@@ -4,6 +4,10 @@
 //                mass with the same phase one cycle earlier.
 //  single_shock: transient cycles, e switched at run.switch_phase before the recorded cycle,
 //                then one recorded cycle.
+// The time series carries, besides centre of mass, mass and energies, the container-frame
+// energy budget (frame_energy, accumulated body work, collisional loss and floor energy, and
+// the residual of E - E0 - W + L - F), the periodicity measure of the last two cycles (also
+// printed in the summary) and the restitution in effect at each row.
 #include "continuum/run_continuum.hpp"
 
 #include <fmt/format.h>
