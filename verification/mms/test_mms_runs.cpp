@@ -49,14 +49,16 @@ std::string study_name() {
 constexpr double rounding_level = 1e-9;
 
 /// Fits, writes the study and fails (with the measured orders) for every series out of band;
-/// series at rounding level on every grid are checked against rounding_level instead.
-void check_and_write(const conv::ErrorTable& table, double design_order) {
+/// with fields_may_be_exact (term-alone runs), series at rounding level on every grid are
+/// checked against rounding_level instead (temporal studies reach 1e-12 legitimately).
+void check_and_write(const conv::ErrorTable& table, double design_order,
+                     bool fields_may_be_exact = false) {
   std::vector<conv::OrderCheck> checks;
   for (const auto& c : conv::check_orders(table, design_order, order_tolerance, 3)) {
     const auto series = table.series({c.study, c.field, c.norm});
     double largest = 0.0;
     for (const auto& row : series) largest = std::max(largest, row.error);
-    if (largest < rounding_level) {
+    if (fields_may_be_exact && largest < rounding_level) {
       std::printf("%-44s %-3s %-5s exact to rounding: largest error %.3e\n", c.study.c_str(),
                   c.field.c_str(), c.norm.c_str(), largest);
       continue;
@@ -167,7 +169,7 @@ TEST_P(MmsTermAlone1D, SecondOrder) {
   c.t_end = 1.0;
   conv::ErrorTable table;
   mms::spatial_study(c, {20, 40, 80, 160}, study_name(), table);
-  check_and_write(table, design_space_order);
+  check_and_write(table, design_space_order, true);
 }
 INSTANTIATE_TEST_SUITE_P(
     Terms, MmsTermAlone1D,

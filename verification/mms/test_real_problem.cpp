@@ -69,7 +69,7 @@ TEST(NightlyRealProblem, BaseCase1DGridConvergence) {
         SHAKER_BASE_CASE,
         {"continuum.cell_size=" + std::to_string(h),
          "run.transient_cycles=" + std::to_string(transient_cycles), "run.sampled_cycles=1",
-         "run.phases_per_cycle=100", "run.output=\"" + output.string() + "\""});
+         "run.phases_per_cycle=100", "run.output=" + output.string()});
     ASSERT_EQ(shaker::continuum::run(config), 0) << "cell size " << h;
     values.push_back(quantities(shaker::read_run_file(output)));
     for (const auto& [name, v] : values.back()) std::printf("h %.3f %-26s %.6g\n", h, name.c_str(), v);
