@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "common/errors.hpp"
+
 namespace shaker::md {
 
 Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial,
@@ -32,6 +34,9 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
       use_calendar_(queue == QueueKind::calendar) {
   const std::size_t n = data_.particles.size();
   cells_.build(geometry_, n);
+  if (data_.cell_head.size() != cells_.head_.size())
+    throw InputError(fmt::format("checkpoint cell grid has {} cells, this geometry needs {} (written "
+                                 "by another version of the solver)", data_.cell_head.size(), cells_.head_.size()));
   cells_.head_ = std::move(data_.cell_head);
   cells_.next_ = std::move(data_.cell_next);
   cells_.prev_ = std::move(data_.cell_prev);
