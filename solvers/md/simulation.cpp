@@ -213,11 +213,7 @@ void Simulation::predict(std::int32_t i) {
     if (j == i) return;
     Vec3 rj, vj;
     state_at(data_.particles[j], now, g, rj, vj);
-    const double dt = pair_contact_delay(p.r - rj - shift, p.v - vj, best);
-    if (dt < best) {
-      best = dt;
-      event.partner = j;
-    }
+    if (pair_contact_before(p.r - rj - shift, p.v - vj, best)) event.partner = j;
   });
   if (best < never) event.partner_counter = data_.counters[event.partner];
   predict_walls(i, event, best, cell_delay);
@@ -261,9 +257,7 @@ void Simulation::predict_after_crossing(std::int32_t i, int direction) {
                               [&](std::int32_t j, const Vec3& shift) {
     Vec3 rj, vj;
     state_at(data_.particles[j], now, g, rj, vj);
-    const double dt = pair_contact_delay(p.r - rj - shift, p.v - vj, best);
-    if (dt < best) {
-      best = dt;
+    if (pair_contact_before(p.r - rj - shift, p.v - vj, best)) {
       event.kind = EventKind::pair;
       event.partner = j;
       event.partner_counter = data_.counters[j];
