@@ -43,14 +43,30 @@ int command_config(const RunOptions& options) {
   return 0;
 }
 
-int command_analyze(const std::string& run_file, const std::string& csv_file) {
+namespace {
+// One row per stored phase and bin: the profile and its Mach number (for plots of Ma(z)).
+void write_profiles_csv(const RunRecord& run, const std::string& path) {
+  std::string csv = "phase,z,n,nu,uz,T,mach\n";
+  for (const auto& p : run.profiles) {
+    const auto mach = analysis::mach_number(p, run.e);
+    for (std::size_t i = 0; i < p.size(); ++i)
+      csv += fmt::format("{},{},{},{},{},{},{}\n", p.phase, p.z[i], p.n[i], p.nu[i], p.uz[i],
+                         p.T[i], mach[i]);
+  }
+  write_text_atomically(path, csv);
+}
+}  // namespace
+
+int command_analyze(const std::string& run_file, const std::string& csv_file,
+                    const std::string& profiles_csv) {
   const RunRecord run = read_run_file(run_file);
   fmt::print("# {}: solver {}, {}, e = {}, program {} ({})\n", run_file, run.solver,
              run.model_variant, run.e, run.program_version, run.git_commit);
   fmt::print("{:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>7}\n", "phase", "plate_z",
              "layer_lo", "layer_hi", "com", "shock_z", "width", "d/xi", "max_Ma");
   std::string csv = "phase,time,plate_z,layer_bottom,layer_top,center_of_mass,shock_location,"
-                    "shock_width,width_over_mfp,max_mach\n";
+                    "shock_width,width_over_mfp,max_mach,shock_compressed_top,"
+                    "shock_undisturbed_bottom\n";
   auto field = [](bool present, double value) {
     return present ? fmt::format("{}", value) : std::string("nan");
   };
@@ -66,14 +82,16 @@ int command_analyze(const std::string& run_file, const std::string& csv_file) {
                optional_number(k ? std::optional(shock.width) : std::nullopt, 2),
                optional_number(k ? std::optional(shock.width_over_mfp()) : std::nullopt, 2),
                s.max_mach);
-    csv += fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.phase, p.time, s.plate_z,
+    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", s.phase, p.time, s.plate_z,
                        field(l, layer.bottom), field(l, layer.top), s.center_of_mass,
                        field(k, shock.location), field(k, shock.width),
-                       field(k, k ? shock.width_over_mfp() : 0.0), s.max_mach);
+                       field(k, k ? shock.width_over_mfp() : 0.0), s.max_mach,
+                       field(k, shock.compressed_top), field(k, shock.undisturbed_bottom));
   }
   const auto speed = analysis::shock_speed(run.profiles);
   fmt::print("# average shock speed (plate frame): {}\n", optional_number(speed));
   if (!csv_file.empty()) write_text_atomically(csv_file, csv);
+  if (!profiles_csv.empty()) write_profiles_csv(run, profiles_csv);
   return 0;
 }
 

@@ -25,12 +25,14 @@ int main(int argc, char** argv) {
       show_config);
   config->get_option("CONFIG")->required(false);
 
-  std::string run_file, analysis_csv;
+  std::string run_file, analysis_csv, profiles_csv;
   auto* analyze = app.add_subcommand(
       "analyze", "Print the analysis of a run per stored phase: layer, centre of mass, "
                  "shock location and width, d/xi, maximum Ma");
   analyze->add_option("RUN", run_file, "HDF5 run file")->required();
   analyze->add_option("--csv", analysis_csv, "also write the table as CSV to this file");
+  analyze->add_option("--profiles-csv", profiles_csv,
+                      "also write every profile with its Mach number (phase,z,n,nu,uz,T,mach)");
 
   std::string first, second, compare_csv;
   auto* compare = app.add_subcommand(
@@ -53,7 +55,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
     if (app.got_subcommand("config")) return command_config(show_config);
-    if (app.got_subcommand("analyze")) return command_analyze(run_file, analysis_csv);
+    if (app.got_subcommand("analyze")) return command_analyze(run_file, analysis_csv, profiles_csv);
     if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
   } catch (const InputError& error) {
     fmt::print(stderr, "shaker: error: {}\n", error.what());

@@ -1,0 +1,505 @@
+#!/usr/bin/python3
+"""Writes the validation report (markdown + PNG plots) from the results of
+validation/run_validation.py.
+
+    make_validation_report.py --results WORKDIR/results.json --output reports/validation.md
+
+Reads only files: results.json (runs, claim evaluations, agreement metrics, written by the
+runner), the HDF5 run files it names (docs/output-schema.md) and their `shaker analyze --csv`
+tables (RUN.h5.analysis.csv). The plots go into a folder beside the report named after it
+(reports/validation/ for reports/validation.md). One section per figure of Bougie et al.,
+PRE 66, 051301 (2002), then the claims table (reference-data/claims.toml), then the agreement
+metrics of every case run by both solvers.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+STYLE = {"md": dict(marker="o", ms=3, ls="none"), "continuum": dict(ls="-", lw=1.2)}
+FIG1_PHASES = (0.0, 0.15, 0.22, 0.40)
+FIG2_CASES = (("single_shock_e0p99", "e = 0.99"), ("single_shock_e0p90", "e = 0.90"),
+              ("single_shock_e0p85", "e = 0.85"))
+DEPTHS = (("depth_h4p5", "H = 4.5"), ("base", "H = 9"), ("depth_h13p5", "H = 13.5"))
+
+
+# ---- reading -------------------------------------------------------------------------------
+
+class Results:
+    def __init__(self, path):
+        with open(path) as f:
+            self.data = json.load(f)
+        self.views = self.data["views"]
+
+    def view(self, case, solver):
+        v = self.views.get(f"{case}/{solver}")
+        return v if v and v["status"] == "ok" and v["path"] and os.path.exists(v["path"]) \
+            else None
+
+    def analysis(self, case, solver):
+        v = self.view(case, solver)
+        if not v or not os.path.exists(v["analysis_csv"]):
+            return None
+        with open(v["analysis_csv"]) as f:
+            rows = list(csv.DictReader(f))
+        return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else None
+
+    def profiles(self, case, solver):
+        v = self.view(case, solver)
+        if not v:
+            return None
+        with h5py.File(v["path"], "r") as f:
+            prof = {k: np.array(f["profiles"][k]) for k in f["profiles"]}
+        mach_csv = v["path"] + ".profiles.csv"  # `shaker analyze --profiles-csv`
+        if os.path.exists(mach_csv):
+            with open(mach_csv) as f:
+                rows = list(csv.DictReader(f))
+            if len(rows) == prof["z"].size:
+                prof["mach"] = np.array([float(r["mach"]) for r in rows]).reshape(
+                    prof["z"].shape)
+        return prof
+
+    def status(self, case, solver):
+        v = self.views.get(f"{case}/{solver}")
+        return v["status"] if v else "not run"
+
+
+def nearest(phases, target):
+    return int(np.argmin(np.abs(((np.asarray(phases) - target + 0.5) % 1.0) - 0.5)))
+
+
+def fmt(x, digits=3):
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "–"
+    return f"{x:.{digits}g}"
+
+
+def missing_text(results, needs):
+    absent = [f"{solver} {case} ({results.status(case, solver)})" for case, solver in needs
+              if not results.view(case, solver)]
+    return "runs not available: " + ", ".join(absent) if absent else ""
+
+
+def save(fig, out_dir, name):
+    os.makedirs(out_dir, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, name), dpi=90)
+    plt.close(fig)
+    return name
+
+
+# ---- figures (each returns markdown) ---------------------------------------------------------
+
+def shock_region(row):
+    """(low, high) of the shock region: the analysis' compressed-region top and undisturbed
+    bottom when `shaker analyze` prints them, else location -/+ width/2 (approximate)."""
+    if "shock_compressed_top" in row:
+        return row["shock_compressed_top"], row["shock_undisturbed_bottom"], True
+    return row["shock_location"] - row["shock_width"] / 2, \
+        row["shock_location"] + row["shock_width"] / 2, False
+
+
+def figure1(results, out_dir, link):
+    needs = [("base", "md"), ("base", "continuum")]
+    runs = {s: (results.profiles("base", s), results.analysis("base", s)) for _, s in needs}
+    runs = {s: r for s, r in runs.items() if r[0] is not None}
+    text = ["## Fig. 1: volume fraction and temperature against height (base case)", ""]
+    if not runs:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    fig, axes = plt.subplots(2, len(FIG1_PHASES), figsize=(14, 7), sharey="col")
+    rows = ["| f t | solver | plate z | layer bottom | layer top | shock location | width d |",
+            "| --- | --- | --- | --- | --- | --- | --- |"]
+    exact = True
+    for col, phase in enumerate(FIG1_PHASES):
+        top = 0.0
+        for solver, (prof, table) in runs.items():
+            k = nearest(prof["phase"], phase)
+            axes[0, col].plot(prof["nu"][k], prof["z"][k], label=solver, **STYLE[solver])
+            axes[1, col].plot(prof["T"][k], prof["z"][k], label=solver, **STYLE[solver])
+            row = {name: table[name][k] for name in table}
+            top = max(top, np.nan_to_num(row["layer_top"]) + 12)
+            rows.append(f"| {prof['phase'][k]:.2f} | {solver} | {fmt(row['plate_z'])} | "
+                        f"{fmt(row['layer_bottom'])} | {fmt(row['layer_top'])} | "
+                        f"{fmt(row['shock_location'])} | {fmt(row['shock_width'])} |")
+            if solver == "continuum" and not math.isnan(row["shock_location"]):
+                lo, hi, exact_region = shock_region(row)
+                exact = exact and exact_region
+                for ax in axes[:, col]:
+                    ax.axhspan(lo, hi, color="0.8", zorder=0)
+            for ax in axes[:, col]:
+                ax.axhline(prof["plate_z"][k], color="k", lw=2)
+        plate = min(p[0]["plate_z"][nearest(p[0]["phase"], phase)] for p in runs.values())
+        for ax in axes[:, col]:
+            ax.set_ylim(plate - 1, max(top, plate + 20))
+        axes[0, col].set_title(f"f t = {phase:.2f}")
+        axes[0, col].set_xlabel("nu")
+        axes[1, col].set_xlabel("T / (g sigma)")
+    for r in range(2):
+        axes[r, 0].set_ylabel("z / sigma (lab frame)")
+    axes[0, 0].legend()
+    name = save(fig, out_dir, "fig1-profiles.png")
+    region = ("the continuum's shock region (compressed-region top to undisturbed bottom)"
+              if exact else "location -/+ d/2 of the continuum shock (approximate: `shaker "
+              "analyze` does not print the region's ends)")
+    return text + [f"MD points, continuum lines; the plate is the black line; grey: {region}.",
+                   "", f"![Fig. 1]({link}/{name})", ""] + rows + [""]
+
+
+def figure2(results, out_dir, link):
+    needs = [(c, s) for c, _ in FIG2_CASES for s in ("md", "continuum")]
+    text = ["## Fig. 2: shock location and centre of mass, e = 0.99, 0.90, 0.85 (single shock)",
+            ""]
+    available = [(c, label) for c, label in FIG2_CASES
+                 if results.view(c, "md") or results.view(c, "continuum")]
+    if not available:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    fig, axes = plt.subplots(1, len(available), figsize=(5 * len(available), 5), squeeze=False)
+    rows = ["| case | solver | formation f t | shock speed | centre-of-mass apex |",
+            "| --- | --- | --- | --- | --- |"]
+    for ax, (case, label) in zip(axes[0], available):
+        prof = results.profiles(case, "continuum")
+        if prof is not None:
+            phase = np.repeat(prof["phase"][:, None], prof["z"].shape[1], axis=1)
+            ax.pcolormesh(phase, prof["z"], prof["nu"], cmap="Greys", shading="gouraud",
+                          vmin=0, vmax=0.65)
+        for solver in ("continuum", "md"):
+            t = results.analysis(case, solver)
+            if t is None:
+                continue
+            if solver == "continuum":
+                ax.plot(t["phase"], t["shock_location"], "r-", label="continuum shock")
+                ax.plot(t["phase"], t["center_of_mass"], "b--", label="continuum centre of mass")
+            else:
+                ax.plot(t["phase"], t["shock_location"], "r^", ms=4, label="MD shock")
+                ax.plot(t["phase"], t["center_of_mass"], "bo", ms=3, label="MD centre of mass")
+                ax.plot(t["phase"], t["layer_top"], "g+", ms=5, label="MD layer top")
+                ax.plot(t["phase"], t["layer_bottom"], "gx", ms=4, label="MD layer bottom")
+            ax.plot(t["phase"], t["plate_z"], "k-", lw=2.5)
+            v = results.views[f"{case}/{solver}"]
+            rows.append(f"| {case} | {solver} | {fmt(first_shock(t))} | "
+                        f"{fmt(v['shock_speed'])}{pm(v.get('shock_speed_error'))} | "
+                        f"{fmt(float(np.max(t['center_of_mass'])))} |")
+        ax.set_title(label)
+        ax.set_xlabel("f t")
+        ax.set_ylim(0, 60)
+    axes[0, 0].set_ylabel("z / sigma (lab frame)")
+    axes[0, 0].legend(fontsize=7)
+    name = save(fig, out_dir, "fig2-single-shock.png")
+    note = missing_text(results, needs)
+    return text + ["Shading: continuum volume fraction (dark = dense). Lines continuum, "
+                   "markers MD (pooled single-shock runs)." + (f" Missing: {note}." if note
+                                                               else ""), "",
+                   f"![Fig. 2]({link}/{name})", ""] + rows + [""]
+
+
+def first_shock(t):
+    idx = np.nonzero(~np.isnan(t["shock_location"]))[0]
+    return float(t["phase"][idx[0]]) if len(idx) else math.nan
+
+
+def pm(error):
+    return f" ± {fmt(error, 2)}" if error is not None else ""
+
+
+def figure3(results, out_dir, link):
+    needs = [("base", "md"), ("base", "continuum")]
+    text = ["## Fig. 3: Mach number and 10 nu against height at f t = 0.22 (base case)", ""]
+    runs = {s: (results.profiles("base", s), results.analysis("base", s)) for _, s in needs}
+    runs = {s: r for s, r in runs.items() if r[0] is not None}
+    if not runs:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    fig, ax = plt.subplots(figsize=(6, 6))
+    rows = ["| solver | f t | shock location | maximum Ma in the layer |", "| --- | --- | --- | --- |"]
+    has_profile = False
+    for solver, (prof, table) in runs.items():
+        k = nearest(prof["phase"], 0.22)
+        ax.plot(10 * prof["nu"][k], prof["z"][k], label=f"{solver} 10 nu", **STYLE[solver])
+        if "mach" in prof:
+            has_profile = True
+            ax.plot(prof["mach"][k], prof["z"][k], label=f"{solver} Ma", ls="--")
+        if not math.isnan(table["shock_location"][k]):
+            ax.plot([table["max_mach"][k]], [table["shock_location"][k]], "r^" if solver == "md"
+                    else "rs", ms=8, label=f"{solver} max Ma (at the shock)")
+        ax.axhline(prof["plate_z"][k], color="k", lw=2)
+        rows.append(f"| {solver} | {prof['phase'][k]:.2f} | {fmt(table['shock_location'][k])} | "
+                    f"{fmt(table['max_mach'][k])} |")
+    ax.set_xlabel("Ma, 10 nu")
+    ax.set_ylabel("z / sigma (lab frame)")
+    plate = min(r[0]["plate_z"][nearest(r[0]["phase"], 0.22)] for r in runs.values())
+    ax.set_ylim(plate - 1, plate + 30)
+    ax.legend(fontsize=8)
+    name = save(fig, out_dir, "fig3-mach.png")
+    note = ("" if has_profile else " The Mach-number profile Ma(z) is not drawn: `shaker analyze` "
+            "prints only the maximum Ma in the layer, which the paper locates at the leading "
+            "edge of the shock; it is drawn there.")
+    return text + ["Lines continuum, markers MD." + note, "", f"![Fig. 3]({link}/{name})", ""] \
+        + rows + [""]
+
+
+def figure4(results, out_dir, link):
+    needs = [("base", "md"), ("base", "continuum")]
+    text = ["## Fig. 4: maximum Mach number and d/xi against f t (base case)", ""]
+    tables = {s: results.analysis("base", s) for _, s in needs}
+    tables = {s: t for s, t in tables.items() if t is not None}
+    if not tables:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    rows = ["| f t | " + " | ".join(f"{s} max Ma | {s} d/xi" for s in tables) + " |",
+            "| --- |" + " --- | --- |" * len(tables)]
+    for solver, t in tables.items():
+        marker = dict(ls="none", marker="^") if solver == "md" else dict(ls="--")
+        ax.plot(t["phase"], t["max_mach"], label=f"{solver} max Ma", **marker)
+        marker = dict(ls="none", marker="o") if solver == "md" else dict(ls="-")
+        ax.plot(t["phase"], t["width_over_mfp"], label=f"{solver} d/xi", **marker)
+    ax.axvline(0.12, color="0.6", lw=0.8)
+    ax.axvline(0.35, color="0.6", lw=0.8)
+    ax.set_xlim(0, 0.5)
+    ax.set_yscale("log")
+    ax.set_xlabel("f t")
+    ax.legend(fontsize=8)
+    name = save(fig, out_dir, "fig4-mach-width.png")
+    first = next(iter(tables.values()))
+    for k, phase in enumerate(first["phase"]):
+        if phase > 0.5:
+            break
+        cells = []
+        for t in tables.values():
+            cells += [fmt(t["max_mach"][k]), fmt(t["width_over_mfp"][k])]
+        rows.append(f"| {phase:.2f} | " + " | ".join(cells) + " |")
+    return text + ["Grey lines: the paper's formation (0.12) and exit (0.35) phases.", "",
+                   f"![Fig. 4]({link}/{name})", ""] + rows + [""]
+
+
+def figure5(results, out_dir, link):
+    text = ["## Fig. 5: average shock speed against e (single shock, plate frame)", ""]
+    points = {"md": [], "continuum": []}
+    for key, v in sorted(results.views.items()):
+        if v["protocol"] == "single_shock" and v["status"] == "ok" and \
+                v["case"].startswith("single_shock_e"):
+            points[v["solver"]].append((v["switch_e"], v["shock_speed"],
+                                        v.get("shock_speed_error")))
+    if not any(points.values()):
+        return text + ["No plot: no single-shock run is available.", ""]
+    fig, ax = plt.subplots(figsize=(6, 5))
+    rows = ["| e | MD v_shock | continuum v_shock |", "| --- | --- | --- |"]
+    for solver, pts in points.items():
+        pts = sorted((e, v, err) for e, v, err in pts if v is not None)
+        if not pts:
+            continue
+        e, v, err = zip(*pts)
+        if solver == "md":
+            ax.errorbar(e, v, yerr=[x or 0 for x in err], fmt="o", capsize=3,
+                        label="MD (pooled, jackknife error)")
+        else:
+            ax.plot(e, v, "-s", label="continuum")
+    for e in sorted({p[0] for pts in points.values() for p in pts}):
+        cell = {s: next((f"{fmt(v)}{pm(err)}" for ee, v, err in points[s] if ee == e), "–")
+                for s in points}
+        rows.append(f"| {e:.2f} | {cell['md']} | {cell['continuum']} |")
+    ax.set_xlabel("e")
+    ax.set_ylabel("v_shock / sqrt(g sigma)")
+    ax.legend()
+    name = save(fig, out_dir, "fig5-shock-speed.png")
+    return text + [f"![Fig. 5]({link}/{name})", ""] + rows + [""]
+
+
+def figure6(results, out_dir, link):
+    pair = (("single_shock_e0p90", "constant e = 0.9"), ("velocity_dependent", "e(v_n)"))
+    needs = [(c, "md") for c, _ in pair]
+    text = ["## Fig. 6: constant against velocity-dependent restitution (MD, single shock)", ""]
+    tables = [(label, results.analysis(c, "md"), c) for c, label in pair]
+    tables = [t for t in tables if t[1] is not None]
+    if not tables:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    rows = ["| restitution | shock speed | centre-of-mass apex |", "| --- | --- | --- |"]
+    for (label, t, case), (shock, com) in zip(tables, (("r^", "bo"), ("mx", "c+"))):
+        ax.plot(t["phase"], t["shock_location"], shock, label=f"shock, {label}")
+        ax.plot(t["phase"], t["center_of_mass"], com, label=f"centre of mass, {label}")
+        ax.plot(t["phase"], t["plate_z"], "k-", lw=2.5)
+        v = results.views[f"{case}/md"]
+        rows.append(f"| {label} | {fmt(v['shock_speed'])}{pm(v.get('shock_speed_error'))} | "
+                    f"{fmt(float(np.max(t['center_of_mass'])))} |")
+    ax.set_xlabel("f t")
+    ax.set_ylabel("z / sigma (lab frame)")
+    ax.legend(fontsize=8)
+    name = save(fig, out_dir, "fig6-restitution-models.png")
+    note = missing_text(results, needs)
+    return text + ([f"Missing: {note}.", ""] if note else []) + \
+        [f"![Fig. 6]({link}/{name})", ""] + rows + [""]
+
+
+def figure7(results, out_dir, link):
+    needs = [(c, s) for c, _ in DEPTHS for s in ("md", "continuum")]
+    text = ["## Fig. 7: centre of mass over a cycle and shock location for H = 4.5, 9, 13.5",
+            ""]
+    if not any(results.analysis(c, s) is not None for c, s in needs):
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    fig, (a, b) = plt.subplots(2, 1, figsize=(7, 9), sharex=True)
+    rows = ["| H | solver | mean centre of mass | formation f t | shock speed |",
+            "| --- | --- | --- | --- | --- |"]
+    for (case, label), color in zip(DEPTHS, ("C0", "C1", "C2")):
+        for solver in ("md", "continuum"):
+            t = results.analysis(case, solver)
+            if t is None:
+                continue
+            style = dict(ls="none", marker="o", ms=3) if solver == "md" else dict(ls="-")
+            a.plot(t["phase"], t["center_of_mass"], color=color, label=f"{label} {solver}",
+                   **style)
+            b.plot(t["phase"], t["shock_location"], color=color, label=f"{label} {solver}",
+                   **style)
+            v = results.views[f"{case}/{solver}"]
+            rows.append(f"| {label[4:]} | {solver} | {fmt(float(np.mean(t['center_of_mass'])))}"
+                        f" | {fmt(first_shock(t))} | {fmt(v['shock_speed'])} |")
+    a.set_ylabel("centre of mass z / sigma")
+    b.set_ylabel("shock location z / sigma")
+    b.set_xlabel("f t")
+    a.legend(fontsize=7)
+    name = save(fig, out_dir, "fig7-depths.png")
+    note = missing_text(results, needs)
+    return text + (["Missing: " + note + ".", ""] if note else []) + \
+        [f"![Fig. 7]({link}/{name})", ""] + rows + [""]
+
+
+# ---- claims and metrics ------------------------------------------------------------------
+
+def value_text(value, error):
+    if value is None:
+        return "–"
+    if isinstance(value, list):
+        if error is None or not isinstance(error, list):
+            error = [None] * len(value)
+        return "[" + ", ".join(f"{fmt(v)}{pm(e)}" for v, e in zip(value, error)) + "]"
+    return f"{fmt(value, 4)}{pm(error)}"
+
+
+def band_text(check):
+    c, b = check["comparison"], check["band"]
+    return {"range": lambda: f"{b[0]:g} to {b[1]:g}", "all_in_range": lambda:
+            f"all in {b[0]:g} to {b[1]:g}", "less_than": lambda: f"< {b[0]:g}",
+            "greater_than": lambda: f"> {b[0]:g}", "strictly_increasing":
+            lambda: "strictly increasing", "true": lambda: "detected"}[c]()
+
+
+def mark(status):
+    return {"pass": "pass", "fail": "**FAIL**", "inconclusive": "inconclusive"}.get(status, status)
+
+
+def solver_cell(results, claim, solver):
+    r = claim["per_solver"].get(solver)
+    if r is None:
+        return "n/a"
+    parts = []
+    for check, ev in zip(claim["checks"], r["checks"]):
+        if ev["status"] == "not measured":
+            unavailable = any(results.status(c, s) == "unavailable" for c in claim["cases"]
+                              for s in (("md", "continuum") if solver == "md_vs_continuum"
+                                        else (solver,)))
+            parts.append("not measured: solver unavailable" if unavailable
+                         else f"not measured: {ev['reason']}")
+        else:
+            bound = " (lower bound)" if ev.get("bound") == "lower" else ""
+            parts.append(f"{value_text(ev['value'], ev.get('error'))}{bound} "
+                         f"({mark(ev['status'])})")
+    return "; ".join(parts)
+
+
+def claims_section(results):
+    lines = ["## Claims C1 to C20", "",
+             "Bands and claims from reference-data/claims.toml. MD uncertainty: jackknife over "
+             "the pooled single-shock runs, or the spread of a parametric bootstrap of the "
+             "periodic MD profiles over their standard errors (one standard deviation). "
+             "Continuum uncertainty: no grid-convergence index is available to this report yet.",
+             "", "| id | claim | paper | MD | continuum | band | result |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
+    counts = {}
+    for claim in results.data["claims"]:
+        bands = "; ".join(band_text(c) for c in claim["checks"])
+        if claim["solvers"] == "md_vs_continuum":
+            md = "MD vs continuum: " + solver_cell(results, claim, "md_vs_continuum")
+            co = "(one value for the pair)"
+        else:
+            md, co = solver_cell(results, claim, "md"), solver_cell(results, claim, "continuum")
+        status = claim["status"]
+        counts[status] = counts.get(status, 0) + 1
+        lines.append(f"| {claim['id']} | {claim['statement']} | {claim['paper_value']} | {md} | "
+                     f"{co} | {bands} | {mark(status)} |")
+    notes = sorted({f"{claim['id']}: {n}" for claim in results.data["claims"]
+                    for r in claim["per_solver"].values() for ev in r["checks"]
+                    for n in ev.get("notes", [])})
+    lines += [""] + [f"- {n}" for n in notes] + ([""] if notes else [])
+    return lines, counts
+
+
+def metrics_section(results):
+    lines = ["## Agreement metrics (continuum against MD as reference)", ""]
+    metrics = results.data["metrics"]
+    if not metrics:
+        return lines + ["No case has finished runs of both solvers.", ""]
+    names = sorted({k for m in metrics.values() for k in m})
+    lines += ["| metric | " + " | ".join(metrics) + " |", "| --- |" + " --- |" * len(metrics)]
+    for name in names:
+        lines.append(f"| {name} | " + " | ".join(fmt(m.get(name)) if not isinstance(
+            m.get(name), str) else m[name] for m in metrics.values()) + " |")
+    return lines + [""]
+
+
+def header(results, counts):
+    d = results.data
+    lines = ["# Validation: MD against continuum against the paper", "",
+             "Bougie, Moon, Swift and Swinney, Phys. Rev. E 66, 051301 (2002); claims from "
+             "../shared/spec/paper-claims.md. Written by reports/make_validation_report.py from "
+             "validation/run_validation.py.", "",
+             f"- commit: {d['commit']}{' (with uncommitted changes)' if d['dirty'] else ''}",
+             f"- date: {d['date']}", f"- program: {d['shaker_version']}",
+             f"- mode: {'quick (reduced cycles and resolution)' if d['quick'] else 'full study'}"
+             f"; cases: {', '.join(d['cases'])}",
+             f"- wall time of this validation: {d['wall_seconds']:.0f} s; solver time of the "
+             f"runs started now: {d['simulated_seconds']:.0f} s",
+             "- claims: " + ", ".join(f"{v} {k}" for k, v in sorted(counts.items())), ""]
+    cps = [f"{v['case']}: {v['collisions_per_second']:.3g}" for v in d["views"].values()
+           if v.get("collisions_per_second")]
+    lines += ["- MD collisions per second: " + (", ".join(cps) if cps else
+                                                "not available (needs a cumulative `collisions`"
+                                                " time-series column and a fresh run)"), ""]
+    lines += ["| case | solver | member | status | seconds | reused |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    for r in d["runs"]:
+        status = r["status"] + (f" (with {', '.join(r['fallback'])})" if r.get("fallback")
+                                else "")
+        lines.append(f"| {r['case']} | {r['solver']} | "
+                     f"{'' if r['member'] is None else r['member']} | {status} | "
+                     f"{r['seconds']:.1f} | {'yes' if r['reused'] else 'no'} |")
+    return lines + [""]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--results", required=True)
+    parser.add_argument("--output", required=True)
+    args = parser.parse_args()
+    results = Results(args.results)
+    out_dir = os.path.splitext(args.output)[0]
+    link = os.path.basename(out_dir)
+    body = []
+    for figure in (figure1, figure2, figure3, figure4, figure5, figure6, figure7):
+        body += figure(results, out_dir, link)
+    claims, counts = claims_section(results)
+    text = header(results, counts) + body + claims + metrics_section(results)
+    tmp = args.output + ".partial"
+    with open(tmp, "w") as f:
+        f.write("\n".join(text) + "\n")
+    os.replace(tmp, args.output)
+    print(f"report: {args.output}")
+
+
+if __name__ == "__main__":
+    main()

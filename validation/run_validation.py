@@ -1,0 +1,643 @@
+#!/usr/bin/python3
+"""Runs the validation study of issue 6 and writes reports/validation.md.
+
+    validation/run_validation.py --shaker build/release/solvers/app/shaker [--quick]
+        [--cases base,depth_h4p5] [--workdir DIR] [--report reports/validation.md]
+        [--jobs 2] [--require C1,C4,C10] [--reuse-only] [--rerun]
+
+Steps (data flows one way: case file -> solver -> run file -> analysis -> claims -> report):
+1. every case of validation/studies.toml (or the --cases / --quick subset) is run with each
+   solver that the paper used for it. A run is keyed by the SHA-256 of its effective
+   configuration (`shaker config CASE --set ...`), so a finished run is reused, never
+   re-simulated; --rerun forces new runs. MD single-shock cases are run md_pool times from
+   consecutive cycles of the periodic state (run.transient_cycles + k).
+2. every finished run is analysed by `shaker analyze --csv` (the project's one analysis
+   implementation); MD uncertainties: single-shock pools get a jackknife over the pooled runs,
+   periodic runs a parametric bootstrap of the profiles with their standard errors.
+3. `shaker compare --csv` gives the agreement metrics of every case run by both solvers.
+4. every claim of reference-data/claims.toml is evaluated per solver against its band
+   (validation/quantities.py), and reports/make_validation_report.py writes the report.
+
+Exit status: 0 when the report is written and every claim named by --require passes in every
+solver it applies to; 1 otherwise (a missing solver makes its claims "not measured", which
+fails --require). Uses /usr/bin/python3 with numpy, matplotlib and h5py only.
+"""
+import argparse
+import concurrent.futures
+import csv
+import datetime
+import hashlib
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+import tomllib
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import quantities  # noqa: E402
+
+SOLVERS = ("md", "continuum")
+SOLVER_UNAVAILABLE = 3  # exit code of a solver that is not built yet (README)
+PROFILE_FIELDS = ("n", "nu", "uz", "T")
+
+
+def log(message):
+    print(f"[validation] {message}", flush=True)
+
+
+# ---- configuration files --------------------------------------------------------------------
+
+def load_toml(path):
+    with open(path, "rb") as f:
+        return tomllib.load(f)
+
+
+def load_studies(path):
+    studies = load_toml(path)
+    studies["by_name"] = {c["name"]: c for c in studies["case"]}
+    return studies
+
+
+def case_file(name):
+    return os.path.join(HERE, "cases", f"{name}.toml")
+
+
+def effective_config(shaker, name, overrides):
+    """`shaker config` text of a case with overrides (exit status 2 -> ValueError)."""
+    cmd = [shaker, "config", case_file(name)] + [a for o in overrides for a in ("--set", o)]
+    result = subprocess.run(cmd, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise ValueError(f"{' '.join(cmd)} failed ({result.returncode}): {result.stderr.strip()}")
+    return result.stdout
+
+
+# ---- one run and its views ------------------------------------------------------------------
+
+class RunView:
+    """One solver's result for a case (a run, a pool of runs, or a replicate of either) as the
+    quantities see it."""
+
+    def __init__(self, case, solver, status, path=None, config=None):
+        self.case, self.solver, self.status, self.path = case, solver, status, path
+        self.config = config or {}
+        self.analysis, self.shock_speed = None, math.nan
+        self.replicates, self.replicate_kind = [], None
+        self.notes, self.runs = set(), []
+        self.stderr_tail = ""
+        self._profiles = None
+
+    @property
+    def switch_e(self):
+        return float(self.config["run"]["switch_e"])
+
+    def profiles(self):
+        if self._profiles is None:
+            with h5py.File(self.path, "r") as f:
+                self._profiles = {k: np.array(f["profiles"][k]) for k in f["profiles"]}
+        return self._profiles
+
+    def timeseries(self):
+        with h5py.File(self.path, "r") as f:
+            return {k: np.array(f["timeseries"][k]) for k in f["timeseries"]}
+
+    def particles_per_cycle_above(self, height):
+        """Particles per cycle reaching z >= height (lab frame). Preferred source: a cumulative
+        time-series column crossings_z<height> (upward crossings counted by the solver); the
+        fallback is a lower bound from the profiles: the largest mean number of particles above
+        the height at any stored phase."""
+        series = self.timeseries()
+        column = f"crossings_z{height:g}"
+        if column in series and len(series[column]) > 1:
+            t, count = series["t"], series[column]
+            frequency = float(self.config["shaker"]["frequency"])
+            cycles = (t[-1] - t[0]) * frequency
+            return quantities.Bound(float((count[-1] - count[0]) / cycles), None), \
+                f"time-series column {column}"
+        prof = self.profiles()
+        width = float(self.config["md"]["box_width"])
+        per_phase = [float(np.sum(prof["n"][k][prof["z"][k] >= height])
+                           * width * width * prof["bin_height"][k])
+                     for k in range(len(prof["phase"]))]
+        return quantities.Bound(max(per_phase), "lower"), (
+            "lower bound from the profiles (largest mean count above the height at a stored "
+            f"phase); the MD time series has no column {column}")
+
+
+def read_analysis_csv(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else None
+
+
+def analyze(shaker, run_file, with_profiles=False):
+    """`shaker analyze --csv`: the analysis table and the average shock speed (and, with
+    with_profiles, RUN.profiles.csv: every profile with its Mach number, for the plots)."""
+    csv_path = run_file + ".analysis.csv"
+    cmd = [shaker, "analyze", run_file, "--csv", csv_path]
+    if with_profiles:
+        cmd += ["--profiles-csv", run_file + ".profiles.csv"]
+    result = subprocess.run(cmd, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise RuntimeError(f"shaker analyze {run_file}: {result.stderr.strip()}")
+    speed = math.nan
+    for line in result.stdout.splitlines():
+        if line.startswith("# average shock speed"):
+            text = line.rsplit(":", 1)[1].strip()
+            speed = float(text) if text != "-" else math.nan
+    return read_analysis_csv(csv_path), speed
+
+
+class Comparer:
+    """`shaker compare --csv A B`, cached per pair of files."""
+
+    def __init__(self, shaker, directory):
+        self.shaker, self.directory, self.cache = shaker, directory, {}
+
+    def __call__(self, a, b):
+        key = (a.path, b.path)
+        if key not in self.cache:
+            name = hashlib.sha256(f"{a.path}|{b.path}".encode()).hexdigest()[:16]
+            out = os.path.join(self.directory, f"compare-{name}.csv")
+            result = subprocess.run([self.shaker, "compare", a.path, b.path, "--csv", out],
+                                    capture_output=True, text=True)
+            if result.returncode != 0:
+                raise quantities.NotMeasured(f"shaker compare failed: {result.stderr.strip()}")
+            with open(out) as f:
+                self.cache[key] = {r["metric"]: float(r["value"]) for r in csv.DictReader(f)}
+        return self.cache[key]
+
+
+# ---- running the solvers --------------------------------------------------------------------
+
+def plan_runs(shaker, studies, case_names, quick):
+    """The list of solver runs: dicts with case, solver, member (pool index), overrides,
+    config text and key."""
+    quick_overrides = studies["quick"]["overrides"] if quick else []
+    plan = []
+    for name in case_names:
+        case = studies["by_name"][name]
+        for solver in case["solvers"]:
+            pool = case.get("md_pool", 0) if solver == "md" else 0
+            if quick and pool:
+                pool = min(pool, studies["quick"]["md_pool"])
+            base_config = tomllib.loads(effective_config(shaker, name, quick_overrides))
+            members = range(pool) if pool else [None]
+            for member in members:
+                overrides = list(quick_overrides)
+                if member is not None:
+                    first = base_config["run"]["transient_cycles"]
+                    overrides.append(f"run.transient_cycles={first + member}")
+                plan.append(dict(case=name, solver=solver, member=member, overrides=overrides,
+                                 timeout=case.get("timeout", studies["quick" if quick else
+                                                                     "defaults"]["timeout"]),
+                                 fallback=case.get("md_fallback", []) if solver == "md" else [],
+                                 expect_failure=case.get("expect_failure", False)))
+    return plan
+
+
+def run_key(shaker, run):
+    text = effective_config(shaker, run["case"], run["overrides"])
+    return text, hashlib.sha256(text.encode()).hexdigest()
+
+
+def execute(shaker, workdir, run, rerun, reuse_only):
+    """Runs (or reuses) one solver run; returns its record (status, path, seconds, ...)."""
+    text, key = run_key(shaker, run)
+    stem = os.path.join(workdir, "runs", f"{run['solver']}-{key[:20]}")
+    record_path, output = stem + ".json", stem + ".h5"
+    if not rerun and os.path.exists(record_path):
+        with open(record_path) as f:
+            record = json.load(f)
+        if record["status"] in ("ok", "collapse") and (record["status"] != "ok"
+                                                       or os.path.exists(output)):
+            record["reused"] = True
+            return record
+    if reuse_only:
+        status = "ok" if os.path.exists(output) else "unavailable"
+        return dict(status=status, path=output if status == "ok" else None, seconds=0.0,
+                    key=key, config=text, reused=status == "ok", returncode=None,
+                    stderr="--reuse-only: no finished run", command="")
+    cmd = [shaker, run["solver"], case_file(run["case"])]
+    cmd += [a for o in run["overrides"] for a in ("--set", o)]
+    cmd += ["--set", f"run.output={output}"]
+    log(f"run {run['solver']} {run['case']}" + (f" [{run['member']}]" if run["member"] is not None
+                                                else "") + f" -> {os.path.basename(output)}")
+    start = time.monotonic()
+    try:
+        result = subprocess.run(cmd, capture_output=True, text=True, timeout=run["timeout"])
+        rc, stdout, stderr = result.returncode, result.stdout, result.stderr
+    except subprocess.TimeoutExpired as expired:
+        rc, stdout, stderr = None, str(expired.stdout or ""), str(expired.stderr or "")
+    seconds = time.monotonic() - start
+    if rc == 0 and os.path.exists(output):
+        status = "ok"
+    elif rc is None:
+        status = "hang"
+    elif rc == SOLVER_UNAVAILABLE:
+        status = "unavailable"
+    elif rc == 1 and "collapse" in stderr.lower():
+        status = "collapse"
+    else:
+        status = "failed"
+    record = dict(status=status, path=output if status == "ok" else None, seconds=seconds,
+                  key=key, config=text, returncode=rc, command=" ".join(cmd),
+                  stdout=stdout[-3000:], stderr=stderr[-3000:], reused=False)
+    if status in ("ok", "collapse"):
+        tmp = record_path + ".partial"
+        with open(tmp, "w") as f:
+            json.dump(record, f, indent=1)
+        os.replace(tmp, record_path)
+    return record
+
+
+def execute_all(shaker, workdir, plan, jobs, rerun, reuse_only):
+    def one(run):
+        record = execute(shaker, workdir, run, rerun, reuse_only)
+        if record["status"] == "collapse" and run["fallback"] and not run["expect_failure"]:
+            guarded = dict(run, overrides=run["overrides"] + run["fallback"])
+            record = execute(shaker, workdir, guarded, rerun, reuse_only)
+            record["fallback"] = run["fallback"]
+        return record
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        records = list(pool.map(one, plan))
+    for run, record in zip(plan, records):
+        run["record"] = record
+    return plan
+
+
+# ---- pooling and replicates ----------------------------------------------------------------
+
+def _write_profiles_like(template, path, fields, variant_note):
+    """A copy of a run file with replaced profile fields (a pool or a replicate). The copy
+    keeps the template's attributes (configuration included) and notes how it was made."""
+    tmp = path + ".partial"
+    shutil.copyfile(template, tmp)
+    with h5py.File(tmp, "r+") as f:
+        group = f["profiles"]
+        for name, values in fields.items():
+            if name in group:
+                del group[name]
+            group.create_dataset(name, data=values)
+        f.attrs["model_variant"] = f"{f.attrs['model_variant']} ({variant_note})"
+    os.replace(tmp, path)
+
+
+def pooled_fields(profile_sets):
+    """Pools the profiles of runs of the same configuration started from different cycles, as
+    the MD sampler pools cycles (physics.md): n and nu averaged, u_z and T over all particles
+    (weights: samples if stored, else n; T gains the spread of the runs' mean u_z, the only
+    mean velocity component stored). Standard errors from the scatter between the runs."""
+    stack = {k: np.array([p[k] for p in profile_sets]) for k in PROFILE_FIELDS}
+    weights = (np.array([p["samples"] for p in profile_sets]) if all("samples" in p for p in
+                                                                     profile_sets)
+               else stack["n"])
+    total = weights.sum(axis=0)
+    safe = np.where(total > 0, total, 1.0)
+    uz = (weights * stack["uz"]).sum(axis=0) / safe
+    T = (weights * (stack["T"] + (stack["uz"] - uz) ** 2 / 3.0)).sum(axis=0) / safe
+    runs = len(profile_sets)
+    fields = {"n": stack["n"].mean(axis=0), "nu": stack["nu"].mean(axis=0), "uz": uz, "T": T}
+    if runs > 1:
+        for k in ("n", "uz", "T"):
+            fields[f"{k}_se"] = stack[k].std(axis=0, ddof=1) / math.sqrt(runs)
+    if all("samples" in p for p in profile_sets):
+        fields["samples"] = weights.sum(axis=0)
+    return fields
+
+
+def build_view(shaker, case, solver, records, workdir, bootstrap, seed):
+    """The view of one case in one solver: a run, or the pool of an MD single-shock case,
+    with its replicates (jackknife for pools, parametric bootstrap for periodic MD runs)."""
+    ok = [r for r in records if r["status"] == "ok"]
+    statuses = sorted({r["status"] for r in records})
+    config = tomllib.loads(records[0]["config"]) if records else {}
+    if not ok:
+        view = RunView(case, solver, statuses[0] if len(statuses) == 1 else "/".join(statuses),
+                       config=config)
+        view.runs = records
+        view.stderr_tail = " | ".join(r.get("stderr", "").strip()[-300:] for r in records)
+        return view
+    pool_dir = os.path.join(workdir, "derived")
+    os.makedirs(pool_dir, exist_ok=True)
+    if len(records) > 1:
+        sets = []
+        for r in ok:
+            with h5py.File(r["path"], "r") as f:
+                sets.append({k: np.array(f["profiles"][k]) for k in f["profiles"]})
+        key = hashlib.sha256("|".join(r["key"] for r in ok).encode()).hexdigest()[:20]
+        path = os.path.join(pool_dir, f"pool-{solver}-{key}.h5")
+        _write_profiles_like(ok[0]["path"], path, pooled_fields(sets),
+                             f"pooled over {len(ok)} single-shock runs")
+        view = RunView(case, solver, "ok", path, config)
+        view.analysis, view.shock_speed = analyze(shaker, path, with_profiles=True)
+        if len(ok) >= 3:
+            view.replicate_kind = "jackknife"
+            for i in range(len(ok)):
+                rest = sets[:i] + sets[i + 1:]
+                rpath = os.path.join(pool_dir, f"pool-{solver}-{key}-without{i}.h5")
+                _write_profiles_like(ok[0]["path"], rpath, pooled_fields(rest),
+                                     f"jackknife: pool without run {i}")
+                rep = RunView(case, solver, "ok", rpath, config)
+                rep.analysis, rep.shock_speed = analyze(shaker, rpath)
+                view.replicates.append(rep)
+        if len(ok) < len(records):
+            view.notes.add(f"{len(records) - len(ok)} of {len(records)} pooled runs failed")
+    else:
+        view = RunView(case, solver, "ok", ok[0]["path"], config)
+        view.analysis, view.shock_speed = analyze(shaker, ok[0]["path"], with_profiles=True)
+        prof = view.profiles()
+        if solver == "md" and bootstrap > 0 and all(f"{k}_se" in prof for k in ("n", "uz", "T")):
+            view.replicate_kind = "bootstrap"
+            rng = np.random.default_rng(seed)
+            for b in range(bootstrap):
+                n = np.maximum(prof["n"] + prof["n_se"] * rng.standard_normal(prof["n"].shape), 0)
+                ratio = np.divide(n, prof["n"], out=np.zeros_like(n), where=prof["n"] > 0)
+                fields = {"n": n, "nu": prof["nu"] * ratio,
+                          "uz": prof["uz"] + prof["uz_se"] * rng.standard_normal(n.shape),
+                          "T": np.maximum(prof["T"] + prof["T_se"]
+                                          * rng.standard_normal(n.shape), 0.0)}
+                rpath = os.path.join(pool_dir, f"boot-{solver}-{ok[0]['key'][:20]}-{b}.h5")
+                _write_profiles_like(ok[0]["path"], rpath, fields, f"bootstrap replicate {b}")
+                rep = RunView(case, solver, "ok", rpath, config)
+                rep.analysis, rep.shock_speed = analyze(shaker, rpath)
+                view.replicates.append(rep)
+    guarded = [r for r in records if r.get("fallback")]
+    if guarded:
+        view.notes.add(f"{len(guarded)} of {len(records)} MD runs stopped by inelastic collapse "
+                       "and were rerun with " + ", ".join(guarded[0]["fallback"]))
+    view.runs = records
+    return view
+
+
+# ---- claims -----------------------------------------------------------------------------------
+
+def _spread(kind, values):
+    values = [v for v in values if v is not None and not (isinstance(v, float) and math.isnan(v))]
+    if len(values) < 2:
+        return math.nan
+    values = np.array(values, dtype=float)
+    if kind == "jackknife":
+        n = len(values)
+        return float(math.sqrt((n - 1) / n * np.sum((values - values.mean()) ** 2)))
+    return float(values.std(ddof=1))
+
+
+def _as_plain(value):
+    if isinstance(value, quantities.Bound):
+        return value.value
+    return value
+
+
+def evaluate(check_spec, claim, solver, views, comparer, partial_cases_ok):
+    """Value, uncertainty, pass/fail (or not measured) of one check of a claim in one solver
+    ('md_vs_continuum' for pair claims)."""
+    fn = quantities.QUANTITIES[check_spec["quantity"]]
+    params = check_spec.get("parameters", {})
+
+    def query(replicate):
+        def get_run(case, s):
+            view = views.get((case, s))
+            if view is None or view.status != "ok" and check_spec["quantity"] != \
+                    "collapse_detected":
+                return None
+            if replicate is not None and view.replicates:
+                return view.replicates[replicate]
+            return view
+        return quantities.Query(get_run, comparer, solver, claim["cases"], params,
+                                partial_cases_ok)
+
+    try:
+        value = fn(query(None))
+    except quantities.NotMeasured as reason:
+        missing = [f"{s} {c}: {views[(c, s)].status}" for c in claim["cases"]
+                   for s in SOLVERS if (c, s) in views and views[(c, s)].status != "ok"]
+        return dict(value=None, status="not measured", reason=str(reason)
+                    + (f" ({'; '.join(missing)})" if missing else ""))
+    bound = value.kind if isinstance(value, quantities.Bound) else None
+    value = _as_plain(value)
+    # Uncertainty: the same quantity on every replicate of the MD views involved.
+    involved = [v for (c, s), v in views.items() if c in claim["cases"] and v.replicates
+                and (solver in (s, "md_vs_continuum"))]
+    error = None
+    if involved and isinstance(value, float):
+        count = min(len(v.replicates) for v in involved)
+        kind = involved[0].replicate_kind
+        reps = []
+        for b in range(count):
+            try:
+                reps.append(_as_plain(fn(query(b))))
+            except quantities.NotMeasured:
+                pass
+        error = _spread(kind, reps)
+        error = None if math.isnan(error) else error
+    elif involved and isinstance(value, list):
+        count = min(len(v.replicates) for v in involved)
+        kind = involved[0].replicate_kind
+        reps = []
+        for b in range(count):
+            try:
+                reps.append(_as_plain(fn(query(b))))
+            except quantities.NotMeasured:
+                pass
+        if reps:
+            error = [_spread(kind, [r[i] for r in reps if len(r) == len(value)])
+                     for i in range(len(value))]
+            error = [None if math.isnan(e) else e for e in error]
+    passed = quantities.check(check_spec["comparison"], check_spec["band"], value)
+    status = "pass" if passed else "fail"
+    if bound == "lower" and check_spec["comparison"] == "less_than" and passed:
+        status = "inconclusive"
+    if bound == "lower" and check_spec["comparison"] == "greater_than" and not passed:
+        status = "inconclusive"
+    notes = sorted({n for (c, s), v in views.items() if c in claim["cases"]
+                    and solver in (s, "md_vs_continuum") for n in v.notes})
+    return dict(value=value, error=error, status=status, bound=bound, notes=notes)
+
+
+def evaluate_claims(claims, views, comparer, partial_cases_ok):
+    results = []
+    for claim in claims:
+        solvers = (["md", "continuum"] if claim["solvers"] == "both" else [claim["solvers"]])
+        checks = [dict(quantity=claim["quantity"], parameters=claim.get("parameters", {}),
+                       comparison=claim["comparison"], band=claim["band"])]
+        checks += claim.get("also", [])
+        per_solver = {}
+        for solver in solvers:
+            evaluations = [evaluate(c, claim, solver, views, comparer, partial_cases_ok)
+                           for c in checks]
+            statuses = [e["status"] for e in evaluations]
+            overall = ("fail" if "fail" in statuses else "not measured" if "not measured" in
+                       statuses else "inconclusive" if "inconclusive" in statuses else "pass")
+            per_solver[solver] = dict(status=overall, checks=evaluations)
+        statuses = [s["status"] for s in per_solver.values()]
+        overall = ("fail" if "fail" in statuses else "not measured" if "not measured" in
+                   statuses else "inconclusive" if "inconclusive" in statuses else "pass")
+        results.append(dict(claim, checks=checks, per_solver=per_solver, status=overall))
+    return results
+
+
+# ---- main ------------------------------------------------------------------------------------
+
+def git(*args):
+    result = subprocess.run(["git", "-C", ROOT] + list(args), capture_output=True, text=True)
+    return result.stdout.strip() if result.returncode == 0 else "unknown"
+
+
+def collisions_per_second(view):
+    """Collisions per second of wall time from an MD run's time series: the growth of a
+    cumulative `collisions` column, or of the sum of the columns named *collisions*."""
+    if view.solver != "md" or view.status != "ok" or not view.runs:
+        return None
+    series = view.timeseries() if view.path and os.path.exists(view.path) else {}
+    columns = [k for k in series if k == "collisions"] or \
+        [k for k in series if "collisions" in k and "loss" not in k]
+    seconds = sum(r["seconds"] for r in view.runs if r["status"] == "ok")
+    if not columns or seconds <= 0 or any(r.get("reused") for r in view.runs):
+        return None
+    total = sum(float(series[k][-1] - series[k][0]) for k in columns)
+    return total / seconds if total > 0 else None
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--shaker", required=True, help="path of the shaker program")
+    parser.add_argument("--quick", action="store_true",
+                        help="reduced cycles and resolution, base case only (the ctest subset)")
+    parser.add_argument("--cases", help="comma-separated subset of validation/studies.toml")
+    parser.add_argument("--workdir", default=os.path.join(HERE, "work"),
+                        help="where runs, analyses and derived files go (reused across calls)")
+    parser.add_argument("--report", default=os.path.join(ROOT, "reports", "validation.md"))
+    parser.add_argument("--claims", default=os.path.join(ROOT, "reference-data", "claims.toml"))
+    parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
+    parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
+    parser.add_argument("--bootstrap", type=int, help="bootstrap replicates of MD profiles")
+    parser.add_argument("--require", default="",
+                        help="comma-separated claim ids that must pass (else exit status 1)")
+    parser.add_argument("--rerun", action="store_true", help="ignore finished runs")
+    parser.add_argument("--reuse-only", action="store_true",
+                        help="never start a solver; use finished runs in --workdir only")
+    args = parser.parse_args(argv)
+
+    shaker = os.path.abspath(args.shaker)
+    workdir = os.path.abspath(args.workdir)
+    os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
+    studies = load_studies(args.studies)
+    claims = load_toml(args.claims)["claim"]
+    if args.cases:
+        names = [c.strip() for c in args.cases.split(",") if c.strip()]
+    elif args.quick:
+        names = list(studies["quick"]["cases"])
+    else:
+        names = [c["name"] for c in studies["case"]]
+    unknown = [n for n in names if n not in studies["by_name"]]
+    if unknown:
+        parser.error(f"unknown case(s) {', '.join(unknown)}; known: "
+                     + ", ".join(studies["by_name"]))
+    bootstrap = args.bootstrap if args.bootstrap is not None else \
+        studies["quick" if args.quick else "defaults"]["bootstrap"]
+
+    started = time.monotonic()
+    plan = execute_all(shaker, workdir, plan_runs(shaker, studies, names, args.quick), args.jobs,
+                       args.rerun, args.reuse_only)
+    views = {}
+    for name in names:
+        for solver in studies["by_name"][name]["solvers"]:
+            records = [r["record"] for r in plan if r["case"] == name and r["solver"] == solver]
+            seed = int(hashlib.sha256(f"{name}/{solver}".encode()).hexdigest()[:8], 16)
+            views[(name, solver)] = build_view(shaker, name, solver, records, workdir,
+                                               bootstrap, seed)
+    comparer = Comparer(shaker, os.path.join(workdir, "derived"))
+    metrics = {}
+    for name in names:
+        md, co = views.get((name, "md")), views.get((name, "continuum"))
+        if md and co and md.status == "ok" and co.status == "ok":
+            try:
+                metrics[name] = comparer(co, md)
+            except quantities.NotMeasured as reason:
+                metrics[name] = {"error": str(reason)}
+    partial = bool(args.cases) or args.quick
+    results = evaluate_claims(claims, views, comparer, partial)
+
+    runs = [dict(case=r["case"], solver=r["solver"], member=r["member"],
+                 status=r["record"]["status"], seconds=r["record"]["seconds"],
+                 reused=r["record"].get("reused", False), path=r["record"].get("path"),
+                 fallback=r["record"].get("fallback"),
+                 stderr=r["record"].get("stderr", "")[-600:]) for r in plan]
+    summary = dict(
+        commit=git("rev-parse", "HEAD"), dirty=bool(git("status", "--porcelain", "--", ".")),
+        date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        quick=args.quick, cases=names, shaker=shaker,
+        shaker_version=subprocess.run([shaker, "--version"], capture_output=True,
+                                      text=True).stdout.strip(),
+        wall_seconds=time.monotonic() - started,
+        simulated_seconds=sum(r["seconds"] for r in runs if not r["reused"]),
+        runs=runs, metrics=metrics, claims=results,
+        views={f"{c}/{s}": dict(case=c, solver=s, status=v.status, path=v.path,
+                                analysis_csv=(v.path + ".analysis.csv") if v.path else None,
+                                shock_speed=v.shock_speed,
+                                shock_speed_error=_spread(v.replicate_kind, [
+                                    r.shock_speed for r in v.replicates]) if v.replicates else
+                                None,
+                                replicate_kind=v.replicate_kind, replicates=len(v.replicates),
+                                switch_e=v.config.get("run", {}).get("switch_e"),
+                                protocol=v.config.get("run", {}).get("protocol"),
+                                collisions_per_second=collisions_per_second(v),
+                                notes=sorted(v.notes))
+               for (c, s), v in views.items()})
+    results_path = os.path.join(workdir, "results.json")
+    with open(results_path + ".partial", "w") as f:
+        json.dump(plain(summary), f, indent=1)
+    os.replace(results_path + ".partial", results_path)
+
+    report = subprocess.run([sys.executable, os.path.join(ROOT, "reports",
+                                                          "make_validation_report.py"),
+                             "--results", results_path, "--output", args.report])
+    if report.returncode != 0:
+        log("the report generator failed")
+        return 1
+    required = [c.strip() for c in args.require.split(",") if c.strip()]
+    failing = [f"{c['id']} ({c['status']})" for c in results
+               if c["id"] in required and c["status"] != "pass"]
+    for c in results:
+        log(f"{c['id']}: {c['status']}  " + "; ".join(
+            f"{s}: {r['status']} {_format_value(r['checks'][0].get('value'))}"
+            for s, r in c["per_solver"].items()))
+    if failing:
+        log("required claims not passing: " + ", ".join(failing))
+        return 1
+    return 0
+
+
+def plain(x):
+    """JSON-ready copy: NaN -> None, numpy scalars -> Python numbers."""
+    if isinstance(x, dict):
+        return {str(k): plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [plain(v) for v in x]
+    if isinstance(x, (float, np.floating)):
+        return None if math.isnan(x) else float(x)
+    if isinstance(x, np.integer):
+        return int(x)
+    return x
+
+
+def _format_value(value):
+    if isinstance(value, list):
+        return "[" + ", ".join("nan" if v is None or math.isnan(v) else f"{v:.4g}"
+                               for v in value) + "]"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return "-"
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""ctest validation.claims_file: reference-data/claims.toml holds C1..C20, each once, with
+every field, a quantity the runner knows (validation/quantities.py) and the parameters it
+needs, a known comparison with a band of the right shape, cases that validation/studies.toml
+runs with the solvers the claim needs, and a provenance in the paper.
+
+It then checks that the checker itself catches broken files (a missing field, an unknown
+quantity, a band of the wrong length, a missing id, a case nobody runs), so that a pass means
+something. Exit status 0 only if the real file is clean and every broken copy is caught.
+"""
+import copy
+import os
+import sys
+import tomllib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+VALIDATION = os.path.dirname(HERE)
+ROOT = os.path.dirname(VALIDATION)
+sys.path.insert(0, VALIDATION)
+import quantities  # noqa: E402
+
+FIELDS = {"id": str, "statement": str, "paper_value": str, "cases": list, "quantity": str,
+          "parameters": dict, "comparison": str, "band": list, "solvers": str,
+          "provenance": str}
+SOLVERS = {"md": {"md"}, "continuum": {"continuum"}, "both": {"md", "continuum"},
+           "md_vs_continuum": {"md", "continuum"}}
+
+
+def check_one(check, claim, where, errors):
+    q = check.get("quantity")
+    if q not in quantities.QUANTITIES:
+        errors.append(f"{where}: unknown quantity '{q}'")
+        return
+    params = check.get("parameters", {})
+    for name in quantities.REQUIRED_PARAMETERS.get(q, ()):
+        if name not in params:
+            errors.append(f"{where}: quantity '{q}' needs parameter '{name}'")
+    for name in quantities.CASE_PARAMETERS:
+        if name in params:
+            named = params[name] if isinstance(params[name], list) else [params[name]]
+            for case in named:
+                if case not in claim.get("cases", []):
+                    errors.append(f"{where}: parameter {name} names case '{case}', which is "
+                                  "not among the claim's cases")
+    comparison = check.get("comparison")
+    if comparison not in quantities.BAND_LENGTH:
+        errors.append(f"{where}: unknown comparison '{comparison}'")
+        return
+    band = check.get("band")
+    if not isinstance(band, list) or len(band) != quantities.BAND_LENGTH[comparison]:
+        errors.append(f"{where}: comparison '{comparison}' needs a band of "
+                      f"{quantities.BAND_LENGTH[comparison]} numbers, got {band!r}")
+    elif not all(isinstance(b, (int, float)) for b in band):
+        errors.append(f"{where}: band {band!r} is not numeric")
+    elif comparison in ("range", "all_in_range") and not band[0] < band[1]:
+        errors.append(f"{where}: band {band!r} is empty")
+
+
+def validate(claims, studies):
+    errors = []
+    runs = {c["name"]: set(c["solvers"]) for c in studies["case"]}
+    ids = [c.get("id") for c in claims]
+    for n in range(1, 21):
+        if ids.count(f"C{n}") != 1:
+            errors.append(f"C{n} appears {ids.count(f'C{n}')} times (expected once)")
+    extra = [i for i in ids if i not in {f"C{n}" for n in range(1, 21)}]
+    if extra:
+        errors.append(f"unexpected ids {extra}")
+    for claim in claims:
+        where = claim.get("id", "?")
+        for field, kind in FIELDS.items():
+            if field not in claim:
+                errors.append(f"{where}: field '{field}' missing")
+            elif not isinstance(claim[field], kind):
+                errors.append(f"{where}: field '{field}' is not a {kind.__name__}")
+            elif kind in (str, list) and not claim[field] and field != "band":
+                errors.append(f"{where}: field '{field}' is empty")
+        if claim.get("solvers") not in SOLVERS:
+            errors.append(f"{where}: solvers must be one of {sorted(SOLVERS)}")
+        else:
+            for case in claim.get("cases", []):
+                if case not in runs:
+                    errors.append(f"{where}: case '{case}' is not in validation/studies.toml")
+                elif not SOLVERS[claim["solvers"]] <= runs[case]:
+                    errors.append(f"{where}: case '{case}' is not run with "
+                                  f"{sorted(SOLVERS[claim['solvers']] - runs[case])}")
+        if "Sec." not in claim.get("provenance", "") and "Fig." not in claim.get("provenance",
+                                                                                   ""):
+            errors.append(f"{where}: provenance names no section or figure of the paper")
+        check_one(claim, claim, where, errors)
+        for i, extra_check in enumerate(claim.get("also", [])):
+            check_one(extra_check, claim, f"{where} (also #{i + 1})", errors)
+    return errors
+
+
+def broken_copies(claims):
+    """(description, broken claims list) pairs the checker must reject."""
+    def edit(fn):
+        c = copy.deepcopy(claims)
+        fn(c)
+        return c
+    return [
+        ("missing field", edit(lambda c: c[3].pop("provenance"))),
+        ("unknown quantity", edit(lambda c: c[0].update(quantity="shock_sped"))),
+        ("band of the wrong length", edit(lambda c: c[0].update(band=[0.1]))),
+        ("missing id", edit(lambda c: c.pop(19))),
+        ("case nobody runs", edit(lambda c: c[0].update(cases=["no_such_case"]))),
+        ("missing parameter", edit(lambda c: c[4].update(parameters={}))),
+        ("unknown comparison", edit(lambda c: c[1].update(comparison="about"))),
+    ]
+
+
+def main():
+    with open(os.path.join(ROOT, "reference-data", "claims.toml"), "rb") as f:
+        claims = tomllib.load(f)["claim"]
+    with open(os.path.join(VALIDATION, "studies.toml"), "rb") as f:
+        studies = tomllib.load(f)
+    failures = 0
+    errors = validate(claims, studies)
+    for e in errors:
+        print(f"claims.toml: {e}")
+    failures += len(errors)
+    print(f"claims.toml: {len(claims)} claims, {len(errors)} problems")
+    for description, broken in broken_copies(claims):
+        found = validate(broken, studies)
+        print(f"broken copy ({description}): {len(found)} problem(s) found"
+              + (f": {found[0]}" if found else " -- NOT CAUGHT"))
+        failures += 0 if found else 1
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

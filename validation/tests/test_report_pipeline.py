@@ -1,0 +1,111 @@
+#!/usr/bin/python3
+"""ctest validation.report_pipeline: the whole validation pipeline on synthetic run files,
+without the solvers.
+
+synthetic_runs.py writes cartoon run files (docs/output-schema.md) under the names the runner
+reuses; run_validation.py --reuse-only then analyses them with the real `shaker analyze` and
+`shaker compare`, pools the single-shock runs, evaluates every claim and writes the report.
+Checks: every claim id C1..C20 in the claims table, pass, FAIL and "not measured" marks all
+present, the seven figure PNGs exist and are non-empty, no run was re-simulated, values the
+cartoon fixes exactly (particles per cycle above z = 80 from the crossings column: 0.3 and 5;
+the collapse detected from the recorded exit status) come out exactly, and --require sets the
+exit status (0 for a passing claim, 1 for a failing one).
+
+    test_report_pipeline.py --shaker SHAKER
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+VALIDATION = os.path.dirname(HERE)
+CASES = ("base,single_shock_e0p99,single_shock_e0p90,single_shock_e0p85,velocity_dependent,"
+         "depth_h4p5,depth_h13p5,collapse_e0p70")
+FIGURES = ("fig1-profiles.png", "fig2-single-shock.png", "fig3-mach.png", "fig4-mach-width.png",
+           "fig5-shock-speed.png", "fig6-restitution-models.png", "fig7-depths.png")
+
+
+def run_validation(shaker, workdir, report, require):
+    cmd = [sys.executable, os.path.join(VALIDATION, "run_validation.py"), "--shaker", shaker,
+           "--workdir", workdir, "--report", report, "--cases", CASES, "--quick",
+           "--reuse-only", "--require", require]
+    result = subprocess.run(cmd, capture_output=True, text=True)
+    return result.returncode, result.stdout + result.stderr
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--shaker", required=True)
+    shaker = os.path.abspath(parser.parse_args().shaker)
+    tmp = tempfile.mkdtemp(prefix="validation-report-pipeline-")
+    problems = []
+
+    def expect(condition, message):
+        print(("ok:      " if condition else "PROBLEM: ") + message)
+        if not condition:
+            problems.append(message)
+
+    workdir, report = os.path.join(tmp, "work"), os.path.join(tmp, "validation.md")
+    made = subprocess.run([sys.executable, os.path.join(HERE, "synthetic_runs.py"), "--shaker",
+                           shaker, "--workdir", workdir, "--cases", CASES, "--quick"],
+                          capture_output=True, text=True)
+    expect(made.returncode == 0, f"synthetic run files written ({made.stderr.strip()[-300:]})")
+
+    rc, output = run_validation(shaker, workdir, report, "C18")
+    expect(rc == 0, f"--require C18 (a passing claim) exits 0 (got {rc})")
+    if rc not in (0, 1):
+        print(output)
+    text = open(report).read() if os.path.exists(report) else ""
+    rows = {m.group(1): m.group(0) for m in re.finditer(r"^\| (C\d+) \|.*$", text, re.M)}
+    expect(sorted(rows, key=lambda i: int(i[1:])) == [f"C{n}" for n in range(1, 21)],
+           f"claims table has rows C1..C20 (found {sorted(rows)})")
+    expect(any(r.endswith("| pass |") for r in rows.values()), "some claim is marked pass")
+    expect(any(r.endswith("| **FAIL** |") for r in rows.values()), "some claim is marked FAIL")
+    expect("not measured" in rows.get("C15", ""),
+           "C15 (its continuum_ceiling200 runs absent) is reported as not measured")
+    for name in FIGURES:
+        path = os.path.join(tmp, "validation", name)
+        expect(os.path.exists(path) and os.path.getsize(path) > 10000,
+               f"{name} exists ({os.path.getsize(path) if os.path.exists(path) else 0} bytes)")
+    for n in range(1, 8):
+        expect(f"## Fig. {n}:" in text, f"section for Fig. {n}")
+    expect("## Agreement metrics" in text and "center_of_mass_fractional_rms" in text,
+           "agreement metrics table")
+
+    results = json.load(open(os.path.join(workdir, "results.json")))
+    expect(all(r["reused"] for r in results["runs"]), "every run reused, none re-simulated")
+    claims = {c["id"]: c for c in results["claims"]}
+
+    def value(claim, solver):
+        return claims[claim]["per_solver"][solver]["checks"][0]["value"]
+
+    expect(abs(value("C17", "md") - 0.3) < 1e-9, f"C17 particles per cycle above 80 = {value('C17', 'md')}"
+           " (cartoon: 0.3)")
+    expect(abs(value("C20", "md") - 5.0) < 1e-9, f"C20 particles per cycle above 80 = {value('C20', 'md')}"
+           " (cartoon: 5)")
+    expect(claims["C18"]["status"] == "pass" and value("C18", "md") == 1.0,
+           "C18: collapse detected from the recorded exit status")
+    c10 = value("C10", "md_vs_continuum")
+    expect(c10 is not None and 0 < c10 < 0.03, f"C10 centre-of-mass fractional RMS {c10}")
+    md_c13 = claims["C13"]["per_solver"]["md"]["status"]
+    expect(md_c13 == "not measured", f"C13 without the e = 0.80 runs: {md_c13}")
+    expect(claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None,
+           "C14 has a jackknife error from the pooled runs")
+
+    rc, _ = run_validation(shaker, workdir, report, "C3")
+    expect(rc == 1, f"--require C3 (failing on the cartoon) exits 1 (got {rc})")
+
+    if problems:
+        print(f"{len(problems)} problem(s); files kept in {tmp}")
+        return 1
+    shutil.rmtree(tmp)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
