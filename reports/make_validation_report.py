@@ -224,7 +224,8 @@ def figure3(results, out_dir, link):
         ax.plot(10 * prof["nu"][k], prof["z"][k], label=f"{solver} 10 nu", **STYLE[solver])
         if "mach" in prof:
             has_profile = True
-            ax.plot(prof["mach"][k], prof["z"][k], label=f"{solver} Ma", ls="--")
+            ax.plot(prof["mach"][k], prof["z"][k], label=f"{solver} Ma",
+                    **(dict(ls="none", marker="^", ms=4) if solver == "md" else dict(ls="--")))
         if not math.isnan(table["shock_location"][k]):
             ax.plot([table["max_mach"][k]], [table["shock_location"][k]], "r^" if solver == "md"
                     else "rs", ms=8, label=f"{solver} max Ma (at the shock)")
