@@ -26,6 +26,17 @@ each is the header shown; numbers are decimal (nan allowed); names contain no co
       quantities as fractions) and the asymptotic-range ratio GCI32 / (r21^p GCI21); passes
       when |ratio - 1| <= asymptotic_tolerance. A two-grid row (convergence "two-grids"; h3,
       phi3, gci32, ratio and pass nan; assumed order, Fs = 3) is shown but is not a check.
+  *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,standard_error
+      MD sampling convergence (verification/convergence/md_sampling.hpp): the standard error
+      of one quantity (phase = f t, nan for all phases) from blocks of K sampled cycles.
+  *.sampling-fit.csv  study,quantity,phase,fit_points,fitted_slope,slope_std_error,
+                      expected_slope,band,pass
+      The least-squares slope of ln se against ln K; passes when |slope - expected_slope|
+      <= band (the band follows from the degrees of freedom of each standard error).
+  *.bin-size.csv      study,quantity,phase,sigma_value,half_sigma_value,statistic,value,
+                      criterion,limit,pass
+      Bin size sigma against sigma/2: `statistic` names `value`; criterion at_least passes
+      when value >= limit, at_most when value <= limit.
 
 The pass/fail marks are recomputed here from the numbers; a `pass` column that disagrees is
 reported and counts as a failure. A failing check is listed with its measured value, never
@@ -55,7 +66,13 @@ ORDERS_HEADER = ["study", "field", "norm", "fit_points", "fitted_order", "order_
 GCI_HEADER = ["study", "quantity", "h1", "h2", "h3", "phi1", "phi2", "phi3", "order",
               "phi_extrapolated", "relative_difference21", "extrapolated_error21", "gci21",
               "gci32", "asymptotic_ratio", "convergence", "asymptotic_tolerance", "pass"]
-TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence"}
+SAMPLING_HEADER = ["study", "quantity", "phase", "K", "blocks", "degrees_of_freedom",
+                   "standard_error"]
+SAMPLING_FIT_HEADER = ["study", "quantity", "phase", "fit_points", "fitted_slope",
+                       "slope_std_error", "expected_slope", "band", "pass"]
+BIN_SIZE_HEADER = ["study", "quantity", "phase", "sigma_value", "half_sigma_value", "statistic",
+                   "value", "criterion", "limit", "pass"]
+TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence", "statistic", "criterion"}
 NORM_ORDER = {"L1": 0, "L2": 1, "Linf": 2}
 
 
@@ -88,9 +105,12 @@ def read_csv(path, header):
 
 
 def read_inputs(directory):
-    found = {"errors": [], "orders": [], "gci": []}
+    found = {"errors": [], "orders": [], "gci": [], "sampling": [], "sampling-fit": [],
+             "bin-size": []}
     files = []
-    for kind, header in (("errors", ERRORS_HEADER), ("orders", ORDERS_HEADER), ("gci", GCI_HEADER)):
+    for kind, header in (("errors", ERRORS_HEADER), ("orders", ORDERS_HEADER), ("gci", GCI_HEADER),
+                         ("sampling", SAMPLING_HEADER), ("sampling-fit", SAMPLING_FIT_HEADER),
+                         ("bin-size", BIN_SIZE_HEADER)):
         for path in sorted(glob.glob(os.path.join(directory, "**", f"*.{kind}.csv"), recursive=True)):
             found[kind].extend(read_csv(path, header))
             files.append(os.path.relpath(path, directory))
@@ -111,6 +131,21 @@ def order_passes(row):
 
 def gci_passes(row):
     return within(row["asymptotic_ratio"], 1.0, row["asymptotic_tolerance"])
+
+
+def sampling_fit_passes(row):
+    return within(row["fitted_slope"], row["expected_slope"], row["band"])
+
+
+def bin_size_passes(row):
+    value, limit = row["value"], row["limit"]
+    if not (math.isfinite(value) and math.isfinite(limit)):
+        return False
+    if row["criterion"] == "at_least":
+        return value >= limit
+    if row["criterion"] == "at_most":
+        return value <= limit
+    return False
 
 
 def verdict(recomputed, claimed):
@@ -178,6 +213,107 @@ def plot_study(study, series, design_orders, out_dir):
     rc.save_figure_atomically(fig, os.path.join(out_dir, name))
     plt.close(fig)
     return name
+
+
+def phase_text(phase):
+    return "all" if math.isnan(phase) else rc.fmt(phase, 3)
+
+
+def plot_sampling(study, rows, out_dir):
+    """se / se(smallest K) against K for every quantity of one study, with K^-1/2."""
+    series = {}
+    for r in rows:
+        series.setdefault((r["quantity"], r["phase"] if not math.isnan(r["phase"]) else -1.0),
+                          []).append(r)
+    fig, ax = plt.subplots(figsize=(5.6, 4.2))
+    k_all = []
+    for (quantity, phase), points in sorted(series.items()):
+        points.sort(key=lambda r: r["K"])
+        k = np.array([r["K"] for r in points])
+        se = np.array([r["standard_error"] for r in points])
+        if len(k) == 0 or not (se[0] > 0):
+            continue
+        keep = se > 0
+        label = f"{quantity} (f t {'all' if phase < 0 else rc.fmt(phase, 3)})"
+        ax.loglog(k[keep], se[keep] / se[0], "o-", ms=4, lw=1, label=label)
+        k_all.extend(k)
+    if k_all:
+        ks = np.array([min(k_all), max(k_all)], dtype=float)
+        ax.loglog(ks, (ks / ks[0]) ** -0.5, "k--", lw=1.5, label="K^-1/2")
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.set_xlabel("sampled cycles K")
+    ax.set_ylabel("se / se(smallest K)")
+    ax.set_title(f"{study}: standard error against K")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    name = f"sampling-{safe_name(study)}.png"
+    rc.save_figure_atomically(fig, os.path.join(out_dir, name))
+    plt.close(fig)
+    return name
+
+
+def sampling_section(data, out_dir, failures):
+    """The MD sampling study: slope fits, the se table, bin size; returns (lines, checks)."""
+    lines = ["## MD sampling convergence", "",
+             "Standard error of MD fields and quantities of interest against the number K of "
+             "sampled cycles (expected slope -1/2 of ln se against ln K, band from the degrees "
+             "of freedom of each standard error), and the bin size sigma against sigma/2.", "",
+             "| study | quantity | f t | fitted slope (± s.e., points) | expected | band | result |",
+             "|---|---|---|---|---|---|---|"]
+    fits = sorted(data["sampling-fit"], key=lambda r: (r["study"], r["quantity"],
+                                                       -1 if math.isnan(r["phase"]) else r["phase"]))
+    for r in fits:
+        mark, ok = verdict(sampling_fit_passes(r), r["pass"])
+        band = f"{rc.fmt(r['expected_slope'] - r['band'], 3)}–{rc.fmt(r['expected_slope'] + r['band'], 3)}"
+        lines.append(f"| {r['study']} | {r['quantity']} | {phase_text(r['phase'])} | "
+                     f"{rc.fmt(r['fitted_slope'], 4)} ± {rc.fmt(r['slope_std_error'], 2)} "
+                     f"({int(r['fit_points'])}) | {rc.fmt(r['expected_slope'])} | {band} | {mark} |")
+        if not ok:
+            failures.append(f"sampling {r['study']} / {r['quantity']} / f t {phase_text(r['phase'])}: "
+                            f"slope {rc.fmt(r['fitted_slope'], 4)} outside "
+                            f"{rc.fmt(r['expected_slope'])} ± {rc.fmt(r['band'], 3)}")
+    if not fits:
+        lines.append("| (no MD sampling studies found) | | | | | | |")
+    lines.append("")
+
+    by_study = {}
+    for r in data["sampling"]:
+        by_study.setdefault(r["study"], []).append(r)
+    for study in sorted(by_study):
+        rows = by_study[study]
+        ks = sorted({int(r["K"]) for r in rows})
+        lines += [f"### {study}: standard error against K", "",
+                  "| quantity | f t | " + " | ".join(f"K = {k}" for k in ks) + " |",
+                  "|---|---" + "|---" * len(ks) + "|"]
+        keys = sorted({(r["quantity"], r["phase"]) for r in rows},
+                      key=lambda q: (q[0], -1 if math.isnan(q[1]) else q[1]))
+        for quantity, phase in keys:
+            cells = {int(r["K"]): r["standard_error"] for r in rows if r["quantity"] == quantity
+                     and (r["phase"] == phase or (math.isnan(r["phase"]) and math.isnan(phase)))}
+            lines.append(f"| {quantity} | {phase_text(phase)} | " +
+                         " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
+        name = plot_sampling(study, rows, out_dir)
+        lines += ["", f"![{study}: se against K]({name})", ""]
+
+    lines += ["### Bin size: sigma against sigma/2", "",
+              "| study | quantity | f t | sigma | sigma/2 | statistic | value | criterion | result |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    bins = sorted(data["bin-size"], key=lambda r: (r["study"], r["quantity"]))
+    for r in bins:
+        mark, ok = verdict(bin_size_passes(r), r["pass"])
+        relation = {"at_least": ">=", "at_most": "<="}.get(r["criterion"], r["criterion"])
+        lines.append(f"| {r['study']} | {r['quantity']} | {phase_text(r['phase'])} | "
+                     f"{rc.fmt(r['sigma_value'], 5)} | {rc.fmt(r['half_sigma_value'], 5)} | "
+                     f"{r['statistic']} | {rc.fmt(r['value'], 4)} | {relation} {rc.fmt(r['limit'], 4)} | "
+                     f"{mark} |")
+        if not ok:
+            failures.append(f"bin size {r['study']} / {r['quantity']}: {r['statistic']} = "
+                            f"{rc.fmt(r['value'], 4)}, required {relation} {rc.fmt(r['limit'], 4)}")
+    if not bins:
+        lines.append("| (no bin-size checks found) | | | | | | | | |")
+    lines.append("")
+    return lines, len(fits) + len(bins)
 
 
 def error_tables(series):
@@ -279,6 +415,8 @@ def main(argv=None):
         gci_lines.append("| (no GCI studies found) | | | | | | | | | | | | |")
     gci_lines.append("")
 
+    sampling_lines, sampling_checks = sampling_section(data, out_dir, failures)
+
     series = series_of(data["errors"])
     plot_lines = ["## Plots", ""]
     for study in sorted(series):
@@ -286,7 +424,7 @@ def main(argv=None):
         name = plot_study(study, series[study], designs, out_dir)
         plot_lines += [f"![{study}]({name})", ""]
 
-    checks = len(order_rows) + len(gci_rows) - two_grid_rows
+    checks = len(order_rows) + len(gci_rows) - two_grid_rows + sampling_checks
     lines = ["# Convergence report", "",
              f"- commit: {commit}",
              f"- date: {rc.utc_now()}",
@@ -300,7 +438,7 @@ def main(argv=None):
     if failures:
         lines += ["", "Failing checks (measured values):", ""] + [f"- {f}" for f in failures]
     lines.append("")
-    lines += order_lines + gci_lines + error_tables(series) + plot_lines
+    lines += order_lines + gci_lines + sampling_lines + error_tables(series) + plot_lines
     lines += ["## Input files", ""] + [f"- {f}" for f in files] + [""]
     rc.write_text_atomically(args.output, "\n".join(lines))
     print(f"wrote {args.output}: {checks} checks, {len(failures)} failing")

@@ -3,7 +3,9 @@
 
 Argument: the reports/ directory. Checks the provenance header, the order and GCI rows with
 their pass/fail marks (including a check whose file claims a pass its numbers contradict),
-the failure summary with measured values, the PNG plot, --strict, and bad input.
+the failure summary with measured values, the PNG plot, --strict, and bad input; and the MD
+sampling section (slope fits against K^-1/2, the se table, its plot, the bin-size checks) on
+a synthetic sampling study.
 """
 import math
 import os
@@ -71,6 +73,36 @@ def synthetic_study(directory):
          0.4, 2.8, "oscillatory", 0.1, 0),
         ("base-3d", "shock_location", 0.5, 1.0, "nan", 1.01, 1.04, "nan", 2.0, 1.0, 0.0297, 0.01,
          0.0297, "nan", "nan", "two-grids", "nan", "nan")])
+
+
+def synthetic_sampling_study(directory):
+    """Standard errors of independent cycles (se ~ K^-1/2) and of drifting ones (flat)."""
+    study = "synthetic-md-sampling"
+    ks = [2, 4, 8, 16]
+    se_rows, fit_rows = [], []
+    for quantity, phase, exponent in (("T_se_layer_rms", "0.22", -0.5),
+                                      ("center_of_mass", "0.5", 0.05),  # must fail
+                                      ("n_se_layer_rms", "nan", -0.5)):
+        se = [0.3 * k ** exponent for k in ks]
+        for k, e in zip(ks, se):
+            se_rows.append((study, quantity, phase, k, 16 // k, (16 // k) * (k - 1), repr(e)))
+        slope = np.polyfit(np.log(ks), np.log(se), 1)[0]
+        claimed = 1 if quantity == "n_se_layer_rms" else int(abs(slope + 0.5) <= 0.42)
+        if quantity == "n_se_layer_rms":
+            slope = -0.95  # the file claims a pass that its numbers contradict
+        fit_rows.append((study, quantity, phase, 4, repr(slope), "0.01", "-0.5", "0.42", claimed))
+    write(os.path.join(directory, "md.sampling.csv"),
+          "study,quantity,phase,K,blocks,degrees_of_freedom,standard_error", se_rows)
+    write(os.path.join(directory, "md.sampling-fit.csv"),
+          "study,quantity,phase,fit_points,fitted_slope,slope_std_error,expected_slope,band,pass",
+          fit_rows)
+    write(os.path.join(directory, "md.bin-size.csv"),
+          "study,quantity,phase,sigma_value,half_sigma_value,statistic,value,criterion,limit,pass", [
+              (study, "T", 0.22, "nan", "nan", "fraction of layer bins within 2 combined se", 0.96,
+               "at_least", 0.9, 1),
+              (study, "uz", 0.22, "nan", "nan", "fraction of layer bins within 2 combined se", 0.8,
+               "at_least", 0.9, 0),
+              (study, "shock_location", 0.22, 17.0, 17.5, "shift", 0.5, "at_most", 1.1, 1)])
 
 
 def run(*args):
@@ -151,6 +183,42 @@ try:
     check(result.returncode == 2 and "first line must be" in result.stderr,
           f"bad header: exit {result.returncode}, stderr '{result.stderr.strip()}'")
     check(not os.path.exists(bad_report), "a report was written from bad input")
+
+    # ---- the MD sampling section, from its own input directory ----
+    sampling_in = os.path.join(work, "sampling-input")
+    os.makedirs(sampling_in)
+    synthetic_sampling_study(sampling_in)
+    sampling_report = os.path.join(work, "sampling-out", "convergence.md")
+    result = run("--input", sampling_in, "--output", sampling_report, "--commit", "abc")
+    check(result.returncode == 0, f"sampling report: exit {result.returncode}: {result.stderr}")
+    text = open(sampling_report).read() if os.path.exists(sampling_report) else ""
+    check("## MD sampling convergence" in text, "MD sampling section missing")
+    check("6 checks: 3 pass, 3 fail." in text, "sampling summary count missing or wrong")
+    row = line_with(text, "| synthetic-md-sampling | T_se_layer_rms | 0.22 |")
+    check(row.endswith("| PASS |") and "-0.5 ± " in row and "-0.92–-0.08" in row,
+          f"T_se fit should pass with its band shown: '{row}'")
+    row = line_with(text, "| synthetic-md-sampling | center_of_mass | 0.5 |")
+    check("**FAIL**" in row and "| 0.05 ± " in row, f"flat se must fail with slope 0.05: '{row}'")
+    check(line_with(text, "- sampling synthetic-md-sampling / center_of_mass / f t 0.5: slope 0.05")
+          != "", "failing slope missing from the summary")
+    row = line_with(text, "| synthetic-md-sampling | n_se_layer_rms | all |")
+    check("**FAIL**" in row and "file says pass" in row, f"inconsistent fit not flagged: '{row}'")
+    se_header = line_with(text, "| quantity | f t | K = 2 | K = 4 | K = 8 | K = 16 |")
+    check(se_header != "", "se table header missing")
+    se_row = line_with(text, "| T_se_layer_rms | 0.22 | 0.2121 |")
+    check(se_row.endswith("| 0.075 |"), f"se table row wrong: '{se_row}'")
+    bins_t = line_with(text, "| synthetic-md-sampling | T | 0.22 |")
+    check(bins_t.endswith("| PASS |") and ">= 0.9" in bins_t, f"bin-size T should pass: '{bins_t}'")
+    bins_uz = line_with(text, "| synthetic-md-sampling | uz | 0.22 |")
+    check("**FAIL**" in bins_uz and "| 0.8 |" in bins_uz, f"bin-size uz should fail at 0.8: '{bins_uz}'")
+    check(line_with(text, "- bin size synthetic-md-sampling / uz: fraction of layer bins within 2 "
+                          "combined se = 0.8, required >= 0.9") != "", "bin-size failure not summarised")
+    shock = line_with(text, "| synthetic-md-sampling | shock_location | 0.22 | 17 | 17.5 |")
+    check(shock.endswith("| PASS |") and "<= 1.1" in shock, f"bin-size shock row wrong: '{shock}'")
+    png = os.path.join(work, "sampling-out", "sampling-synthetic-md-sampling.png")
+    check(os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+          and os.path.getsize(png) > 5000, "sampling PNG missing or not a PNG")
+    check("(sampling-synthetic-md-sampling.png)" in text, "sampling plot not linked")
 finally:
     shutil.rmtree(work, ignore_errors=True)
 

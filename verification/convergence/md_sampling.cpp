@@ -1,0 +1,327 @@
+#include "md_sampling.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "analysis/analysis.hpp"
+#include "common/case_parameters.hpp"
+#include "common/hdf5_file.hpp"
+#include "common/units.hpp"
+#include "md/initial_states.hpp"
+#include "md/protocol.hpp"
+#include "md/sampling.hpp"
+#include "md/simulation.hpp"
+
+namespace shaker::convergence {
+namespace {
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+double sample_variance(std::span<const double> x) {
+  const double m = static_cast<double>(x.size());
+  double mean = 0.0;
+  for (double v : x) mean += v;
+  mean /= m;
+  double squares = 0.0;
+  for (double v : x) squares += (v - mean) * (v - mean);
+  return squares / (m - 1.0);
+}
+}  // namespace
+
+double block_standard_error(std::span<const double> per_cycle, std::size_t K) {
+  if (K < 2 || K > per_cycle.size())
+    throw std::invalid_argument(fmt::format("block_standard_error: K = {} with {} values", K,
+                                            per_cycle.size()));
+  for (double v : per_cycle)
+    if (std::isnan(v)) throw std::invalid_argument("block_standard_error: a value is NaN");
+  const std::size_t blocks = per_cycle.size() / K;
+  double mean_se2 = 0.0;
+  for (std::size_t b = 0; b < blocks; ++b)
+    mean_se2 += sample_variance(per_cycle.subspan(b * K, K)) / static_cast<double>(K);
+  return std::sqrt(mean_se2 / static_cast<double>(blocks));
+}
+
+std::size_t block_degrees_of_freedom(std::size_t cycles, std::size_t K) {
+  return K == 0 ? 0 : (cycles / K) * (K - 1);
+}
+
+double expected_slope_scatter(std::span<const std::size_t> block_sizes, std::size_t cycles) {
+  const double m = static_cast<double>(block_sizes.size());
+  double mean_x = 0.0;
+  for (std::size_t K : block_sizes) mean_x += std::log(static_cast<double>(K)) / m;
+  double sxx = 0.0, weighted = 0.0;
+  for (std::size_t K : block_sizes) {
+    const double dx = std::log(static_cast<double>(K)) - mean_x;
+    const double dof = static_cast<double>(block_degrees_of_freedom(cycles, K));
+    sxx += dx * dx;
+    weighted += dx * dx / (2.0 * dof);
+  }
+  return std::sqrt(weighted) / sxx;
+}
+
+bool SamplingFit::pass() const {
+  return std::isfinite(fit.order) && std::abs(fit.order - expected_slope) <= band;
+}
+
+SamplingFit fit_sampling(const std::string& study, const std::string& quantity, double phase,
+                         std::vector<std::size_t> block_sizes, std::vector<double> standard_errors,
+                         std::size_t cycles) {
+  SamplingFit f;
+  f.study = study;
+  f.quantity = quantity;
+  f.phase = phase;
+  std::vector<double> K(block_sizes.begin(), block_sizes.end());
+  f.band = slope_band_sigmas * expected_slope_scatter(block_sizes, cycles);
+  f.block_sizes = std::move(block_sizes);
+  f.standard_errors = std::move(standard_errors);
+  bool positive = true;
+  for (double se : f.standard_errors) positive = positive && se > 0.0 && std::isfinite(se);
+  if (positive) f.fit = fit_order(K, f.standard_errors);
+  else f.fit = OrderFit{nan, nan, nan, K.size()};  // a zero or missing se fails the check
+  return f;
+}
+
+std::vector<std::size_t> layer_bins(const Profile& p) {
+  std::vector<std::size_t> bins;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.nu[i] > analysis::layer_volume_fraction) bins.push_back(i);
+  return bins;
+}
+
+Profile pair_average(const Profile& fine) {
+  Profile p = fine;
+  p.bin_height = 2.0 * fine.bin_height;
+  const std::size_t bins = fine.size() / 2;
+  auto mean = [](const std::vector<double>& x, std::size_t j) { return 0.5 * (x[2 * j] + x[2 * j + 1]); };
+  auto combined = [](const std::vector<double>& se, std::size_t j) {
+    return 0.5 * std::hypot(se[2 * j], se[2 * j + 1]);
+  };
+  for (auto* field : {&p.z, &p.n, &p.nu, &p.uz, &p.T, &p.samples, &p.n_se, &p.uz_se, &p.T_se})
+    field->assign(bins, 0.0);
+  for (std::size_t j = 0; j < bins; ++j) {
+    p.z[j] = mean(fine.z, j);
+    p.n[j] = mean(fine.n, j);
+    p.nu[j] = mean(fine.nu, j);
+    p.uz[j] = mean(fine.uz, j);
+    p.T[j] = mean(fine.T, j);
+    p.samples[j] = fine.samples[2 * j] + fine.samples[2 * j + 1];
+    p.n_se[j] = combined(fine.n_se, j);
+    p.uz_se[j] = combined(fine.uz_se, j);
+    p.T_se[j] = combined(fine.T_se, j);
+  }
+  return p;
+}
+
+FieldAgreement compare_fields(const Profile& coarse, const Profile& paired, const std::string& field,
+                              double sigmas) {
+  if (coarse.size() != paired.size())
+    throw std::invalid_argument(fmt::format("compare_fields: {} bins against {}", coarse.size(),
+                                            paired.size()));
+  const auto value = field == "T" ? &Profile::T : field == "uz" ? &Profile::uz
+                     : field == "nu" ? &Profile::nu
+                                     : throw std::invalid_argument("compare_fields: field " + field);
+  const auto se = field == "T" ? &Profile::T_se : field == "uz" ? &Profile::uz_se : &Profile::n_se;
+  const double se_scale = field == "nu" ? volume_fraction(1.0) : 1.0;
+  FieldAgreement a;
+  for (std::size_t i : layer_bins(coarse)) {
+    const double difference = std::abs((coarse.*value)[i] - (paired.*value)[i]);
+    const double combined = se_scale * std::hypot((coarse.*se)[i], (paired.*se)[i]);
+    ++a.bins;
+    if (difference < sigmas * combined) ++a.within;
+    a.max_abs_difference = std::max(a.max_abs_difference, difference);
+    a.max_difference_in_se = std::max(a.max_difference_in_se, difference / combined);
+  }
+  return a;
+}
+
+bool BinSizeCheck::pass() const {
+  if (!std::isfinite(value) || !std::isfinite(limit)) return false;
+  return criterion == "at_least" ? value >= limit : value <= limit;
+}
+
+// ---- the trajectory ---------------------------------------------------------------------
+
+const Profile& at_phase(const std::vector<Profile>& profiles, double phase) {
+  const auto phases = static_cast<double>(profiles.size());
+  const auto k = static_cast<std::size_t>(std::lround(phase * phases));
+  if (profiles.empty() || k >= profiles.size() || std::abs(profiles[k].phase - phase) > 1e-9)
+    throw std::invalid_argument(fmt::format("f t = {} is not on the grid of {} phases", phase,
+                                            profiles.size()));
+  return profiles[k];
+}
+
+namespace {
+
+md::Simulation make_simulation(const CaseParameters& c, const md::MdSettings& s) {
+  md::Geometry g;
+  g.width = c.md_box_width;
+  g.height = s.ceiling;
+  g.gravity = gravity;
+  g.plate = md::PlateMotion::from(c.shaker);
+  md::CollisionRules rules;
+  rules.restitution = c.restitution;
+  rules.tc_guard = s.tc_guard;
+  rules.tc = s.tc;
+  return md::Simulation(g, rules, md::flat_layer(g, static_cast<std::size_t>(c.particles), c.run.seed),
+                        s.queue);
+}
+
+/// A single-cycle profile carries se = 0 (no spread from one cycle): drop them so that the
+/// shock detection treats the standard errors as unknown rather than zero.
+Profile without_standard_errors(Profile p) {
+  p.n_se.clear();
+  p.uz_se.clear();
+  p.T_se.clear();
+  return p;
+}
+
+double shock_location(const Profile& p) {
+  const auto shock = analysis::find_shock(p);
+  return shock ? shock->location : nan;
+}
+
+}  // namespace
+
+SamplingTrajectory run_sampling_trajectory(const config::Config& config,
+                                           std::span<const std::size_t> block_sizes,
+                                           double fine_bin_height) {
+  const CaseParameters c = CaseParameters::from(config);
+  const md::MdSettings s = md::MdSettings::from(config);
+  if (c.run.kind != RunProtocol::Kind::periodic)
+    throw std::invalid_argument("run_sampling_trajectory: needs run.protocol = periodic");
+  const auto cycles = static_cast<std::size_t>(c.run.sampled_cycles);
+  for (std::size_t K : block_sizes)
+    if (K < 2 || cycles % K != 0)
+      throw std::invalid_argument(fmt::format("block size {} does not divide {} cycles", K, cycles));
+  const int phases = static_cast<int>(c.run.phases_per_cycle);
+  const double width = c.md_box_width, top = s.ceiling;
+  auto sampler = [&](double bin) { return std::make_unique<md::PhaseSampler>(phases, bin, top, width); };
+
+  SamplingTrajectory out;
+  out.cycles = cycles;
+  out.quantity_names = {"center_of_mass", "center_of_mass", "center_of_mass", "center_of_mass",
+                        "shock_location"};
+  out.quantity_phases = {0.0, 0.25, 0.5, 0.75, 0.22};
+  out.per_cycle.assign(out.quantity_names.size(), {});
+  out.n_se.resize(block_sizes.size());
+  out.T_se.resize(block_sizes.size());
+
+  md::Simulation sim = make_simulation(c, s);
+  auto pooled = sampler(s.bin_height), pooled_fine = sampler(fine_bin_height);
+  std::vector<std::unique_ptr<md::PhaseSampler>> blocks;
+  for (std::size_t b = 0; b < block_sizes.size(); ++b) blocks.push_back(sampler(s.bin_height));
+  std::vector<md::Vec3> r, v;
+  const auto start = std::chrono::steady_clock::now();
+  const auto transient = static_cast<std::size_t>(c.run.transient_cycles);
+  for (std::size_t m = 0; m < transient + cycles; ++m) {
+    const bool sampled = m >= transient;
+    auto cycle = sampler(s.bin_height), cycle_fine = sampler(fine_bin_height);
+    for (int k = 0; k < phases; ++k) {
+      // The same instants as run_protocol: (cycle + k / phases) / f from t = 0.
+      const double t = (static_cast<double>(m) + static_cast<double>(k) / phases) / c.shaker.f;
+      sim.advance_to(t);
+      if (!sampled) continue;
+      sim.positions_at(t, r, v);
+      for (auto* one : {pooled.get(), pooled_fine.get(), cycle.get(), cycle_fine.get()}) one->add(k, t, r, v);
+      for (auto& block : blocks) block->add(k, t, r, v);
+    }
+    if (!sampled) continue;
+    const std::vector<Profile> profiles = cycle->profiles(c.shaker);
+    for (std::size_t q = 0; q < out.quantity_names.size(); ++q) {
+      const Profile p = without_standard_errors(at_phase(profiles, out.quantity_phases[q]));
+      out.per_cycle[q].push_back(out.quantity_names[q] == "shock_location"
+                                     ? shock_location(p)
+                                     : analysis::center_of_mass(p));
+    }
+    out.per_cycle_shock_fine.push_back(
+        shock_location(without_standard_errors(at_phase(cycle_fine->profiles(c.shaker), 0.22))));
+    const std::size_t done = m + 1 - transient;
+    for (std::size_t b = 0; b < block_sizes.size(); ++b) {
+      if (done % block_sizes[b] != 0) continue;
+      const std::vector<Profile> block = blocks[b]->profiles(c.shaker);
+      if (b == 0 && done == block_sizes[0]) out.first_block = block;
+      auto& n_se = out.n_se[b].emplace_back();
+      auto& T_se = out.T_se[b].emplace_back();
+      for (const Profile& p : block) {
+        n_se.push_back(p.n_se);
+        T_se.push_back(p.T_se);
+      }
+      blocks[b] = sampler(s.bin_height);
+    }
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.pooled = pooled->profiles(c.shaker);
+  out.pooled_fine = pooled_fine->profiles(c.shaker);
+  return out;
+}
+
+double layer_rms_standard_error(const std::vector<std::vector<std::vector<double>>>& blocks_se,
+                                const std::vector<Profile>& pooled, double phase) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < pooled.size(); ++k) {
+    if (phase >= 0.0 && &pooled[k] != &at_phase(pooled, phase)) continue;
+    for (std::size_t i : layer_bins(pooled[k]))
+      for (const auto& block : blocks_se) {
+        sum += block[k][i] * block[k][i];
+        ++count;
+      }
+  }
+  return count ? std::sqrt(sum / static_cast<double>(count)) : nan;
+}
+
+// ---- tables -----------------------------------------------------------------------------
+
+namespace {
+std::string number(double x) { return fmt::format("{:.17g}", x); }
+std::string phase_text(double phase) { return std::isnan(phase) ? "nan" : number(phase); }
+}  // namespace
+
+std::vector<std::filesystem::path> write_sampling_study(const std::filesystem::path& directory,
+                                                        const std::string& name,
+                                                        std::span<const SamplingFit> fits,
+                                                        std::span<const BinSizeCheck> bin_checks,
+                                                        std::size_t cycles) {
+  if (name.find_first_of("/,\"\n") != std::string::npos)
+    throw std::invalid_argument("write_sampling_study: bad study file name " + name);
+  std::string se = "study,quantity,phase,K,blocks,degrees_of_freedom,standard_error\n";
+  std::string fit = "study,quantity,phase,fit_points,fitted_slope,slope_std_error,expected_slope,"
+                    "band,pass\n";
+  for (const SamplingFit& f : fits) {
+    for (std::size_t k = 0; k < f.block_sizes.size(); ++k)
+      se += fmt::format("{},{},{},{},{},{},{}\n", f.study, f.quantity, phase_text(f.phase),
+                        f.block_sizes[k], cycles / f.block_sizes[k],
+                        block_degrees_of_freedom(cycles, f.block_sizes[k]),
+                        number(f.standard_errors[k]));
+    fit += fmt::format("{},{},{},{},{},{},{},{},{}\n", f.study, f.quantity, phase_text(f.phase),
+                       f.fit.points, number(f.fit.order), number(f.fit.order_std_error),
+                       number(f.expected_slope), number(f.band), f.pass() ? 1 : 0);
+  }
+  std::string bins = "study,quantity,phase,sigma_value,half_sigma_value,statistic,value,criterion,"
+                     "limit,pass\n";
+  for (const BinSizeCheck& b : bin_checks)
+    bins += fmt::format("{},{},{},{},{},{},{},{},{},{}\n", b.study, b.quantity, phase_text(b.phase),
+                        number(b.sigma_value), number(b.half_sigma_value), b.statistic,
+                        number(b.value), b.criterion, number(b.limit), b.pass() ? 1 : 0);
+
+  std::vector<std::filesystem::path> targets{directory}, written;
+  if (const char* collected = std::getenv(study_directory_variable); collected && *collected)
+    targets.emplace_back(collected);
+  for (const auto& target : targets) {
+    std::filesystem::create_directories(target);
+    for (const auto& [suffix, text] : {std::pair{".sampling.csv", &se},
+                                       std::pair{".sampling-fit.csv", &fit},
+                                       std::pair{".bin-size.csv", &bins}}) {
+      write_text_atomically(target / (name + suffix), *text);
+      written.push_back(target / (name + suffix));
+    }
+  }
+  return written;
+}
+
+}  // namespace shaker::convergence
