@@ -65,9 +65,26 @@ def shock_run(table):
     return np.arange(best[0], best[1])
 
 
-def formation_phase(table):
+def formation_phase(table, periodic=False):
+    """Phase of the first stored phase of the shock's life. In a periodic run the stored
+    phases are one cycle, so a life that starts at f t = 0 may have begun at the end of the
+    cycle before: then the formation phase is that phase minus 1 (e.g. -0.02 for 0.98)."""
     run = shock_run(table)
-    return float(table["phase"][run[0]]) if len(run) else math.nan
+    if not len(run):
+        return math.nan
+    first = int(run[0])
+    present = _has_shock(table)
+    if periodic and first == 0:
+        k = len(present)
+        while k - 1 > run[-1] and present[k - 1]:
+            k -= 1
+        if k < len(present):
+            return float(table["phase"][k]) - 1.0
+    return float(table["phase"][first])
+
+
+def _periodic(view):
+    return view.config.get("run", {}).get("protocol") == "periodic"
 
 
 def exit_phase(table):
@@ -125,7 +142,8 @@ class Query:
 # ---- the quantities -----------------------------------------------------------------------
 
 def q_shock_formation_phase(q):
-    return formation_phase(q.table(q.cases[0]))
+    view = q.run(q.cases[0])
+    return formation_phase(view.analysis, periodic=_periodic(view))
 
 
 def q_shock_exit_phase(q):
@@ -240,7 +258,8 @@ def q_com_mean_excess_of_shallow(q):
 
 
 def q_shock_formation_phase_by_case(q):
-    return [formation_phase(q.table(c)) for c in q.params["order"]]
+    views = [q.run(c) for c in q.params["order"]]
+    return [formation_phase(v.analysis, periodic=_periodic(v)) for v in views]
 
 
 def q_shock_speed_by_case(q):

@@ -521,7 +521,8 @@ def main(argv=None):
     parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
     parser.add_argument("--bootstrap", type=int, help="bootstrap replicates of MD profiles")
     parser.add_argument("--require", default="",
-                        help="comma-separated claim ids that must pass (else exit status 1)")
+                        help="comma-separated claim ids that must pass (else exit status 1); "
+                        "ID:SOLVER requires only that solver's check (e.g. C1:md)")
     parser.add_argument("--rerun", action="store_true", help="ignore finished runs")
     parser.add_argument("--reuse-only", action="store_true",
                         help="never start a solver; use finished runs in --workdir only")
@@ -604,9 +605,7 @@ def main(argv=None):
     if report.returncode != 0:
         log("the report generator failed")
         return 1
-    required = [c.strip() for c in args.require.split(",") if c.strip()]
-    failing = [f"{c['id']} ({c['status']})" for c in results
-               if c["id"] in required and c["status"] != "pass"]
+    failing = required_not_passing(results, args.require)
     for c in results:
         log(f"{c['id']}: {c['status']}  " + "; ".join(
             f"{s}: {r['status']} {_format_value(r['checks'][0].get('value'))}"
@@ -615,6 +614,25 @@ def main(argv=None):
         log("required claims not passing: " + ", ".join(failing))
         return 1
     return 0
+
+
+def required_not_passing(results, require):
+    """The entries of --require (ID, or ID:SOLVER for one solver's check of a claim, e.g.
+    C1:md) that do not pass, as 'ID (status)' strings; an unknown entry counts as failing."""
+    failing = []
+    for entry in (e.strip() for e in require.split(",") if e.strip()):
+        claim_id, _, solver = entry.partition(":")
+        claim = next((c for c in results if c["id"] == claim_id), None)
+        if claim is None:
+            failing.append(f"{entry} (no such claim)")
+        elif not solver:
+            if claim["status"] != "pass":
+                failing.append(f"{entry} ({claim['status']})")
+        elif solver not in claim["per_solver"]:
+            failing.append(f"{entry} (not checked for {solver})")
+        elif claim["per_solver"][solver]["status"] != "pass":
+            failing.append(f"{entry} ({claim['per_solver'][solver]['status']})")
+    return failing
 
 
 def plain(x):

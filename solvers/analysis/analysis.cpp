@@ -131,6 +131,15 @@ std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& c) {
   std::size_t steepest = *peak;
   for (std::size_t k = *peak; k < *trough; ++k)
     if (p.T[k] - p.T[k + 1] > p.T[steepest] - p.T[steepest + 1]) steepest = k;
+  // The shock of physics.md is a shock in the layer: the front where the falling layer's
+  // material is stopped. So the material where T falls steepest must be layer material
+  // (nu above the layer threshold). This rejects the dilute gas that a continuum keeps in the
+  // gap under a falling layer: squeezed against the plate, it is hot and T falls from it into
+  // the cold layer, but that drop lies in gas (nu 0.015-0.022 in the base case at
+  // f t = 0.92-0.96), not in the layer, and no layer material has been stopped yet. A shock
+  // compresses what it decelerates, so a real one has layer material on both sides.
+  const double nu_at_shock = 0.5 * (p.nu[steepest] + p.nu[steepest + 1]);
+  if (!(nu_at_shock > layer_volume_fraction)) return std::nullopt;
   Shock shock;
   shock.location = 0.5 * (p.z[steepest] + p.z[steepest + 1]);
   // Once the steepest drop is above the layer's top the shock has left the layer.

@@ -47,7 +47,9 @@ struct Shock {
   double mean_free_path = 0.0;   ///< xi at the shock location
   double width_over_mfp() const { return width / mean_free_path; }
 };
-/// The shock of physics.md ("Analysis quantities"), or nothing if the profile has none.
+/// The shock of physics.md ("Analysis quantities"), or nothing if the profile has none. It is
+/// a shock in the layer: nu at its location is above the layer threshold and the location is
+/// below the layer's top (see find_shock in analysis.cpp for why).
 std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& criteria = {});
 
 /// Everything `shaker analyze` prints for one phase.
