@@ -240,6 +240,9 @@ def plot_sampling(study, rows, out_dir):
     if k_all:
         ks = np.array([min(k_all), max(k_all)], dtype=float)
         ax.loglog(ks, (ks / ks[0]) ** -0.5, "k--", lw=1.5, label="K^-1/2")
+        ticks = sorted(set(k_all))
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([f"{k:g}" for k in ticks])
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel("sampled cycles K")
     ax.set_ylabel("se / se(smallest K)")
@@ -286,12 +289,11 @@ def sampling_section(data, out_dir, failures):
         lines += [f"### {study}: standard error against K", "",
                   "| quantity | f t | " + " | ".join(f"K = {k}" for k in ks) + " |",
                   "|---|---" + "|---" * len(ks) + "|"]
-        keys = sorted({(r["quantity"], r["phase"]) for r in rows},
-                      key=lambda q: (q[0], -1 if math.isnan(q[1]) else q[1]))
-        for quantity, phase in keys:
-            cells = {int(r["K"]): r["standard_error"] for r in rows if r["quantity"] == quantity
-                     and (r["phase"] == phase or (math.isnan(r["phase"]) and math.isnan(phase)))}
-            lines.append(f"| {quantity} | {phase_text(phase)} | " +
+        def key(r):  # nan (all phases) never equals itself: -1 stands for it
+            return (r["quantity"], -1.0 if math.isnan(r["phase"]) else r["phase"])
+        for quantity, phase in sorted({key(r) for r in rows}):
+            cells = {int(r["K"]): r["standard_error"] for r in rows if key(r) == (quantity, phase)}
+            lines.append(f"| {quantity} | {phase_text(phase if phase >= 0 else math.nan)} | " +
                          " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
         name = plot_sampling(study, rows, out_dir)
         lines += ["", f"![{study}: se against K]({name})", ""]

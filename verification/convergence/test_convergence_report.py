@@ -207,6 +207,8 @@ try:
     check(se_header != "", "se table header missing")
     se_row = line_with(text, "| T_se_layer_rms | 0.22 | 0.2121 |")
     check(se_row.endswith("| 0.075 |"), f"se table row wrong: '{se_row}'")
+    all_rows = [l for l in text.splitlines() if l.startswith("| n_se_layer_rms | all | ")]
+    check(len(all_rows) == 1, f"the all-phases se row must appear once, found {len(all_rows)}")
     bins_t = line_with(text, "| synthetic-md-sampling | T | 0.22 |")
     check(bins_t.endswith("| PASS |") and ">= 0.9" in bins_t, f"bin-size T should pass: '{bins_t}'")
     bins_uz = line_with(text, "| synthetic-md-sampling | uz | 0.22 |")
