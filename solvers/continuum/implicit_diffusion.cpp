@@ -13,14 +13,29 @@ inline double harmonic_mean(double a, double b) {
   const double sum = a + b;
   return sum > 0.0 ? 2.0 * a * b / sum : 0.0;
 }
+
+/// Diffusion coefficient of `component` (0..2: u_x, u_y, u_z; 3: T) across a face normal
+/// to `direction`.
+inline double coefficient(const Operator::Closure& cl, std::ptrdiff_t c, int component, int direction) {
+  if (component == 3) return cl.kappa[c];
+  return direction == component ? cl.lambda[c] + 4.0 / 3.0 * cl.mu[c] : cl.mu[c];
+}
 }  // namespace
 
-ImplicitDiffusion::ImplicitDiffusion(const Grid& grid) : grid_(grid) {
+ImplicitDiffusion::ImplicitDiffusion(const Grid& grid)
+    : grid_(grid), column_(grid.dimension == 1 && grid.z_boundary == ZBoundary::walls) {
   for (int k = 0; k < grid.nz; ++k)
     for (int j = 0; j < grid.ny; ++j)
       for (int i = 0; i < grid.nx; ++i) storage_.push_back(grid.index(i, j, k));
   const auto cells = static_cast<Eigen::Index>(storage_.size());
-  matrix_.resize(cells, cells);
+  for (Eigen::VectorXd* v : {&rhs_, &dissipation_, &temperature_, &velocity_[0], &velocity_[1], &velocity_[2]})
+    v->resize(cells);
+  if (column_) {
+    face_.assign(storage_.size(), 0.0);
+    forward_.assign(storage_.size(), 0.0);
+  } else {
+    matrix_.resize(cells, cells);
+  }
 }
 
 // Calls visit(m, neighbour_m or -1 for a wall, direction) for each face of each cell once
@@ -46,6 +61,36 @@ template <class Visit> void for_each_face(const Grid& g, Visit visit) {
       }
 }
 
+// Thomas algorithm for the column: sub/super-diagonals -face_[m], diagonal the mass term
+// plus the faces of the cell (plus the mirrored wall for u_z). The mass term makes the matrix
+// strictly diagonally dominant, so elimination without pivoting is stable.
+void ImplicitDiffusion::solve_column(const Operator& op, int component, double dt, Eigen::VectorXd& x) {
+  const double* n = op.primitives()[0].data();
+  const auto& cl = op.closure();
+  const std::size_t M = storage_.size();
+  const double inv_h2 = 1.0 / (grid_.h * grid_.h);
+  const double mass_factor = (component == 3 ? 1.5 : 1.0) / dt;
+  for (std::size_t m = 0; m + 1 < M; ++m)
+    face_[m] = harmonic_mean(coefficient(cl, storage_[m], component, 2),
+                             coefficient(cl, storage_[m + 1], component, 2)) * inv_h2;
+  face_[M - 1] = 0.0;
+  const auto diagonal = [&](std::size_t m) {
+    double d = mass_factor * n[storage_[m]] + face_[m] + (m > 0 ? face_[m - 1] : 0.0);
+    // wall: only u_z has a condition (u_z = 0, mirror ghost), the rest no flux
+    if (component == 2 && (m == 0 || m + 1 == M)) d += 2.0 * coefficient(cl, storage_[m], 2, 2) * inv_h2;
+    return d;
+  };
+  double pivot = diagonal(0);
+  forward_[0] = -face_[0] / pivot;
+  x[0] = rhs_[0] / pivot;
+  for (std::size_t m = 1; m < M; ++m) {
+    pivot = diagonal(m) + face_[m - 1] * forward_[m - 1];
+    forward_[m] = -face_[m] / pivot;
+    x[m] = (rhs_[m] + face_[m - 1] * x[m - 1]) / pivot;
+  }
+  for (std::size_t m = M - 1; m-- > 0;) x[m] -= forward_[m] * x[m + 1];
+}
+
 void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
   const auto& w = op.primitives();
   const auto& cl = op.closure();
@@ -56,18 +101,15 @@ void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
     const auto c = storage_[m];
     triplets_.emplace_back(m, m, mass_factor * w[0][c] / dt);
   }
-  const auto coefficient = [&](std::ptrdiff_t c, int direction) {
-    if (component == 3) return cl.kappa[c];
-    return direction == component ? cl.lambda[c] + 4.0 / 3.0 * cl.mu[c] : cl.mu[c];
-  };
   for_each_face(grid_, [&](Eigen::Index a, Eigen::Index b, int direction) {
     const auto ca = storage_[a];
     if (b < 0) {  // wall: only u_z has a condition (u_z = 0, mirror ghost), the rest no flux
-      if (component == 2) triplets_.emplace_back(a, a, 2.0 * coefficient(ca, direction) * inv_h2);
+      if (component == 2) triplets_.emplace_back(a, a, 2.0 * coefficient(cl, ca, component, direction) * inv_h2);
       return;
     }
     if (a == b) return;  // a single cell across a periodic direction
-    const double f = harmonic_mean(coefficient(ca, direction), coefficient(storage_[b], direction)) * inv_h2;
+    const double f = harmonic_mean(coefficient(cl, ca, component, direction),
+                                   coefficient(cl, storage_[b], component, direction)) * inv_h2;
     triplets_.emplace_back(a, a, f);
     triplets_.emplace_back(b, b, f);
     triplets_.emplace_back(a, b, -f);
@@ -76,72 +118,85 @@ void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
   matrix_.setFromTriplets(triplets_.begin(), triplets_.end());
 }
 
-Eigen::VectorXd ImplicitDiffusion::solve(const Eigen::VectorXd& rhs) {
+void ImplicitDiffusion::solve_sparse(Eigen::VectorXd& x) {
   if (grid_.dimension == 1) {
-    if (!tridiagonal_) {
-      tridiagonal_ = std::make_unique<Tridiagonal>();
-      tridiagonal_->analyzePattern(matrix_);
+    if (!banded_) {
+      banded_ = std::make_unique<Banded>();
+      banded_->analyzePattern(matrix_);
     }
-    tridiagonal_->factorize(matrix_);
-    if (tridiagonal_->info() != Eigen::Success) throw DomainError("implicit diffusion: factorisation failed");
-    return tridiagonal_->solve(rhs);
+    banded_->factorize(matrix_);
+    if (banded_->info() != Eigen::Success) throw DomainError("implicit diffusion: factorisation failed");
+    x = banded_->solve(rhs_);
+    return;
   }
   Eigen::ConjugateGradient<Matrix, Eigen::Lower | Eigen::Upper> solver;
   solver.setTolerance(1e-13);
   solver.compute(matrix_);
-  Eigen::VectorXd x = solver.solve(rhs);
+  x = solver.solve(rhs_);
   if (solver.info() != Eigen::Success) throw DomainError("implicit diffusion: CG did not converge");
-  return x;
 }
 
-void ImplicitDiffusion::advance(Operator& op, State& U, double dt) {
-  op.prepare(U);
-  const auto& w = op.primitives();
+void ImplicitDiffusion::solve(const Operator& op, int component, double dt, Eigen::VectorXd& x) {
+  if (column_) return solve_column(op, component, dt, x);
+  assemble(op, component, dt);
+  solve_sparse(x);
+}
+
+void ImplicitDiffusion::add_dissipation(const Operator& op, int component, const Eigen::VectorXd& u) {
   const auto& cl = op.closure();
-  const std::size_t cells = storage_.size();
-  const auto M = static_cast<Eigen::Index>(cells);
-  std::vector<Eigen::VectorXd> velocity(3, Eigen::VectorXd(M));
-  Eigen::VectorXd dissipation = Eigen::VectorXd::Zero(M);
   const double inv_h2 = 1.0 / (grid_.h * grid_.h);
+  const auto wall = [&](Eigen::Index a) {
+    if (component == 2) dissipation_[a] += 2.0 * coefficient(cl, storage_[a], 2, 2) * u[a] * u[a] * inv_h2;
+  };
+  if (column_) {  // face_ still holds this component's coefficients
+    const auto M = static_cast<Eigen::Index>(storage_.size());
+    for (Eigen::Index m = 0; m + 1 < M; ++m) {
+      const double jump = u[m] - u[m + 1];
+      dissipation_[m] += 0.5 * face_[m] * jump * jump;
+      dissipation_[m + 1] += 0.5 * face_[m] * jump * jump;
+    }
+    wall(0);
+    if (M > 1) wall(M - 1);
+    return;
+  }
+  for_each_face(grid_, [&](Eigen::Index a, Eigen::Index b, int direction) {
+    if (b < 0) return wall(a);
+    if (a == b) return;
+    const double f = harmonic_mean(coefficient(cl, storage_[a], component, direction),
+                                   coefficient(cl, storage_[b], component, direction)) * inv_h2;
+    const double jump = u[a] - u[b];
+    dissipation_[a] += 0.5 * f * jump * jump;
+    dissipation_[b] += 0.5 * f * jump * jump;
+  });
+}
+
+void ImplicitDiffusion::advance(Operator& op, State& U, double dt, bool closure_is_current) {
+  if (!closure_is_current) op.prepare(U);
+  const auto& w = op.primitives();
+  const std::size_t cells = storage_.size();
+  dissipation_.setZero();
   for (int component = 0; component < 3; ++component) {
-    Eigen::VectorXd rhs(M);
-    for (std::size_t m = 0; m < cells; ++m) rhs[m] = w[0][storage_[m]] * w[1 + component][storage_[m]] / dt;
+    for (std::size_t m = 0; m < cells; ++m) rhs_[m] = w[0][storage_[m]] * w[1 + component][storage_[m]] / dt;
+    Eigen::VectorXd& u = velocity_[component];
     // A component that vanishes everywhere stays zero exactly (e.g. u_x, u_y of a 1D column).
-    if (rhs.isZero(0.0)) {
-      velocity[component].setZero();
+    if (rhs_.isZero(0.0)) {
+      u.setZero();
       continue;
     }
-    assemble(op, component, dt);
-    velocity[component] = solve(rhs);
-    const Eigen::VectorXd& u = velocity[component];
+    solve(op, component, dt, u);
     // Discrete dissipation: what the implicit step removes from the kinetic energy.
     for (std::size_t m = 0; m < cells; ++m) {
       const double change = u[m] - w[1 + component][storage_[m]];
-      dissipation[m] += 0.5 * w[0][storage_[m]] * change * change / dt;
+      dissipation_[m] += 0.5 * w[0][storage_[m]] * change * change / dt;
     }
-    for_each_face(grid_, [&](Eigen::Index a, Eigen::Index b, int direction) {
-      const auto coefficient = [&](std::ptrdiff_t c) {
-        return direction == component ? cl.lambda[c] + 4.0 / 3.0 * cl.mu[c] : cl.mu[c];
-      };
-      if (b < 0) {
-        if (component == 2) dissipation[a] += 2.0 * coefficient(storage_[a]) * u[a] * u[a] * inv_h2;
-        return;
-      }
-      if (a == b) return;
-      const double f = harmonic_mean(coefficient(storage_[a]), coefficient(storage_[b])) * inv_h2;
-      const double jump = u[a] - u[b];
-      dissipation[a] += 0.5 * f * jump * jump;
-      dissipation[b] += 0.5 * f * jump * jump;
-    });
+    add_dissipation(op, component, u);
   }
-  Eigen::VectorXd rhs(M);
   for (std::size_t m = 0; m < cells; ++m)
-    rhs[m] = 1.5 * w[0][storage_[m]] * w[4][storage_[m]] / dt + dissipation[m];
-  assemble(op, 3, dt);
-  const Eigen::VectorXd T = solve(rhs);
+    rhs_[m] = 1.5 * w[0][storage_[m]] * w[4][storage_[m]] / dt + dissipation_[m];
+  solve(op, 3, dt, temperature_);
   for (std::size_t m = 0; m < cells; ++m) {
     const auto c = storage_[m];
-    store_primitive(U, c, Primitive{w[0][c], velocity[0][m], velocity[1][m], velocity[2][m], T[m]});
+    store_primitive(U, c, Primitive{w[0][c], velocity_[0][m], velocity_[1][m], velocity_[2][m], temperature_[m]});
   }
 }
 

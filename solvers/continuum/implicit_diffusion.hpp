@@ -6,12 +6,15 @@
 //   (3/2) n (T* - T) / dt = div(kappa grad T*) + Phi,
 // Phi the viscous dissipation of the implicit momentum step (discrete, face by face, plus
 // n |u* - u|^2 / (2 dt)), which makes the step conserve total energy exactly (to the linear
-// solver's tolerance). Each system is symmetric positive definite (Eigen: LDLT in 1D,
-// preconditioned conjugate gradients in 3D). Mass is untouched. The mixed-derivative
-// viscous terms of 3D (d_i (mu d_j u_i), i != j) are not part of this operator; in 3D the full
-// variant keeps only the terms above (stated in the report).
+// solver's tolerance). Each system is symmetric positive definite and diagonally dominant.
+// A 1D column between walls gives a tridiagonal system, solved directly by the Thomas
+// algorithm (O(n), no pivoting needed, nothing allocated per step); other grids use Eigen
+// (LDLT for a periodic column, preconditioned conjugate gradients in 3D). Mass is untouched.
+// The mixed-derivative viscous terms of 3D (d_i (mu d_j u_i), i != j) are not part of this
+// operator; in 3D the full variant keeps only the terms above (stated in the report).
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -22,23 +25,34 @@ namespace shaker::continuum {
 class ImplicitDiffusion {
  public:
   explicit ImplicitDiffusion(const Grid& grid);
-  /// Advances the interior of U by dt; op supplies the closure (evaluated here at U).
-  void advance(Operator& op, State& U, double dt);
+  /// Advances the interior of U by dt. op supplies the closure: evaluated here at U, unless
+  /// closure_is_current says op's primitives and closure already belong to U.
+  void advance(Operator& op, State& U, double dt, bool closure_is_current = false);
 
  private:
   using Matrix = Eigen::SparseMatrix<double>;
-  void assemble(const Operator& op, int component, double dt);  ///< component 0..2: u, 3: T
-  Eigen::VectorXd solve(const Eigen::VectorXd& rhs);
+  /// Solves the system of `component` (0..2: u, 3: T) for rhs_ into x and adds nothing else.
+  void solve(const Operator& op, int component, double dt, Eigen::VectorXd& x);
+  void solve_column(const Operator& op, int component, double dt, Eigen::VectorXd& x);
+  void assemble(const Operator& op, int component, double dt);
+  void solve_sparse(Eigen::VectorXd& x);
+  /// Adds the discrete viscous dissipation of velocity component `component` to dissipation_.
+  void add_dissipation(const Operator& op, int component, const Eigen::VectorXd& u);
 
   Grid grid_;
+  bool column_ = false;  ///< 1D between walls: tridiagonal, Thomas algorithm
   std::vector<std::ptrdiff_t> storage_;  ///< interior cell m -> storage index
+  // Work vectors, sized once.
+  Eigen::VectorXd rhs_, dissipation_, temperature_;
+  std::array<Eigen::VectorXd, 3> velocity_;
+  std::vector<double> face_, forward_;  ///< column: face coefficients (face m between m, m+1), Thomas c'
+  // Sparse path.
   std::vector<Eigen::Triplet<double>> triplets_;
   Matrix matrix_;
-  // 1D: the matrix is tridiagonal in the natural order (no fill, no reordering needed), and
-  // its pattern never changes: analysed once, only factorised per solve.
+  // A periodic column: tridiagonal plus corners; its pattern never changes, analysed once.
   // (Held by pointer: Eigen's factorisations cannot be moved, the integrator must be.)
-  using Tridiagonal = Eigen::SimplicialLDLT<Matrix, Eigen::Lower, Eigen::NaturalOrdering<int>>;
-  std::unique_ptr<Tridiagonal> tridiagonal_;
+  using Banded = Eigen::SimplicialLDLT<Matrix, Eigen::Lower, Eigen::NaturalOrdering<int>>;
+  std::unique_ptr<Banded> banded_;
 };
 
 }  // namespace shaker::continuum

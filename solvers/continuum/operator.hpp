@@ -72,10 +72,11 @@ class Operator {
   double advective_step(double cfl) const;
   double diffusive_step() const;
 
-  /// Fills ghosts and evaluates primitives and the full closure at U, without fluxes.
-  void prepare(State& U) {
+  /// Fills ghosts and evaluates primitives and the closure at U (with the transport
+  /// coefficients unless need_transport is false), without fluxes.
+  void prepare(State& U, bool need_transport = true) {
     fill_ghosts(U);
-    update_primitives_and_closure(U, true);
+    update_primitives_and_closure(U, need_transport);
   }
 
   void fill_ghosts(State& U) const;  ///< walls (mirror) or periodic, x, y periodic

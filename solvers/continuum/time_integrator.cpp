@@ -175,9 +175,10 @@ bool TimeIntegrator::try_step(double dt, std::string& failure) {
       if (settings_.diffusion == DiffusionIntegrator::rkl2) {
         ok = rkl2(tau, failure);
       } else {
-        implicit_.advance(op_, U_, tau);
+        implicit_.advance(op_, U_, tau, closure_at_start_);
         ok = admissible(U_, t_, failure);
       }
+      closure_at_start_ = false;
       pending_.floor_energy += total_energy() - before;
       return ok;
     };
@@ -196,19 +197,24 @@ bool TimeIntegrator::try_step(double dt, std::string& failure) {
 
 double TimeIntegrator::step(double t_limit) {
   U0_.q = U_.q;
-  const Part first = settings_.diffusion == DiffusionIntegrator::explicit_rk
-                         ? Part::all
-                         : Part::hyperbolic_and_sources;
+  // The split scheme overwrites U0_ and K0_; the explicit one leaves them intact.
+  const bool split = settings_.diffusion != DiffusionIntegrator::explicit_rk;
   try {
-    op_.rhs(t_, U0_, K0_, first);
-    power0_ = op_.source_power();
+    if (split) {
+      // The step needs only the closure here (the hyperbolic right-hand side is evaluated
+      // after the first diffusive half step); with the transport coefficients, the implicit
+      // half step reuses it.
+      op_.prepare(U0_, settings_.diffusion == DiffusionIntegrator::implicit);
+      closure_at_start_ = settings_.diffusion == DiffusionIntegrator::implicit;
+    } else {
+      op_.rhs(t_, U0_, K0_, Part::all);
+      power0_ = op_.source_power();
+    }
   } catch (const std::domain_error& error) {
     throw StepFailure(fmt::format("continuum: the state at t = {:.10g} is outside the model's "
                                   "domain: {}", t_, error.what()));
   }
   double dt = choose_step(t_limit);
-  // The split scheme overwrites U0_ and K0_; the explicit one leaves them intact.
-  const bool split = settings_.diffusion != DiffusionIntegrator::explicit_rk;
   if (split) start_.q = U0_.q;
   std::string failure;
   for (int attempt = 0; attempt <= settings_.max_retries; ++attempt) {
@@ -223,8 +229,7 @@ double TimeIntegrator::step(double t_limit) {
     ++counters_.rejected_steps;
     if (split) {
       U0_.q = start_.q;
-      op_.rhs(t_, U0_, K0_, first);
-      power0_ = op_.source_power();
+      closure_at_start_ = false;
     }
     U_.q = U0_.q;
     dt *= 0.5;

@@ -94,6 +94,7 @@ class TimeIntegrator {
   Counters counters_;
   EnergyBudget budget_, pending_;     ///< pending_: the step being tried
   Operator::SourcePower power0_;      ///< source power at the step's start state U0_
+  bool closure_at_start_ = false;     ///< op_'s closure is that of the step's start state
 };
 
 }  // namespace shaker::continuum
