@@ -27,6 +27,9 @@ std::vector<ParameterSpec> md_parameters() {
       text("md.event_queue", "heap", {"heap", "calendar"},
            "future-event list: indexed binary heap or bounded calendar queue; both give the "
            "same trajectory bit for bit"),
+      real_list("md.crossing_heights", {80.0}, positive(),
+                "lab-frame heights h > 0 whose upward crossings by any particle are counted in "
+                "the time-series columns crossings_z<h> (cumulative since the start of the run)"),
   };
 }
 

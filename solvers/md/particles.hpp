@@ -36,6 +36,16 @@ inline void advance(Particle& p, double t, double g) {
   p.t = t;
 }
 
+/// Whether the free flight of p from its local time to t rises through the lab-frame height h:
+/// it starts below h and reaches h, either at t or at its apex inside the interval. A free
+/// flight is one parabola, so it rises through h at most once.
+inline bool rises_through(const Particle& p, double t, double g, double h) {
+  if (!(p.r.z < h)) return false;
+  const double dt = t - p.t;
+  if (p.v.z - g * dt >= 0.0) return p.r.z + (p.v.z - 0.5 * g * dt) * dt >= h;  // still rising at t
+  return p.v.z > 0.0 && p.r.z + p.v.z * p.v.z / (2.0 * g) >= h;             // apex inside
+}
+
 /// Everything needed to start or continue a run: positions, velocities and local times.
 /// The event-queue and cell-list parts are optional (a checkpoint stores them so that a
 /// restart continues bit for bit; a fresh state leaves them empty).

@@ -1,11 +1,17 @@
 #include "md/protocol.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <chrono>
 #include <cmath>
 
+#include "common/errors.hpp"
 #include "md/sampling.hpp"
 
 namespace shaker::md {
+
+std::string crossing_column(double height) { return fmt::format("crossings_z{:g}", height); }
 
 MdSettings MdSettings::from(const config::Config& c) {
   MdSettings s;
@@ -19,6 +25,14 @@ MdSettings MdSettings::from(const config::Config& c) {
   s.tc_guard = c.text("md.collapse_guard") == "tc";
   s.tc = c.real("md.tc");
   s.queue = c.text("md.event_queue") == "calendar" ? QueueKind::calendar : QueueKind::heap;
+  s.crossing_heights = c.real_list("md.crossing_heights");
+  for (std::size_t k = 0; k < s.crossing_heights.size(); ++k)
+    for (std::size_t m = 0; m < k; ++m)
+      if (crossing_column(s.crossing_heights[k]) == crossing_column(s.crossing_heights[m]))
+        throw InputError(fmt::format("md.crossing_heights = [{}]: the heights {} and {} give the "
+                                     "same column name {}; allowed: distinct heights > 0",
+                                     fmt::join(s.crossing_heights, ", "), s.crossing_heights[m],
+                                     s.crossing_heights[k], crossing_column(s.crossing_heights[k])));
   return s;
 }
 
@@ -26,14 +40,20 @@ namespace {
 
 /// Time-series columns, one row per sampling instant.
 struct SeriesRows {
-  static constexpr const char* names[] = {
+  std::vector<std::string> names = {
       "t", "phase", "plate_z", "com_z", "kinetic", "potential", "plate_work",
       "collisional_loss", "energy_closure", "pair_collisions", "plate_collisions",
-      "ceiling_collisions", "cell_crossings", "guard_activations", "overlaps", "near_plate"};
-  std::vector<std::vector<double>> columns = std::vector<std::vector<double>>(std::size(names));
-  void add(std::initializer_list<double> row) {
+      "ceiling_collisions", "cell_crossings", "guard_activations", "overlaps", "near_plate",
+      "collisions"};
+  std::vector<std::vector<double>> columns;
+  explicit SeriesRows(const std::vector<double>& crossing_heights) {
+    for (double h : crossing_heights) names.push_back(crossing_column(h));
+    columns.resize(names.size());
+  }
+  void add(std::initializer_list<double> row, const std::vector<std::uint64_t>& crossings) {
     std::size_t k = 0;
     for (double x : row) columns[k++].push_back(x);
+    for (std::uint64_t c : crossings) columns[k++].push_back(static_cast<double>(c));
   }
   TimeSeries finish() {
     TimeSeries s;
@@ -75,7 +95,8 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
 
   PhaseSampler sampler(static_cast<int>(phases), settings.bin_height, settings.ceiling,
                        sim.geometry().width);
-  SeriesRows rows;
+  SeriesRows rows(settings.crossing_heights);
+  sim.count_crossings(settings.crossing_heights);
   std::vector<Vec3> r, v;
   auto record = [&](double t) {
     sim.positions_at(t, r, v);
@@ -93,7 +114,9 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
               static_cast<double>(tally.pair), static_cast<double>(tally.plate),
               static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
               static_cast<double>(tally.guard_activations),
-              static_cast<double>(sim.count_overlaps(r, 1e-9)), near_plate});
+              static_cast<double>(sim.count_overlaps(r, 1e-9)), near_plate,
+              static_cast<double>(tally.pair - tally0.pair)},
+             sim.crossings_at(t));
   };
 
   const auto start = std::chrono::steady_clock::now();

@@ -24,8 +24,12 @@ struct MdSettings {
   bool tc_guard = false;
   double tc = 1e-5;
   QueueKind queue = QueueKind::heap;
+  std::vector<double> crossing_heights{80.0};
   static MdSettings from(const config::Config& config);
 };
+
+/// Name of the time-series column counting upward crossings of `height`: crossings_z80.
+std::string crossing_column(double height);
 
 struct EnergyBudget {
   double plate_work = 0.0, collisional_loss = 0.0, energy_change = 0.0;
@@ -40,7 +44,10 @@ struct RunOutcome {
   /// plate_work, collisional_loss (pair + wall, since the start of this run), energy_closure
   /// (relative, see EnergyBudget), pair/plate/ceiling_collisions and cell_crossings (running
   /// totals), guard_activations, overlaps (pairs closer than 1 - 1e-9), near_plate (particles
-  /// less than half a diameter above the plate).
+  /// less than half a diameter above the plate), collisions (pair collisions since the start
+  /// of this run), crossings_z<h> for each h of md.crossing_heights (upward crossings of the
+  /// lab-frame height h by any particle since the start of this run, exact: each free flight
+  /// is checked at the particle's updates, flights under way up to the row's time).
   TimeSeries series;
   EnergyBudget budget;
   std::size_t overlaps = 0;  ///< at the end of the run

@@ -74,9 +74,9 @@ void Simulation::step() {
   const Event event = data_.events[i];
   const bool crossing = event.cell_time < event.time;
   data_.time = crossing ? event.cell_time : event.time;
-  const double now = data_.time, g = geometry_.gravity;
+  const double now = data_.time;
   Particle& p = data_.particles[i];
-  advance(p, now, g);
+  update(i, now);
   Tally& tally = data_.tally;
   if (crossing) {
     ++tally.cell;
@@ -92,7 +92,7 @@ void Simulation::step() {
         break;
       }
       Particle& q = data_.particles[j];
-      advance(q, now, g);
+      update(j, now);
       Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
       r.x -= geometry_.width * std::round(r.x / geometry_.width);
       r.y -= geometry_.width * std::round(r.y / geometry_.width);
@@ -129,6 +129,31 @@ void Simulation::step() {
       break;
   }
   predict(i);
+}
+
+void Simulation::update(std::int32_t i, double now) {
+  Particle& p = data_.particles[i];
+  for (std::size_t k = 0; k < crossing_heights_.size(); ++k)
+    crossings_[k] += rises_through(p, now, geometry_.gravity, crossing_heights_[k]) ? 1 : 0;
+  advance(p, now, geometry_.gravity);
+}
+
+// A particle's next update counts its whole flight since its local time, so the crossings
+// of flights under way that happened before now are subtracted here (a flight crosses at most
+// once, so what it did before now it still has done at its update).
+void Simulation::count_crossings(std::vector<double> heights) {
+  crossing_heights_ = std::move(heights);
+  crossings_.assign(crossing_heights_.size(), 0);
+  const std::vector<std::uint64_t> before = crossings_at(data_.time);
+  for (std::size_t k = 0; k < crossings_.size(); ++k) crossings_[k] = -static_cast<std::int64_t>(before[k]);
+}
+
+std::vector<std::uint64_t> Simulation::crossings_at(double t) const {
+  std::vector<std::int64_t> counts = crossings_;
+  for (const Particle& p : data_.particles)
+    for (std::size_t k = 0; k < crossing_heights_.size(); ++k)
+      counts[k] += rises_through(p, t, geometry_.gravity, crossing_heights_[k]) ? 1 : 0;
+  return std::vector<std::uint64_t>(counts.begin(), counts.end());
 }
 
 void Simulation::note_collision(std::int32_t i, std::int32_t partner) {

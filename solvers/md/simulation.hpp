@@ -101,6 +101,12 @@ class Simulation {
   std::size_t count_overlaps(double t, double tolerance) const;
   /// The same for positions already computed by positions_at(time(), ...).
   std::size_t count_overlaps(const std::vector<Vec3>& r, double tolerance) const;
+  /// Starts counting upward crossings of these lab-frame heights at time() (counts start at
+  /// zero; crossings earlier in flights under way are not counted).
+  void count_crossings(std::vector<double> heights);
+  /// Upward crossings of each height since count_crossings, up to t >= time(): flights still
+  /// under way are counted up to t without changing any particle.
+  std::vector<std::uint64_t> crossings_at(double t) const;
   /// Heap property, index, and every pending event in the future of time().
   bool queue_consistent() const;
   std::size_t bytes_per_particle() const;
@@ -114,6 +120,8 @@ class Simulation {
   double cell_crossing_delay(const Particle& p, int cell, std::int32_t& direction) const;
   void cross_cell(std::int32_t i, std::int32_t direction);
   void note_collision(std::int32_t i, std::int32_t partner);
+  /// Brings particle i to now, counting the crossings of its free flight on the way.
+  void update(std::int32_t i, double now);
 
   Geometry geometry_;
   CollisionRules rules_;
@@ -127,6 +135,9 @@ class Simulation {
   IndexedHeap heap_;
   CalendarQueue calendar_;
   PlateContactFinder plate_finder_;
+  std::vector<double> crossing_heights_;
+  /// Crossings counted at particle updates, less those before count_crossings was called.
+  std::vector<std::int64_t> crossings_;
 };
 
 }  // namespace shaker::md

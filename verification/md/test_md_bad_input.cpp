@@ -49,6 +49,12 @@ TEST(MdBadInput, TooManyParticlesForTheBox) {
   expect_rejected("--set layer.particles=100000", "layer.particles = 100000 does not fit");
 }
 TEST(MdBadInput, BoxNarrowerThanThreeCells) { expect_rejected("--set md.box_width=2.5 --set layer.particles=10", "md.box_width"); }
+TEST(MdBadInput, CrossingHeightNotPositive) {
+  expect_rejected("--set md.crossing_heights=[80,0]", "md.crossing_heights");
+}
+TEST(MdBadInput, CrossingHeightTwice) {
+  expect_rejected("--set md.crossing_heights=[80,80.0]", "md.crossing_heights");
+}
 TEST(MdBadInput, MissingCheckpoint) {
   expect_rejected("--set md.initial_state=checkpoint --set md.checkpoint=/nonexistent.h5", "md.checkpoint");
 }

@@ -83,6 +83,32 @@ TEST(MdVibrated, EnergyBudgetClosesWithVelocityDependentRestitution) {
   EXPECT_GT(work, 1e4);  // the plate did work
 }
 
+TEST(MdVibrated, CrossingAndCollisionColumnsAreCumulative) {
+  const auto dir = testing::test_directory();
+  config::Config c = base_case(dir / "crossings.h5");
+  c.set("run.transient_cycles=1");
+  c.set("run.sampled_cycles=1");
+  c.set("md.crossing_heights=[12.5, 80]");
+  ASSERT_EQ(run(c), 0);
+  const RunRecord record = read_run_file(dir / "crossings.h5");
+  const auto& low = record.series.column("crossings_z12.5");
+  const auto& high = record.series.column("crossings_z80");
+  const auto& collisions = record.series.column("collisions");
+  const auto& pair = record.series.column("pair_collisions");
+  bool monotone = true;
+  for (std::size_t k = 1; k < low.size(); ++k)
+    monotone = monotone && low[k] >= low[k - 1] && high[k] >= high[k - 1] &&
+               collisions[k] >= collisions[k - 1];
+  std::printf("measured: %g crossings of z = 12.5, %g of z = 80, %g pair collisions\n",
+              low.back(), high.back(), collisions.back());
+  EXPECT_TRUE(monotone);
+  EXPECT_GT(low.back(), 1000.0);  // the layer is thrown above 12.5 every cycle
+  EXPECT_LE(high.back(), low.back());
+  EXPECT_EQ(collisions.back() - collisions.front(), pair.back() - pair.front());
+  EXPECT_EQ(collisions.front(), 0.0);  // the first row is the start of the run
+  EXPECT_GT(collisions.back(), 1e5);
+}
+
 bool same_bits(const SimulationData& a, const SimulationData& b) {
   if (a.particles.size() != b.particles.size() || a.time != b.time) return false;
   for (std::size_t i = 0; i < a.particles.size(); ++i) {
