@@ -1,32 +1,30 @@
 // Ghost cells: x and y periodic (3D); z walls that move with the container (mirror state:
 // u_z reversed, everything else copied, which gives u_z = 0 and zero normal gradients of
 // u_x, u_y and T at the wall), or z periodic for manufactured solutions.
+// The primitives and the closure of a ghost are those of the cell it copies (u_z reversed
+// at a wall): copied too, not re-evaluated (exactly the same values, since every closure
+// value is even in u_z).
 #include "continuum/operator.hpp"
 
 namespace shaker::continuum {
 
 namespace {
-void copy_cell(State& U, std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
-  for (int v = 0; v < variable_count; ++v) U.q[v][to] = U.q[v][from];
-  if (reverse_z) U.q[momentum_z][to] = -U.q[momentum_z][from];
-}
-}  // namespace
-
-void Operator::fill_ghosts(State& U) const {
-  const Grid& g = grid_;
+/// Calls copy(to, from, reverse_z) for every ghost cell, in an order in which every source
+/// cell is already filled (x, then y including the x ghosts, then z including both).
+template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
   const int G = Grid::ghosts;
   if (g.dimension == 3) {
     for (int k = 0; k < g.nz; ++k)
       for (int j = 0; j < g.ny; ++j)
         for (int m = 1; m <= G; ++m) {
-          copy_cell(U, g.index(-m, j, k), g.index(g.nx - m, j, k), false);
-          copy_cell(U, g.index(g.nx - 1 + m, j, k), g.index(m - 1, j, k), false);
+          copy(g.index(-m, j, k), g.index(g.nx - m, j, k), false);
+          copy(g.index(g.nx - 1 + m, j, k), g.index(m - 1, j, k), false);
         }
     for (int k = 0; k < g.nz; ++k)
       for (int i = -G; i < g.nx + G; ++i)
         for (int m = 1; m <= G; ++m) {
-          copy_cell(U, g.index(i, -m, k), g.index(i, g.ny - m, k), false);
-          copy_cell(U, g.index(i, g.ny - 1 + m, k), g.index(i, m - 1, k), false);
+          copy(g.index(i, -m, k), g.index(i, g.ny - m, k), false);
+          copy(g.index(i, g.ny - 1 + m, k), g.index(i, m - 1, k), false);
         }
   }
   const int gxy = g.ghosts_xy();
@@ -35,13 +33,31 @@ void Operator::fill_ghosts(State& U) const {
     for (int i = -gxy; i < g.nx + gxy; ++i)
       for (int m = 1; m <= G; ++m) {
         if (walls) {
-          copy_cell(U, g.index(i, j, -m), g.index(i, j, m - 1), true);
-          copy_cell(U, g.index(i, j, g.nz - 1 + m), g.index(i, j, g.nz - m), true);
+          copy(g.index(i, j, -m), g.index(i, j, m - 1), true);
+          copy(g.index(i, j, g.nz - 1 + m), g.index(i, j, g.nz - m), true);
         } else {
-          copy_cell(U, g.index(i, j, -m), g.index(i, j, g.nz - m), false);
-          copy_cell(U, g.index(i, j, g.nz - 1 + m), g.index(i, j, m - 1), false);
+          copy(g.index(i, j, -m), g.index(i, j, g.nz - m), false);
+          copy(g.index(i, j, g.nz - 1 + m), g.index(i, j, m - 1), false);
         }
       }
+}
+}  // namespace
+
+void Operator::fill_ghosts(State& U) const {
+  for_each_ghost(grid_, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
+    for (int v = 0; v < variable_count; ++v) U.q[v][to] = U.q[v][from];
+    if (reverse_z) U.q[momentum_z][to] = -U.q[momentum_z][from];
+  });
+}
+
+void Operator::copy_closure_to_ghosts() {
+  for_each_ghost(grid_, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
+    for (auto& v : w_) v[to] = v[from];
+    if (reverse_z) w_[3][to] = -w_[3][from];
+    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda,
+                    &closure_.kappa, &closure_.loss})
+      (*v)[to] = (*v)[from];
+  });
 }
 
 }  // namespace shaker::continuum

@@ -35,6 +35,7 @@ void Operator::rhs(double t, State& U, State& dUdt, Part part) {
 double Operator::advective_step(double cfl) const {
   const Grid& g = grid_;
   double fastest = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : fastest) if (g.interior_cells() > 4096)
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i) {
@@ -50,6 +51,7 @@ double Operator::diffusive_step() const {
   if (!transport_evaluated_) return std::numeric_limits<double>::infinity();
   const Grid& g = grid_;
   double largest = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : largest) if (g.interior_cells() > 4096)
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i) {

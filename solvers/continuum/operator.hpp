@@ -104,6 +104,7 @@ class Operator {
 
  private:
   void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp
+  void copy_closure_to_ghosts();                                             // boundary.cpp
   void add_inviscid_fluxes(State& dUdt);                                     // riemann.cpp
   void add_diffusive_fluxes(State& dUdt);                                    // viscous_flux.cpp
   void add_sources(double t, const State& U, State& dUdt);                   // sources.cpp

@@ -1,5 +1,5 @@
 // Inviscid fluxes: limited MUSCL reconstruction of (n, u, T, p, c) to both sides of each face
-// and an approximate Riemann solver. Reconstructed are n, u, p, chi = p / (n T) and c; the
+// (each cell's slopes computed once, for both of its faces) and an approximate Riemann solver. Reconstructed are n, u, p, chi = p / (n T) and c; the
 // face temperature is p / (n chi), so pressure and internal energy stay consistent across a
 // contact (no pressure wiggles), and the equation of state is not re-evaluated at faces
 // (second order all the same, two fewer closure evaluations per face). Pressureless runs
@@ -53,8 +53,8 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
   const double* fn = w[0].data();
   const double* fp = closure.p.data();
   const double* fc = closure.c.data();
-  const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, double side,
-                                  double* face) {
+  const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, double* minus,
+                                  double* plus) {
     const double n0 = fn[c], c0 = fc[c];
     if (!(c0 > 0.0)) return;
     const double* u = w[un].data();
@@ -66,12 +66,25 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     const double w2 = limited_slope<L>(dn_b - dp_b * inv_c2, dn_f - dp_f * inv_c2);
     const double w3 = limited_slope<L>(dp_b + impedance * du_b, dp_f + impedance * du_f);
     const double dp = 0.5 * (w1 + w3), du = 0.5 * (w3 - w1) / impedance, dn = w2 + dp * inv_c2;
-    const double n_face = n0 + 0.5 * side * dn, p_face = fp[c] + 0.5 * side * dp;
-    const double n_other = n0 - 0.5 * side * dn, p_other = fp[c] - 0.5 * side * dp;
-    if (!(n_face > 0.0 && p_face > 0.0 && n_other > 0.0 && p_other > 0.0)) return;
-    face[0] = n_face;
-    face[un] = u[c] + 0.5 * side * du;
-    face[4] = p_face;
+    const double n_plus = n0 + 0.5 * dn, p_plus = fp[c] + 0.5 * dp;
+    const double n_minus = n0 - 0.5 * dn, p_minus = fp[c] - 0.5 * dp;
+    if (!(n_plus > 0.0 && p_plus > 0.0 && n_minus > 0.0 && p_minus > 0.0)) return;
+    plus[0] = n_plus;
+    plus[un] = u[c] + 0.5 * du;
+    plus[4] = p_plus;
+    minus[0] = n_minus;
+    minus[un] = u[c] - 0.5 * du;
+    minus[4] = p_minus;
+  };
+  // Both face states of cell c along the direction of stride s, computed once per cell
+  // (each is used by one face): minus at the low face, plus at the high face.
+  const auto cell_faces = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, double* minus,
+                              double* plus) {
+    for (int v = 0; v < 7; ++v) {
+      const double* x = fields[v];
+      reconstruct<L>(x[c - s], x[c], x[c + s], minus[v], plus[v]);
+    }
+    if (pressure) characteristic(c, s, un, minus, plus);
   };
   for (int d = g.first_direction(); d < 3; ++d) {
     const std::ptrdiff_t s = g.stride(d);
@@ -81,20 +94,24 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     const int normal = momentum_x + d;
     const int tangential1 = momentum_x + (d + 1) % 3, tangential2 = momentum_x + (d + 2) % 3;
     const int total = P.count_a * P.count_b;
-#pragma omp parallel for schedule(static) if (total > 1 && g.interior_cells() > 4096)
+    // Dynamic scheduling: on a shared machine a thread that is held up does not hold up the
+    // other (pencils touch disjoint cells, so the result does not depend on the order). A
+    // chunk is a whole row or plane of pencils, so that two threads never write into the
+    // same cache line.
+#pragma omp parallel for schedule(dynamic, P.count_a) if (total > 1 && g.interior_cells() > 4096)
     for (int pencil = 0; pencil < total; ++pencil) {
       const std::ptrdiff_t base = P.base(g, d, pencil % P.count_a, pencil / P.count_a);
+      // Face f lies between cells f - 1 and f; the high face of cell f - 1 carries over.
+      double high_of_left[7], minus_of_right[7], plus_of_right[7];
+      cell_faces(base - s, s, un_index, minus_of_right, high_of_left);
       for (int f = 0; f <= P.length; ++f) {
         const std::ptrdiff_t cR = base + f * s, cL = cR - s;
-        double left[7], right[7], unused;
+        cell_faces(cR, s, un_index, minus_of_right, plus_of_right);
+        double left[7], right[7];
         for (int v = 0; v < 7; ++v) {
-          const double* x = fields[v];
-          reconstruct<L>(x[cL - s], x[cL], x[cL + s], unused, left[v]);
-          reconstruct<L>(x[cL], x[cR], x[cR + s], right[v], unused);
-        }
-        if (pressure) {
-          characteristic(cL, s, un_index, +1.0, left);
-          characteristic(cR, s, un_index, -1.0, right);
+          left[v] = high_of_left[v];
+          right[v] = minus_of_right[v];
+          high_of_left[v] = plus_of_right[v];
         }
         if (walls) {
           // Beside a wall the mirror ghost makes every even field a local extremum, and the

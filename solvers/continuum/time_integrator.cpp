@@ -17,7 +17,7 @@ TimeIntegrator::TimeIntegrator(const Grid& grid, const PhysicsSettings& physics,
 void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y,
                           double c, const State& k) const {
   const Grid& g = op_.grid();
-#pragma omp parallel for schedule(static) if (g.interior_cells() > 4096)
+#pragma omp parallel for schedule(dynamic, 2) if (g.interior_cells() > 4096)
   for (int kz = 0; kz < g.nz; ++kz)
     for (int j = 0; j < g.ny; ++j) {
       const std::ptrdiff_t first = g.index(0, j, kz);

@@ -52,34 +52,41 @@ CellClosure evaluate(const PhysicsSettings& s, double n, double T, double h, boo
 }  // namespace
 
 void Operator::update_primitives_and_closure(const State& U, bool need_transport) {
-  const std::ptrdiff_t cells = static_cast<std::ptrdiff_t>(U.size());
-  const double h = grid_.h;
+  const Grid& g = grid_;
+  const double h = g.h;
   transport_evaluated_ = need_transport;
+  // Interior cells only (ghosts copy theirs afterwards), row by row along x. Dynamic
+  // scheduling: on a shared machine a thread that is held up does not hold up the other.
+  const int rows = g.ny * g.nz;
   // An exception must not leave an OpenMP region: the first failure is kept and rethrown.
   std::exception_ptr failure;
-#pragma omp parallel for schedule(static) if (cells > 4096)
-  for (std::ptrdiff_t c = 0; c < cells; ++c) {
-    try {
-    const Primitive w = to_primitive(U, static_cast<std::size_t>(c));
-    w_[0][c] = w.n;
-    w_[1][c] = w.ux;
-    w_[2][c] = w.uy;
-    w_[3][c] = w.uz;
-    w_[4][c] = w.T;
-    const CellClosure r = evaluate(settings_, w.n, w.T, h, need_transport);
-    closure_.p[c] = r.p;
-    closure_.c[c] = r.c;
-    closure_.chi[c] = w.T > 0.0 ? r.p / (w.n * w.T) : 1.0;
-    closure_.mu[c] = r.mu;
-    closure_.lambda[c] = r.lambda;
-    closure_.kappa[c] = r.kappa;
-    closure_.loss[c] = r.loss;
-    } catch (...) {
+#pragma omp parallel for schedule(dynamic, 16) if (g.interior_cells() > 4096)
+  for (int row = 0; row < rows; ++row) {
+    const std::ptrdiff_t first = g.index(0, row % g.ny, row / g.ny);
+    for (std::ptrdiff_t c = first; c < first + g.nx; ++c) {
+      try {
+        const Primitive w = to_primitive(U, static_cast<std::size_t>(c));
+        w_[0][c] = w.n;
+        w_[1][c] = w.ux;
+        w_[2][c] = w.uy;
+        w_[3][c] = w.uz;
+        w_[4][c] = w.T;
+        const CellClosure r = evaluate(settings_, w.n, w.T, h, need_transport);
+        closure_.p[c] = r.p;
+        closure_.c[c] = r.c;
+        closure_.chi[c] = w.T > 0.0 ? r.p / (w.n * w.T) : 1.0;
+        closure_.mu[c] = r.mu;
+        closure_.lambda[c] = r.lambda;
+        closure_.kappa[c] = r.kappa;
+        closure_.loss[c] = r.loss;
+      } catch (...) {
 #pragma omp critical(shaker_closure_failure)
-      if (!failure) failure = std::current_exception();
+        if (!failure) failure = std::current_exception();
+      }
     }
   }
   if (failure) std::rethrow_exception(failure);
+  copy_closure_to_ghosts();
 }
 
 }  // namespace shaker::continuum
