@@ -35,6 +35,18 @@ class CellList {
   /// Calls f(j, shift) for every particle j in the 27 cells around cell c; shift is the
   /// periodic image offset to add to j's position.
   template <class F> void for_each_neighbor(int c, F&& f) const {
+    const int cx = ix(c), cy = iy(c), cz = iz(c);
+    if (cx > 0 && cx < nx_ - 1 && cy > 0 && cy < ny_ - 1 && cz > 0 && cz < nz_ - 1) {
+      // Away from the box faces no index wraps and no image shift applies; the cells are
+      // visited in the same order as for_each_in_block visits them.
+      const Vec3 none{};
+      const int plane = nx_ * ny_;
+      for (int dz = -plane; dz <= plane; dz += plane)
+        for (int dy = -nx_; dy <= nx_; dy += nx_)
+          for (int dx = -1; dx <= 1; ++dx)
+            for (std::int32_t j = head_[c + dz + dy + dx]; j >= 0; j = next_[j]) f(j, none);
+      return;
+    }
     for_each_in_block(c, -1, 1, -1, 1, -1, 1, f);
   }
   /// The same for the 9 cells that became neighbours when a particle entered cell c by a

@@ -120,6 +120,10 @@ class Simulation {
   double cell_crossing_delay(const Particle& p, int cell, std::int32_t& direction) const;
   void cross_cell(std::int32_t i, std::int32_t direction);
   void note_collision(std::int32_t i, std::int32_t partner);
+  /// Renumbers the particles in cell order (memory locality); called every
+  /// sort_interval * N pair collisions.
+  void sort_by_cell();
+  static constexpr std::uint64_t sort_interval = 2;
   /// Brings particle i to now, counting the crossings of its free flight on the way.
   void update(std::int32_t i, double now);
 
