@@ -80,13 +80,13 @@ void ImplicitDiffusion::solve_column(const Operator& op, int component, double d
     if (component == 2 && (m == 0 || m + 1 == M)) d += 2.0 * coefficient(cl, storage_[m], 2, 2) * inv_h2;
     return d;
   };
-  double pivot = diagonal(0);
-  forward_[0] = -face_[0] / pivot;
-  x[0] = rhs_[0] / pivot;
+  double inverse_pivot = 1.0 / diagonal(0);
+  forward_[0] = -face_[0] * inverse_pivot;
+  x[0] = rhs_[0] * inverse_pivot;
   for (std::size_t m = 1; m < M; ++m) {
-    pivot = diagonal(m) + face_[m - 1] * forward_[m - 1];
-    forward_[m] = -face_[m] / pivot;
-    x[m] = (rhs_[m] + face_[m - 1] * x[m - 1]) / pivot;
+    inverse_pivot = 1.0 / (diagonal(m) + face_[m - 1] * forward_[m - 1]);
+    forward_[m] = -face_[m] * inverse_pivot;
+    x[m] = (rhs_[m] + face_[m - 1] * x[m - 1]) * inverse_pivot;
   }
   for (std::size_t m = M - 1; m-- > 0;) x[m] -= forward_[m] * x[m + 1];
 }

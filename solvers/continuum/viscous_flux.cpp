@@ -34,7 +34,7 @@ void Operator::add_diffusive_fluxes(State& dUdt) {
     const int length = d == 0 ? g.nx : d == 1 ? g.ny : g.nz;
     const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
     const int total = n_a * n_b;
-#pragma omp parallel for schedule(static) if (total > 1 && g.interior_cells() > 4096)
+#pragma omp parallel for schedule(dynamic, n_a) if (total > 1 && g.interior_cells() > 4096)
     for (int pencil = 0; pencil < total; ++pencil) {
       const int a = pencil % n_a, b = pencil / n_a;
       const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
@@ -42,11 +42,13 @@ void Operator::add_diffusive_fluxes(State& dUdt) {
         const std::ptrdiff_t cR = base + f * s, cL = cR - s;
         // grad[i][j] = d u_i / d x_j at the face
         double grad[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+        // Tangential derivatives enter only through d u_d / d x_t and the divergence
+        // (d u_t / d x_t); the other two are not needed.
         for (int i = 0; i < 3; ++i) {
           grad[i][d] = (u[i][cR] - u[i][cL]) * inv_h;
           if (!three_d) continue;
           for (int t = 0; t < 3; ++t) {
-            if (t == d) continue;
+            if (t == d || (i != d && i != t)) continue;
             const std::ptrdiff_t st = g.stride(t);
             grad[i][t] = 0.25 * inv_h * (u[i][cL + st] - u[i][cL - st] + u[i][cR + st] - u[i][cR - st]);
           }
