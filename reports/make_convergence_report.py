@@ -26,9 +26,11 @@ each is the header shown; numbers are decimal (nan allowed); names contain no co
       quantities as fractions) and the asymptotic-range ratio GCI32 / (r21^p GCI21); passes
       when |ratio - 1| <= asymptotic_tolerance. A two-grid row (convergence "two-grids"; h3,
       phi3, gci32, ratio and pass nan; assumed order, Fs = 3) is shown but is not a check.
-  *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,standard_error
+  *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,
+                      standard_error
       MD sampling convergence (verification/convergence/md_sampling.hpp): the standard error
-      of one quantity (phase = f t, nan for all phases) from blocks of K sampled cycles.
+      of one quantity (phase = f t, nan for all phases) from blocks of K sampled cycles;
+      cycles without a value (missing) make the effective number of cycles effective_K < K.
   *.sampling-fit.csv  study,quantity,phase,fit_points,fitted_slope,slope_std_error,
                       expected_slope,band,pass
       The least-squares slope of ln se against ln K; passes when |slope - expected_slope|
@@ -67,7 +69,7 @@ GCI_HEADER = ["study", "quantity", "h1", "h2", "h3", "phi1", "phi2", "phi3", "or
               "phi_extrapolated", "relative_difference21", "extrapolated_error21", "gci21",
               "gci32", "asymptotic_ratio", "convergence", "asymptotic_tolerance", "pass"]
 SAMPLING_HEADER = ["study", "quantity", "phase", "K", "blocks", "degrees_of_freedom",
-                   "standard_error"]
+                   "effective_K", "missing", "standard_error"]
 SAMPLING_FIT_HEADER = ["study", "quantity", "phase", "fit_points", "fitted_slope",
                        "slope_std_error", "expected_slope", "band", "pass"]
 BIN_SIZE_HEADER = ["study", "quantity", "phase", "sigma_value", "half_sigma_value", "statistic",
@@ -229,7 +231,7 @@ def plot_sampling(study, rows, out_dir):
     k_all = []
     for (quantity, phase), points in sorted(series.items()):
         points.sort(key=lambda r: r["K"])
-        k = np.array([r["K"] for r in points])
+        k = np.array([r["effective_K"] for r in points])
         se = np.array([r["standard_error"] for r in points])
         if len(k) == 0 or not (se[0] > 0):
             continue
@@ -244,7 +246,7 @@ def plot_sampling(study, rows, out_dir):
         ax.set_xticks(ticks)
         ax.set_xticklabels([f"{k:g}" for k in ticks])
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.set_xlabel("sampled cycles K")
+    ax.set_xlabel("sampled cycles K (effective)")
     ax.set_ylabel("se / se(smallest K)")
     ax.set_title(f"{study}: standard error against K")
     ax.grid(True, which="both", alpha=0.3)
@@ -293,7 +295,9 @@ def sampling_section(data, out_dir, failures):
             return (r["quantity"], -1.0 if math.isnan(r["phase"]) else r["phase"])
         for quantity, phase in sorted({key(r) for r in rows}):
             cells = {int(r["K"]): r["standard_error"] for r in rows if key(r) == (quantity, phase)}
-            lines.append(f"| {quantity} | {phase_text(phase if phase >= 0 else math.nan)} | " +
+            missing = sum(r["missing"] for r in rows if key(r) == (quantity, phase))
+            note = f" ({int(missing)} values missing over the K's)" if missing else ""
+            lines.append(f"| {quantity}{note} | {phase_text(phase if phase >= 0 else math.nan)} | " +
                          " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
         name = plot_sampling(study, rows, out_dir)
         lines += ["", f"![{study}: se against K]({name})", ""]

@@ -33,35 +33,69 @@ double sample_variance(std::span<const double> x) {
 }
 }  // namespace
 
-double block_standard_error(std::span<const double> per_cycle, std::size_t K) {
+BlockEstimate block_estimate(std::span<const double> per_cycle, std::size_t K) {
   if (K < 2 || K > per_cycle.size())
-    throw std::invalid_argument(fmt::format("block_standard_error: K = {} with {} values", K,
+    throw std::invalid_argument(fmt::format("block_estimate: K = {} with {} values", K,
                                             per_cycle.size()));
-  for (double v : per_cycle)
-    if (std::isnan(v)) throw std::invalid_argument("block_standard_error: a value is NaN");
-  const std::size_t blocks = per_cycle.size() / K;
-  double mean_se2 = 0.0;
-  for (std::size_t b = 0; b < blocks; ++b)
-    mean_se2 += sample_variance(per_cycle.subspan(b * K, K)) / static_cast<double>(K);
-  return std::sqrt(mean_se2 / static_cast<double>(blocks));
+  BlockEstimate e;
+  e.block_size = K;
+  double mean_se2 = 0.0, mean_inverse_count = 0.0;
+  std::vector<double> found;
+  for (std::size_t b = 0; b < per_cycle.size() / K; ++b) {
+    found.clear();
+    for (double v : per_cycle.subspan(b * K, K))
+      if (std::isnan(v)) ++e.missing;
+      else found.push_back(v);
+    if (found.size() < 2) continue;
+    const double n = static_cast<double>(found.size());
+    mean_se2 += sample_variance(found) / n;
+    mean_inverse_count += 1.0 / n;
+    ++e.blocks;
+    e.degrees_of_freedom += found.size() - 1;
+  }
+  if (e.blocks == 0) {
+    e.standard_error = nan;
+    return e;
+  }
+  const double blocks = static_cast<double>(e.blocks);
+  e.standard_error = std::sqrt(mean_se2 / blocks);
+  e.effective_count = blocks / mean_inverse_count;
+  return e;
 }
 
-std::size_t block_degrees_of_freedom(std::size_t cycles, std::size_t K) {
-  return K == 0 ? 0 : (cycles / K) * (K - 1);
+double block_standard_error(std::span<const double> per_cycle, std::size_t K) {
+  const BlockEstimate e = block_estimate(per_cycle, K);
+  if (e.missing) throw std::invalid_argument("block_standard_error: a value is NaN");
+  return e.standard_error;
+}
+
+BlockEstimate complete_blocks(std::size_t cycles, std::size_t K, double standard_error) {
+  BlockEstimate e;
+  e.block_size = K;
+  e.standard_error = standard_error;
+  e.effective_count = static_cast<double>(K);
+  e.blocks = K ? cycles / K : 0;
+  e.degrees_of_freedom = e.blocks * (K - 1);
+  return e;
+}
+
+double expected_slope_scatter(std::span<const BlockEstimate> estimates) {
+  const double m = static_cast<double>(estimates.size());
+  double mean_x = 0.0;
+  for (const auto& e : estimates) mean_x += std::log(e.effective_count) / m;
+  double sxx = 0.0, weighted = 0.0;
+  for (const auto& e : estimates) {
+    const double dx = std::log(e.effective_count) - mean_x;
+    sxx += dx * dx;
+    weighted += dx * dx / (2.0 * static_cast<double>(e.degrees_of_freedom));
+  }
+  return std::sqrt(weighted) / sxx;
 }
 
 double expected_slope_scatter(std::span<const std::size_t> block_sizes, std::size_t cycles) {
-  const double m = static_cast<double>(block_sizes.size());
-  double mean_x = 0.0;
-  for (std::size_t K : block_sizes) mean_x += std::log(static_cast<double>(K)) / m;
-  double sxx = 0.0, weighted = 0.0;
-  for (std::size_t K : block_sizes) {
-    const double dx = std::log(static_cast<double>(K)) - mean_x;
-    const double dof = static_cast<double>(block_degrees_of_freedom(cycles, K));
-    sxx += dx * dx;
-    weighted += dx * dx / (2.0 * dof);
-  }
-  return std::sqrt(weighted) / sxx;
+  std::vector<BlockEstimate> estimates;
+  for (std::size_t K : block_sizes) estimates.push_back(complete_blocks(cycles, K, 1.0));
+  return expected_slope_scatter(estimates);
 }
 
 bool SamplingFit::pass() const {
@@ -69,20 +103,27 @@ bool SamplingFit::pass() const {
 }
 
 SamplingFit fit_sampling(const std::string& study, const std::string& quantity, double phase,
-                         std::vector<std::size_t> block_sizes, std::vector<double> standard_errors,
-                         std::size_t cycles) {
+                         std::vector<BlockEstimate> estimates) {
   SamplingFit f;
   f.study = study;
   f.quantity = quantity;
   f.phase = phase;
-  std::vector<double> K(block_sizes.begin(), block_sizes.end());
-  f.band = slope_band_sigmas * expected_slope_scatter(block_sizes, cycles);
-  f.block_sizes = std::move(block_sizes);
-  f.standard_errors = std::move(standard_errors);
-  bool positive = true;
-  for (double se : f.standard_errors) positive = positive && se > 0.0 && std::isfinite(se);
-  if (positive) f.fit = fit_order(K, f.standard_errors);
-  else f.fit = OrderFit{nan, nan, nan, K.size()};  // a zero or missing se fails the check
+  f.estimates = std::move(estimates);
+  std::vector<double> K, se;
+  bool usable = true;
+  for (const auto& e : f.estimates) {
+    K.push_back(e.effective_count);
+    se.push_back(e.standard_error);
+    usable = usable && e.standard_error > 0.0 && std::isfinite(e.standard_error) &&
+             e.degrees_of_freedom > 0;
+  }
+  if (!usable) {  // a zero or missing se fails the check
+    f.fit = OrderFit{nan, nan, nan, K.size()};
+    f.band = nan;
+    return f;
+  }
+  f.band = slope_band_sigmas * expected_slope_scatter(f.estimates);
+  f.fit = fit_order(K, se);
   return f;
 }
 
@@ -285,19 +326,18 @@ std::string phase_text(double phase) { return std::isnan(phase) ? "nan" : number
 std::vector<std::filesystem::path> write_sampling_study(const std::filesystem::path& directory,
                                                         const std::string& name,
                                                         std::span<const SamplingFit> fits,
-                                                        std::span<const BinSizeCheck> bin_checks,
-                                                        std::size_t cycles) {
+                                                        std::span<const BinSizeCheck> bin_checks) {
   if (name.find_first_of("/,\"\n") != std::string::npos)
     throw std::invalid_argument("write_sampling_study: bad study file name " + name);
-  std::string se = "study,quantity,phase,K,blocks,degrees_of_freedom,standard_error\n";
+  std::string se = "study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,"
+                   "standard_error\n";
   std::string fit = "study,quantity,phase,fit_points,fitted_slope,slope_std_error,expected_slope,"
                     "band,pass\n";
   for (const SamplingFit& f : fits) {
-    for (std::size_t k = 0; k < f.block_sizes.size(); ++k)
-      se += fmt::format("{},{},{},{},{},{},{}\n", f.study, f.quantity, phase_text(f.phase),
-                        f.block_sizes[k], cycles / f.block_sizes[k],
-                        block_degrees_of_freedom(cycles, f.block_sizes[k]),
-                        number(f.standard_errors[k]));
+    for (const BlockEstimate& e : f.estimates)
+      se += fmt::format("{},{},{},{},{},{},{},{},{}\n", f.study, f.quantity, phase_text(f.phase),
+                        e.block_size, e.blocks, e.degrees_of_freedom, number(e.effective_count),
+                        e.missing, number(e.standard_error));
     fit += fmt::format("{},{},{},{},{},{},{},{},{}\n", f.study, f.quantity, phase_text(f.phase),
                        f.fit.points, number(f.fit.order), number(f.fit.order_std_error),
                        number(f.expected_slope), number(f.band), f.pass() ? 1 : 0);

@@ -29,40 +29,55 @@ namespace shaker::convergence {
 
 // ---- statistics -------------------------------------------------------------------------
 
-/// sqrt(mean over the blocks b of s_b^2 / K): the standard error of a K-cycle mean from the
-/// floor(size / K) disjoint blocks of K consecutive values (a remainder is left out).
-/// Throws std::invalid_argument for K < 2, K > size, or a NaN value.
+/// The standard error of a K-cycle mean from the floor(size / K) disjoint blocks of K
+/// consecutive values (a remainder is left out). A NaN marks a cycle without a value (e.g. no
+/// shock detected in that cycle's profile): block b then holds n_b <= K values, blocks with
+/// n_b < 2 are left out, se^2 = mean_b s_b^2 / n_b and E[se^2] = sigma^2 / K_eff with
+/// 1 / K_eff = mean_b 1 / n_b (K_eff = K when nothing is missing), so ln se is fitted against
+/// ln K_eff.
+struct BlockEstimate {
+  std::size_t block_size = 0;          ///< K
+  double standard_error = 0.0;         ///< sqrt(mean_b s_b^2 / n_b); NaN if no block is usable
+  double effective_count = 0.0;        ///< K_eff
+  std::size_t blocks = 0;              ///< blocks used
+  std::size_t degrees_of_freedom = 0;  ///< sum_b (n_b - 1)
+  std::size_t missing = 0;             ///< NaN values in the blocks
+};
+/// Throws std::invalid_argument for K < 2 or K > size.
+BlockEstimate block_estimate(std::span<const double> per_cycle, std::size_t K);
+
+/// block_estimate(...).standard_error; throws std::invalid_argument on a NaN value as well.
 double block_standard_error(std::span<const double> per_cycle, std::size_t K);
 
-/// Degrees of freedom behind block_standard_error: floor(cycles / K) (K - 1).
-std::size_t block_degrees_of_freedom(std::size_t cycles, std::size_t K);
+/// An estimate without missing values: floor(cycles / K) blocks of K, dof = blocks (K - 1).
+BlockEstimate complete_blocks(std::size_t cycles, std::size_t K, double standard_error);
 
-/// Expected standard deviation of the least-squares slope of ln se against ln K when each se
-/// comes from block_degrees_of_freedom(cycles, K) Gaussian degrees of freedom
-/// (var ln se = 1 / (2 dof) to first order) and the estimates at different K are taken as
-/// independent. They share cycles and are positively correlated, which makes the slope
-/// scatter smaller, so this is an upper estimate.
+/// Expected standard deviation of the least-squares slope of ln se against ln K_eff when each
+/// se has the Gaussian degrees of freedom of its estimate (var ln se = 1 / (2 dof) to first
+/// order) and the estimates at different K are taken as independent. They share cycles and
+/// are positively correlated, which makes the slope scatter smaller, so this is an upper
+/// estimate (MdSamplingStatistics measures it).
+double expected_slope_scatter(std::span<const BlockEstimate> estimates);
+/// The same for complete blocks of each K out of `cycles`.
 double expected_slope_scatter(std::span<const std::size_t> block_sizes, std::size_t cycles);
 
 /// Band half-width of the slope check in units of expected_slope_scatter.
 inline constexpr double slope_band_sigmas = 3.0;
 
-/// ln se against ln K for one quantity; passes when |slope + 1/2| <= band.
+/// ln se against ln K_eff for one quantity; passes when |slope + 1/2| <= band.
 struct SamplingFit {
   std::string study, quantity;
   double phase = 0.0;  ///< f t of the quantity; NaN for a quantity over all phases
-  std::vector<std::size_t> block_sizes;
-  std::vector<double> standard_errors;
+  std::vector<BlockEstimate> estimates;  ///< one per K
   OrderFit fit;
   double expected_slope = -0.5;
   double band = 0.0;
   bool pass() const;
 };
-/// Fits standard_errors against block_sizes (convergence::fit_order) with the band
-/// slope_band_sigmas * expected_slope_scatter(block_sizes, cycles).
+/// Fits the standard errors against K_eff (convergence::fit_order) with the band
+/// slope_band_sigmas * expected_slope_scatter(estimates). A NaN or zero se fails.
 SamplingFit fit_sampling(const std::string& study, const std::string& quantity, double phase,
-                         std::vector<std::size_t> block_sizes, std::vector<double> standard_errors,
-                         std::size_t cycles);
+                         std::vector<BlockEstimate> estimates);
 
 // ---- bin size ---------------------------------------------------------------------------
 
@@ -139,7 +154,8 @@ double layer_rms_standard_error(const std::vector<std::vector<std::vector<double
                                 const std::vector<Profile>& pooled, double phase);
 
 // ---- tables -----------------------------------------------------------------------------
-//   <name>.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,standard_error
+//   <name>.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,
+//                            missing,standard_error
 //   <name>.sampling-fit.csv  study,quantity,phase,fit_points,fitted_slope,slope_std_error,
 //                            expected_slope,band,pass
 //   <name>.bin-size.csv      study,quantity,phase,sigma_value,half_sigma_value,statistic,value,
@@ -149,7 +165,6 @@ double layer_rms_standard_error(const std::vector<std::vector<std::vector<double
 std::vector<std::filesystem::path> write_sampling_study(const std::filesystem::path& directory,
                                                         const std::string& name,
                                                         std::span<const SamplingFit> fits,
-                                                        std::span<const BinSizeCheck> bin_checks,
-                                                        std::size_t cycles);
+                                                        std::span<const BinSizeCheck> bin_checks);
 
 }  // namespace shaker::convergence

@@ -85,14 +85,15 @@ def synthetic_sampling_study(directory):
                                       ("n_se_layer_rms", "nan", -0.5)):
         se = [0.3 * k ** exponent for k in ks]
         for k, e in zip(ks, se):
-            se_rows.append((study, quantity, phase, k, 16 // k, (16 // k) * (k - 1), repr(e)))
+            se_rows.append((study, quantity, phase, k, 16 // k, (16 // k) * (k - 1), k, 0, repr(e)))
         slope = np.polyfit(np.log(ks), np.log(se), 1)[0]
         claimed = 1 if quantity == "n_se_layer_rms" else int(abs(slope + 0.5) <= 0.42)
         if quantity == "n_se_layer_rms":
             slope = -0.95  # the file claims a pass that its numbers contradict
         fit_rows.append((study, quantity, phase, 4, repr(slope), "0.01", "-0.5", "0.42", claimed))
     write(os.path.join(directory, "md.sampling.csv"),
-          "study,quantity,phase,K,blocks,degrees_of_freedom,standard_error", se_rows)
+          "study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,standard_error",
+          se_rows)
     write(os.path.join(directory, "md.sampling-fit.csv"),
           "study,quantity,phase,fit_points,fitted_slope,slope_std_error,expected_slope,band,pass",
           fit_rows)
