@@ -295,8 +295,9 @@ def sampling_section(data, out_dir, failures):
             return (r["quantity"], -1.0 if math.isnan(r["phase"]) else r["phase"])
         for quantity, phase in sorted({key(r) for r in rows}):
             cells = {int(r["K"]): r["standard_error"] for r in rows if key(r) == (quantity, phase)}
-            missing = sum(r["missing"] for r in rows if key(r) == (quantity, phase))
-            note = f" ({int(missing)} values missing over the K's)" if missing else ""
+            # The same cycles at every K: the largest count is the number of cycles without one.
+            missing = max(r["missing"] for r in rows if key(r) == (quantity, phase))
+            note = f" ({int(missing)} cycles without a value)" if missing else ""
             lines.append(f"| {quantity}{note} | {phase_text(phase if phase >= 0 else math.nan)} | " +
                          " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
         name = plot_sampling(study, rows, out_dir)
