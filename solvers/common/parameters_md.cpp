@@ -24,7 +24,7 @@ std::vector<ParameterSpec> md_parameters() {
            "off: stop with an error when inelastic collapse starts; tc: collisions within "
            "md.tc of a particle's previous collision are elastic (TC model)"),
       real("md.tc", 1e-5, positive(1.0), "TC model contact duration t_c"),
-      text("md.event_queue", "heap", {"heap", "calendar"},
+      text("md.event_queue", "calendar", {"heap", "calendar"},
            "future-event list: indexed binary heap or bounded calendar queue; both give the "
            "same trajectory bit for bit"),
       real_list("md.crossing_heights", {80.0}, positive(),

@@ -23,7 +23,7 @@ struct MdSettings {
   std::string checkpoint, checkpoint_output;
   bool tc_guard = false;
   double tc = 1e-5;
-  QueueKind queue = QueueKind::heap;
+  QueueKind queue = QueueKind::calendar;
   std::vector<double> crossing_heights{80.0};
   static MdSettings from(const config::Config& config);
 };
