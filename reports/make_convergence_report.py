@@ -238,9 +238,9 @@ def plot_sampling(study, rows, out_dir):
         keep = se > 0
         label = f"{quantity} (f t {'all' if phase < 0 else rc.fmt(phase, 3)})"
         ax.loglog(k[keep], se[keep] / se[0], "o-", ms=4, lw=1, label=label)
-        k_all.extend(k)
+        k_all.extend(r["K"] for r in points)  # nominal K: the ticks
     if k_all:
-        ks = np.array([min(k_all), max(k_all)], dtype=float)
+        ks = np.array([min(k_all), max(k_all)], dtype=float)  # reference line over the K range
         ax.loglog(ks, (ks / ks[0]) ** -0.5, "k--", lw=1.5, label="K^-1/2")
         ticks = sorted(set(k_all))
         ax.set_xticks(ticks)
