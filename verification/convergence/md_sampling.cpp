@@ -175,7 +175,10 @@ FieldAgreement compare_fields(const Profile& coarse, const Profile& paired, cons
     ++a.bins;
     if (difference < sigmas * combined) ++a.within;
     a.max_abs_difference = std::max(a.max_abs_difference, difference);
-    a.max_difference_in_se = std::max(a.max_difference_in_se, difference / combined);
+    if (difference / combined > a.max_difference_in_se) {
+      a.max_difference_in_se = difference / combined;
+      a.worst_z = coarse.z[i];
+    }
   }
   return a;
 }

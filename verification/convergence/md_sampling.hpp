@@ -98,6 +98,7 @@ struct FieldAgreement {
   std::size_t bins = 0, within = 0;
   double max_abs_difference = 0.0;
   double max_difference_in_se = 0.0;  ///< largest |a - b| / combined se
+  double worst_z = 0.0;               ///< height of that bin
   double fraction() const { return bins ? static_cast<double>(within) / static_cast<double>(bins) : 0.0; }
 };
 /// field: "T", "uz" or "nu" (nu has no standard error: its combined se is taken from n_se

@@ -306,8 +306,9 @@ void run_study(const StudyDesign& d, bool cross_check) {
     const auto a = conv::compare_fields(coarse, paired, field);
     checks.push_back({d.name, field, 0.22, nan, nan, "fraction of layer bins within 2 combined se",
                       "at_least", a.fraction(), 0.9});
-    std::printf("bin size %-2s: %zu of %zu layer bins within 2 combined se (%.3f), max |diff| %.4g = %.2f se\n",
-                field.c_str(), a.within, a.bins, a.fraction(), a.max_abs_difference, a.max_difference_in_se);
+    std::printf("bin size %-2s: %zu of %zu layer bins within 2 combined se (%.3f), max |diff| %.4g, "
+                "largest %.2f se at z = %.1f (plate at %.2f)\n", field.c_str(), a.within, a.bins,
+                a.fraction(), a.max_abs_difference, a.max_difference_in_se, a.worst_z, coarse.plate_z);
     EXPECT_GE(a.fraction(), 0.9) << field << ": " << a.within << " of " << a.bins << " layer bins";
   }
   const auto nu = conv::compare_fields(coarse, paired, "nu");
