@@ -28,8 +28,6 @@ ImplicitDiffusion::ImplicitDiffusion(const Grid& grid)
     for (int j = 0; j < grid.ny; ++j)
       for (int i = 0; i < grid.nx; ++i) storage_.push_back(grid.index(i, j, k));
   const auto cells = static_cast<Eigen::Index>(storage_.size());
-  for (Eigen::VectorXd* v : {&rhs_, &dissipation_, &temperature_, &velocity_[0], &velocity_[1], &velocity_[2]})
-    v->resize(cells);
   if (column_) {
     face_.assign(storage_.size(), 0.0);
     forward_.assign(storage_.size(), 0.0);
@@ -174,6 +172,11 @@ void ImplicitDiffusion::advance(Operator& op, State& U, double dt, bool closure_
   if (!closure_is_current) op.prepare(U);
   const auto& w = op.primitives();
   const std::size_t cells = storage_.size();
+  // Work vectors sized on the first step, not at construction: a run that never diffuses
+  // implicitly does not carry them (6 doubles per cell).
+  if (rhs_.size() != static_cast<Eigen::Index>(cells))
+    for (Eigen::VectorXd* v : {&rhs_, &dissipation_, &temperature_, &velocity_[0], &velocity_[1], &velocity_[2]})
+      v->resize(static_cast<Eigen::Index>(cells));
   dissipation_.setZero();
   for (int component = 0; component < 3; ++component) {
     for (std::size_t m = 0; m < cells; ++m) rhs_[m] = w[0][storage_[m]] * w[1 + component][storage_[m]] / dt;

@@ -42,7 +42,7 @@ class ImplicitDiffusion {
   Grid grid_;
   bool column_ = false;  ///< 1D between walls: tridiagonal, Thomas algorithm
   std::vector<std::ptrdiff_t> storage_;  ///< interior cell m -> storage index
-  // Work vectors, sized once.
+  // Work vectors, sized once (on the first advance).
   Eigen::VectorXd rhs_, dissipation_, temperature_;
   std::array<Eigen::VectorXd, 3> velocity_;
   std::vector<double> face_, forward_;  ///< column: face coefficients (face m between m, m+1), Thomas c'
