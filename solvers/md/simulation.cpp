@@ -273,13 +273,14 @@ void Simulation::predict(std::int32_t i) {
   // (at large N each is a cache miss); the results are those of a single pass.
   constexpr int chunk = 64;
   std::int32_t ids[chunk];
-  Vec3 shifts[chunk];
+  double shift_x[chunk], shift_y[chunk], shift_z[chunk];  // no initialisation per call
   int count = 0;
   auto test_collected = [&] {
     for (int k = 0; k < count; ++k) {
       Vec3 rj, vj;
       state_at(data_.particles[ids[k]], now, g, rj, vj);
-      if (pair_contact_before(p.r - rj - shifts[k], p.v - vj, best)) event.partner = ids[k];
+      const Vec3 shift{shift_x[k], shift_y[k], shift_z[k]};
+      if (pair_contact_before(p.r - rj - shift, p.v - vj, best)) event.partner = ids[k];
     }
     count = 0;
   };
@@ -287,7 +288,9 @@ void Simulation::predict(std::int32_t i) {
     if (j == i) return;
     __builtin_prefetch(&data_.particles[j]);
     ids[count] = j;
-    shifts[count] = shift;
+    shift_x[count] = shift.x;
+    shift_y[count] = shift.y;
+    shift_z[count] = shift.z;
     if (++count == chunk) test_collected();
   });
   test_collected();
