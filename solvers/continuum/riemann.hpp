@@ -33,13 +33,20 @@ inline void riemann_flux(const FaceState& L, const FaceState& R, double* F) {
   double FL[5], FR[5];
   physical_flux(L, EL, FL);
   physical_flux(R, ER, FR);
-  if constexpr (Solver == RiemannSolver::hll) {
+  const auto hll = [&] {
     const double UL[5] = {L.n, L.n * L.un, L.n * L.ut1, L.n * L.ut2, EL};
     const double UR[5] = {R.n, R.n * R.un, R.n * R.ut1, R.n * R.ut2, ER};
     const double inv = 1.0 / (SR - SL);
     for (int v = 0; v < 5; ++v) F[v] = (SR * FL[v] - SL * FR[v] + SL * SR * (UR[v] - UL[v])) * inv;
+  };
+  if constexpr (Solver == RiemannSolver::hll) {
+    hll();
   } else {
     const double mL = L.n * (SL - L.un), mR = R.n * (SR - R.un);
+    // Pressureless flux (c = 0 on both sides) with the sides moving apart: SL = L.un and
+    // SR = R.un make both mass fluxes mK zero and S_star 0 / 0 (NaN). The exact solution opens
+    // a vacuum between the sides, whose flux is zero; HLL gives exactly that (F_K = u_K U_K).
+    if (!(mR - mL > 0.0)) return hll();
     const double S_star = (R.p - L.p + L.un * mL - R.un * mR) / (mL - mR);
     const bool left = S_star >= 0.0;
     const FaceState& K = left ? L : R;
