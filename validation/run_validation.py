@@ -30,6 +30,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -507,19 +508,28 @@ def git(*args):
     return result.stdout.strip() if result.returncode == 0 else "unknown"
 
 
+def run_program(record):
+    """The commit of the program that wrote a run file (its git_commit attribute): a reused
+    run may come from an earlier build than the one making the report."""
+    if record.get("status") != "ok" or not record.get("path") or not os.path.exists(record["path"]):
+        return None
+    with h5py.File(record["path"], "r") as f:
+        commit = f.attrs.get("git_commit")
+    return commit.decode() if isinstance(commit, bytes) else commit
+
+
 def collisions_per_second(view):
-    """Collisions per second of wall time from an MD run's time series: the growth of a
-    cumulative `collisions` column, or of the sum of the columns named *collisions*."""
+    """Collisions per second of wall time of an MD case: the collisions its runs report on
+    stdout ("collisions: N (...)"), summed over a pool's runs, over their summed wall time
+    (kept in each run's record, so a reused run reports the rate it was run at)."""
     if view.solver != "md" or view.status != "ok" or not view.runs:
         return None
-    series = view.timeseries() if view.path and os.path.exists(view.path) else {}
-    columns = [k for k in series if k == "collisions"] or \
-        [k for k in series if "collisions" in k and "loss" not in k]
-    seconds = sum(r["seconds"] for r in view.runs if r["status"] == "ok")
-    if not columns or seconds <= 0 or any(r.get("reused") for r in view.runs):
+    runs = [r for r in view.runs if r["status"] == "ok"]
+    counts = [re.search(r"collisions: (\d+) \(", r.get("stdout") or "") for r in runs]
+    seconds = sum(r["seconds"] for r in runs)
+    if not runs or None in counts or seconds <= 0:
         return None
-    total = sum(float(series[k][-1] - series[k][0]) for k in columns)
-    return total / seconds if total > 0 else None
+    return sum(int(m.group(1)) for m in counts) / seconds
 
 
 def main(argv=None):
@@ -586,7 +596,7 @@ def main(argv=None):
     runs = [dict(case=r["case"], solver=r["solver"], member=r["member"],
                  status=r["record"]["status"], seconds=r["record"]["seconds"],
                  reused=r["record"].get("reused", False), path=r["record"].get("path"),
-                 fallback=r["record"].get("fallback"),
+                 fallback=r["record"].get("fallback"), program=run_program(r["record"]),
                  stderr=r["record"].get("stderr", "")[-600:]) for r in plan]
     summary = dict(
         commit=git("rev-parse", "HEAD"), dirty=bool(git("status", "--porcelain", "--", ".")),
