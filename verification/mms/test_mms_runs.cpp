@@ -175,18 +175,20 @@ std::string term_case_name(const ::testing::TestParamInfo<TermCase>& info) {
 // speed), so they cost seconds.
 const std::vector<int> fine_advection{160, 320, 640, 1280};
 
-class MmsTermAlone1D : public ::testing::TestWithParam<TermCase> {};
-
-TEST_P(MmsTermAlone1D, SecondOrder) {
+void term_alone_study(const TermCase& term) {
   mms::MmsCase c;
   c.transport = Transport::full;
-  c.terms = GetParam().terms;
-  c.fixed_dt = GetParam().fixed_dt;
+  c.terms = term.terms;
+  c.fixed_dt = term.fixed_dt;
   c.t_end = 1.0;
   conv::ErrorTable table;
-  mms::spatial_study(c, GetParam().cells, study_name(), table);
+  mms::spatial_study(c, term.cells, study_name(), table);
   check_and_write(table, design_space_order, true);
 }
+
+class MmsTermAlone1D : public ::testing::TestWithParam<TermCase> {};
+
+TEST_P(MmsTermAlone1D, SecondOrder) { term_alone_study(GetParam()); }
 INSTANTIATE_TEST_SUITE_P(
     Terms, MmsTermAlone1D,
     ::testing::Values(TermCase{"advection", alone(&mms::Terms::advection), 0.0, fine_advection},
@@ -203,15 +205,7 @@ INSTANTIATE_TEST_SUITE_P(
 // (about a minute): nightly.
 class NightlyMmsTermAlone1D : public ::testing::TestWithParam<TermCase> {};
 
-TEST_P(NightlyMmsTermAlone1D, SecondOrder) {
-  mms::MmsCase c;
-  c.transport = Transport::full;
-  c.terms = GetParam().terms;
-  c.t_end = 1.0;
-  conv::ErrorTable table;
-  mms::spatial_study(c, GetParam().cells, study_name(), table);
-  check_and_write(table, design_space_order, true);
-}
+TEST_P(NightlyMmsTermAlone1D, SecondOrder) { term_alone_study(GetParam()); }
 INSTANTIATE_TEST_SUITE_P(Terms, NightlyMmsTermAlone1D,
                          ::testing::Values(TermCase{"pressure", alone(&mms::Terms::pressure), 0.0,
                                                     {160, 320, 640, 1280}}),
