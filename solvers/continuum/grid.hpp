@@ -33,6 +33,16 @@ struct Grid {
   /// Volume of a cell; in 1D the column has unit cross section, so amounts are per unit area.
   double cell_volume() const { return dimension == 3 ? h * h * h : h; }
   double height() const { return nz * h; }
+  /// The interior cells as contiguous runs of storage: one run in 1D (no x, y ghosts), one
+  /// row of nx per (j, k) in 3D. Loops over runs instead of (i, j, k) let a 1D column be a
+  /// single loop of nz cells.
+  int interior_rows() const { return dimension == 3 ? ny * nz : 1; }
+  /// First storage index of run `row` (0 <= row < interior_rows()); its cells are
+  /// row_start(row) .. row_start(row) + row_length() - 1.
+  std::ptrdiff_t row_start(int row) const {
+    return dimension == 3 ? index(0, row % ny, row / ny) : index(0, 0, 0);
+  }
+  int row_length() const { return dimension == 3 ? nx : nx * ny * nz; }
 };
 
 /// A grid of cell size h over [0, width]^2 x [0, height]; throws InputError naming the key

@@ -32,34 +32,52 @@ void Operator::rhs(double t, State& U, State& dUdt, Part part) {
   if (part != Part::diffusive) add_sources(t, U, dUdt);
 }
 
+// Both step limits scan the interior as contiguous runs (a 1D column is one run), threaded
+// only on large grids (an OpenMP region with a false `if` still costs a runtime call).
+template <class CellValue>
+static double interior_maximum(const Grid& g, CellValue value) {
+  const int rows = g.interior_rows(), length = g.row_length();
+  const auto run = [&](int row) {
+    const std::ptrdiff_t first = g.row_start(row);
+    double m = 0.0;
+    for (std::ptrdiff_t c = first; c < first + length; ++c) m = std::max(m, value(c));
+    return m;
+  };
+  double largest = 0.0;
+  if (g.interior_cells() > 4096) {
+#pragma omp parallel for schedule(static) reduction(max : largest)
+    for (int row = 0; row < rows; ++row) largest = std::max(largest, run(row));
+  } else {
+    for (int row = 0; row < rows; ++row) largest = std::max(largest, run(row));
+  }
+  return largest;
+}
+
 double Operator::advective_step(double cfl) const {
   const Grid& g = grid_;
-  double fastest = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : fastest) if (g.interior_cells() > 4096)
-  for (int k = 0; k < g.nz; ++k)
-    for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const std::ptrdiff_t c = g.index(i, j, k);
-        double sum = 0.0;
-        for (int d = g.first_direction(); d < 3; ++d) sum += std::abs(w_[1 + d][c]) + closure_.c[c];
-        fastest = std::max(fastest, sum);
-      }
+  const double* u[3] = {w_[1].data(), w_[2].data(), w_[3].data()};
+  const double* c_sound = closure_.c.data();
+  const int first = g.first_direction();
+  const double fastest = interior_maximum(g, [&](std::ptrdiff_t c) {
+    double sum = 0.0;
+    for (int d = first; d < 3; ++d) sum += std::abs(u[d][c]) + c_sound[c];
+    return sum;
+  });
   return fastest > 0.0 ? cfl * g.h / fastest : std::numeric_limits<double>::infinity();
 }
 
 double Operator::diffusive_step() const {
   if (!transport_evaluated_) return std::numeric_limits<double>::infinity();
   const Grid& g = grid_;
-  double largest = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : largest) if (g.interior_cells() > 4096)
-  for (int k = 0; k < g.nz; ++k)
-    for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const std::ptrdiff_t c = g.index(i, j, k);
-        const double momentum = (closure_.lambda[c] + 4.0 / 3.0 * closure_.mu[c]);
-        const double heat = closure_.kappa[c] / 1.5;
-        largest = std::max(largest, std::max(momentum, heat) / w_[0][c]);
-      }
+  const double* n = w_[0].data();
+  const double* mu = closure_.mu.data();
+  const double* lambda = closure_.lambda.data();
+  const double* kappa = closure_.kappa.data();
+  const double largest = interior_maximum(g, [&](std::ptrdiff_t c) {
+    const double momentum = (lambda[c] + 4.0 / 3.0 * mu[c]);
+    const double heat = kappa[c] / 1.5;
+    return std::max(momentum, heat) / n[c];
+  });
   const int dims = g.dimension == 3 ? 3 : 1;
   return largest > 0.0 ? g.h * g.h / (2.0 * dims * largest) : std::numeric_limits<double>::infinity();
 }

@@ -29,6 +29,9 @@ Pencils pencils_of(const Grid& g, int d) {
   return {g.nx, g.ny, g.nz};
 }
 
+/// Faces handled per block of a pencil: the block's face states and fluxes stay in L1.
+constexpr int face_block = 64;
+
 template <Limiter L, RiemannSolver R>
 void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
                      const Operator::Closure& closure, bool pressureful, State& dUdt) {
@@ -53,8 +56,10 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
   const double* fn = w[0].data();
   const double* fp = closure.p.data();
   const double* fc = closure.c.data();
-  const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, double* minus,
-                                  double* plus) {
+  // minus[v][q], plus[v][q]: face states of the block's cell q at its low and high face.
+  using FaceStates = double[7][face_block + 1];
+  const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, int q,
+                                  FaceStates& minus, FaceStates& plus) {
     const double n0 = fn[c], c0 = fc[c];
     if (!(c0 > 0.0)) return;
     const double* u = w[un].data();
@@ -69,22 +74,12 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     const double n_plus = n0 + 0.5 * dn, p_plus = fp[c] + 0.5 * dp;
     const double n_minus = n0 - 0.5 * dn, p_minus = fp[c] - 0.5 * dp;
     if (!(n_plus > 0.0 && p_plus > 0.0 && n_minus > 0.0 && p_minus > 0.0)) return;
-    plus[0] = n_plus;
-    plus[un] = u[c] + 0.5 * du;
-    plus[4] = p_plus;
-    minus[0] = n_minus;
-    minus[un] = u[c] - 0.5 * du;
-    minus[4] = p_minus;
-  };
-  // Both face states of cell c along the direction of stride s, computed once per cell
-  // (each is used by one face): minus at the low face, plus at the high face.
-  const auto cell_faces = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, double* minus,
-                              double* plus) {
-    for (int v = 0; v < 7; ++v) {
-      const double* x = fields[v];
-      reconstruct<L>(x[c - s], x[c], x[c + s], minus[v], plus[v]);
-    }
-    if (pressure) characteristic(c, s, un, minus, plus);
+    plus[0][q] = n_plus;
+    plus[un][q] = u[c] + 0.5 * du;
+    plus[4][q] = p_plus;
+    minus[0][q] = n_minus;
+    minus[un][q] = u[c] - 0.5 * du;
+    minus[4][q] = p_minus;
   };
   for (int d = g.first_direction(); d < 3; ++d) {
     const std::ptrdiff_t s = g.stride(d);
@@ -101,97 +96,112 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
 #pragma omp parallel for schedule(dynamic, P.count_a) if (total > 1 && g.interior_cells() > 4096)
     for (int pencil = 0; pencil < total; ++pencil) {
       const std::ptrdiff_t base = P.base(g, d, pencil % P.count_a, pencil / P.count_a);
-      // Face f lies between cells f - 1 and f; the high face of cell f - 1 carries over.
-      double high_of_left[7], minus_of_right[7], plus_of_right[7];
-      cell_faces(base - s, s, un_index, minus_of_right, high_of_left);
-      for (int f = 0; f <= P.length; ++f) {
-        const std::ptrdiff_t cR = base + f * s, cL = cR - s;
-        cell_faces(cR, s, un_index, minus_of_right, plus_of_right);
-        double left[7], right[7];
+      // Face f lies between cells f - 1 and f. A block of faces f0 .. f1 - 1 first
+      // reconstructs both face states of its cells f0 - 1 .. f1 - 1 (each cell's slopes
+      // once, field by field: simple loops without a dependence from one cell to the next),
+      // then solves the faces' Riemann problems.
+      for (int f0 = 0; f0 <= P.length; f0 += face_block) {
+        const int f1 = std::min(f0 + face_block, P.length + 1);
+        const int cells = f1 - f0 + 1;
+        const std::ptrdiff_t c0 = base + (f0 - 1) * s;  // the block's cell q is c0 + q s
+        FaceStates minus, plus;
         for (int v = 0; v < 7; ++v) {
-          left[v] = high_of_left[v];
-          right[v] = minus_of_right[v];
-          high_of_left[v] = plus_of_right[v];
-        }
-        if (walls) {
-          // Beside a wall the mirror ghost makes every even field a local extremum, and the
-          // limiter would flatten the wall cell to first order (a hydrostatic layer would then
-          // carry O(h) spurious velocities there). Even fields take a one-sided interior
-          // slope instead (zero if a face value would leave [x/2, 2x]); u_z, odd, keeps the
-          // mirror. The wall's own Riemann problem is the exact mirror image of the wall
-          // cell's face state, so its mass and energy fluxes vanish by symmetry too.
-          // The slope is the second-order one-sided difference (-3 x0 + 4 x1 - x2) / 2, exact
-          // for quadratics like the interior central slope: the wall cell's face values then
-          // carry the interior's O(h^2) error, and the jump at its interior face stays O(h^3).
-          // The plain difference x1 - x0 is the slope at that face, not at the cell centre
-          // (twice the centre slope of an even field): its O(h^2) jump, times the sound speed
-          // in the Riemann flux's dissipation, was an O(h) truncation error in the wall cell
-          // and a first-order density error there (MMS full_walls, n Linf pair orders 80 ->
-          // 640 cells: 1.58 1.46 1.11 with x1 - x0; 1.97 2.00 to 320 cells with this slope).
-          const int un = 1 + d;
-          const auto wall_cell = [&](std::ptrdiff_t c, std::ptrdiff_t interior_step, double sign,
-                                     double* face) {
-            for (int v = 0; v < 7; ++v) {
-              if (v == un) continue;
-              const double x0 = fields[v][c];
-              const double half_slope =
-                  0.25 * (4.0 * fields[v][c + interior_step] - 3.0 * x0 -
-                          fields[v][c + 2 * interior_step]);
-              const double value = x0 + sign * half_slope, other = x0 - sign * half_slope;
-              const bool keep = value >= 0.5 * x0 && value <= 2.0 * x0 && other >= 0.5 * x0 &&
-                                other <= 2.0 * x0;
-              face[v] = keep ? value : x0;
-            }
-          };
-          const auto mirror = [&](const double* from, double* to) {
-            for (int v = 0; v < 7; ++v) to[v] = v == un ? -from[v] : from[v];
-          };
-          // sign: +1 when the wanted face lies on the interior side of the cell centre
-          if (f == 0) {
-            wall_cell(cR, s, -1.0, right);
-            mirror(right, left);
-          } else if (f == P.length) {
-            wall_cell(cL, -s, -1.0, left);
-            mirror(left, right);
-          } else {
-            if (f == 1) wall_cell(cL, s, +1.0, left);
-            if (f == P.length - 1) wall_cell(cR, -s, +1.0, right);
+          const double* x = fields[v];
+          for (int q = 0; q < cells; ++q) {
+            const std::ptrdiff_t c = c0 + q * s;
+            reconstruct<L>(x[c - s], x[c], x[c + s], minus[v][q], plus[v][q]);
           }
         }
-        if (pressure) {
-          std::swap(left[4], left[5]);  // left[5] = p, left[4] = T
-          std::swap(right[4], right[5]);
-          left[4] = left[5] / (left[0] * left[4]);
-          right[4] = right[5] / (right[0] * right[4]);
-          // Near vacuum the independently limited n, p and chi can combine into a face
-          // temperature far outside the neighbouring cells' range; such a side falls back to
-          // its cell average (first order there). The band is a factor of 2 around the range,
-          // so smooth flow (where p / (n chi) differs from T by O(h)) never triggers it.
-          const double* T = w[4].data();
-          const auto outside = [](double x, double a, double b, double c) {
-            return !(x >= 0.5 * std::min({a, b, c}) && x <= 2.0 * std::max({a, b, c}));
-          };
-          if (outside(left[4], T[cL - s], T[cL], T[cR])) cell_state(cL, left);
-          if (outside(right[4], T[cL], T[cR], T[cR + s])) cell_state(cR, right);
-        } else {
-          left[5] = right[5] = 0.0;
-        }
-        const int un = 1 + d, u1 = 1 + (d + 1) % 3, u2 = 1 + (d + 2) % 3;
-        const FaceState SL{left[0], left[un], left[u1], left[u2], left[4], left[5], left[6]};
-        const FaceState SR{right[0], right[un], right[u1], right[u2], right[4], right[5], right[6]};
-        double F[5];
-        riemann_flux<R>(SL, SR, F);
-        if (walls && (f == 0 || f == P.length)) F[0] = F[2] = F[3] = F[4] = 0.0;
-        double global[variable_count];
-        global[density] = F[0];
-        global[energy] = F[4];
-        global[normal] = F[1];
-        global[tangential1] = F[2];
-        global[tangential2] = F[3];
-        for (int v = 0; v < variable_count; ++v) {
-          const double change = global[v] * inv_h;
-          if (f < P.length) dUdt.q[v][cR] += change;
-          if (f > 0) dUdt.q[v][cL] -= change;
+        if (pressure)
+          for (int q = 0; q < cells; ++q) characteristic(c0 + q * s, s, un_index, q, minus, plus);
+        for (int f = f0; f < f1; ++f) {
+          const int q = f - f0 + 1;  // the block index of cell f
+          const std::ptrdiff_t cR = base + f * s, cL = cR - s;
+          double left[7], right[7];
+          for (int v = 0; v < 7; ++v) {
+            left[v] = plus[v][q - 1];
+            right[v] = minus[v][q];
+          }
+          if (walls) {
+            // Beside a wall the mirror ghost makes every even field a local extremum, and the
+            // limiter would flatten the wall cell to first order (a hydrostatic layer would then
+            // carry O(h) spurious velocities there). Even fields take a one-sided interior
+            // slope instead (zero if a face value would leave [x/2, 2x]); u_z, odd, keeps the
+            // mirror. The wall's own Riemann problem is the exact mirror image of the wall
+            // cell's face state, so its mass and energy fluxes vanish by symmetry too.
+            // The slope is the second-order one-sided difference (-3 x0 + 4 x1 - x2) / 2, exact
+            // for quadratics like the interior central slope: the wall cell's face values then
+            // carry the interior's O(h^2) error, and the jump at its interior face stays O(h^3).
+            // The plain difference x1 - x0 is the slope at that face, not at the cell centre
+            // (twice the centre slope of an even field): its O(h^2) jump, times the sound speed
+            // in the Riemann flux's dissipation, was an O(h) truncation error in the wall cell
+            // and a first-order density error there (MMS full_walls, n Linf pair orders 80 ->
+            // 640 cells: 1.58 1.46 1.11 with x1 - x0; 1.97 2.00 to 320 cells with this slope).
+            const int un = 1 + d;
+            const auto wall_cell = [&](std::ptrdiff_t c, std::ptrdiff_t interior_step, double sign,
+                                       double* face) {
+              for (int v = 0; v < 7; ++v) {
+                if (v == un) continue;
+                const double x0 = fields[v][c];
+                const double half_slope =
+                    0.25 * (4.0 * fields[v][c + interior_step] - 3.0 * x0 -
+                            fields[v][c + 2 * interior_step]);
+                const double value = x0 + sign * half_slope, other = x0 - sign * half_slope;
+                const bool keep = value >= 0.5 * x0 && value <= 2.0 * x0 && other >= 0.5 * x0 &&
+                                  other <= 2.0 * x0;
+                face[v] = keep ? value : x0;
+              }
+            };
+            const auto mirror = [&](const double* from, double* to) {
+              for (int v = 0; v < 7; ++v) to[v] = v == un ? -from[v] : from[v];
+            };
+            // sign: +1 when the wanted face lies on the interior side of the cell centre
+            if (f == 0) {
+              wall_cell(cR, s, -1.0, right);
+              mirror(right, left);
+            } else if (f == P.length) {
+              wall_cell(cL, -s, -1.0, left);
+              mirror(left, right);
+            } else {
+              if (f == 1) wall_cell(cL, s, +1.0, left);
+              if (f == P.length - 1) wall_cell(cR, -s, +1.0, right);
+            }
+          }
+          if (pressure) {
+            std::swap(left[4], left[5]);  // left[5] = p, left[4] = chi
+            std::swap(right[4], right[5]);
+            left[4] = left[5] / (left[0] * left[4]);
+            right[4] = right[5] / (right[0] * right[4]);
+            // Near vacuum the independently limited n, p and chi can combine into a face
+            // temperature far outside the neighbouring cells' range; such a side falls back to
+            // its cell average (first order there). The band is a factor of 2 around the range,
+            // so smooth flow (where p / (n chi) differs from T by O(h)) never triggers it.
+            const double* T = w[4].data();
+            const auto outside = [](double x, double a, double b, double c) {
+              return !(x >= 0.5 * std::min({a, b, c}) && x <= 2.0 * std::max({a, b, c}));
+            };
+            if (outside(left[4], T[cL - s], T[cL], T[cR])) cell_state(cL, left);
+            if (outside(right[4], T[cL], T[cR], T[cR + s])) cell_state(cR, right);
+          } else {
+            left[5] = right[5] = 0.0;
+          }
+          const int un = 1 + d, u1 = 1 + (d + 1) % 3, u2 = 1 + (d + 2) % 3;
+          const FaceState SL{left[0], left[un], left[u1], left[u2], left[4], left[5], left[6]};
+          const FaceState SR{right[0], right[un], right[u1], right[u2], right[4], right[5], right[6]};
+          double F[5];
+          riemann_flux<R>(SL, SR, F);
+          if (walls && (f == 0 || f == P.length)) F[0] = F[2] = F[3] = F[4] = 0.0;
+          double global[variable_count];
+          global[density] = F[0];
+          global[energy] = F[4];
+          global[normal] = F[1];
+          global[tangential1] = F[2];
+          global[tangential2] = F[3];
+          for (int v = 0; v < variable_count; ++v) {
+            const double change = global[v] * inv_h;
+            if (f < P.length) dUdt.q[v][cR] += change;
+            if (f > 0) dUdt.q[v][cL] -= change;
+          }
         }
       }
     }

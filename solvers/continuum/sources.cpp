@@ -17,28 +17,44 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
   const double force = body_force(t);
   const bool loss = settings_.terms.collisional_loss;
   const bool external = static_cast<bool>(external_source);
-  // The external source is a user callback: it stays serial.
   double body = 0.0, lost = 0.0;
+  const double* N = U.q[density].data();
+  const double* Mz = U.q[momentum_z].data();
+  const double* gamma = closure_.loss.data();
+  double* dMz = dUdt.q[momentum_z].data();
+  double* dE = dUdt.q[energy].data();
+  // Cells first .. first + count - 1 (contiguous), summed in storage order.
+  const auto run = [&](std::ptrdiff_t first, std::ptrdiff_t count, double& body_sum, double& lost_sum) {
+    for (std::ptrdiff_t c = first; c < first + count; ++c) {
+      dMz[c] += N[c] * force;
+      dE[c] += Mz[c] * force;
+      body_sum += Mz[c] * force;
+      if (loss) {
+        dE[c] -= gamma[c];
+        lost_sum += gamma[c];
+      }
+    }
+  };
+  if (g.dimension != 3) {
+    run(g.row_start(0), g.row_length(), body, lost);
+  } else {
 #pragma omp parallel for schedule(static) reduction(+ : body, lost) if (g.nz > 1 && g.interior_cells() > 4096 && !external)
-  for (int k = 0; k < g.nz; ++k)
-    for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const std::ptrdiff_t c = g.index(i, j, k);
-        dUdt.q[momentum_z][c] += U.q[density][c] * force;
-        dUdt.q[energy][c] += U.q[momentum_z][c] * force;
-        body += U.q[momentum_z][c] * force;
-        if (loss) {
-          dUdt.q[energy][c] -= closure_.loss[c];
-          lost += closure_.loss[c];
-        }
-        if (external) {
+    for (int k = 0; k < g.nz; ++k)
+      for (int j = 0; j < g.ny; ++j) run(g.index(0, j, k), g.nx, body, lost);
+  }
+  // The external source is a user callback: it stays serial.
+  if (external) {
+    for (int k = 0; k < g.nz; ++k)
+      for (int j = 0; j < g.ny; ++j)
+        for (int i = 0; i < g.nx; ++i) {
+          const std::ptrdiff_t c = g.index(i, j, k);
           double extra[variable_count] = {0, 0, 0, 0, 0};
           const double x = g.dimension == 3 ? g.center(i) : 0.0;
           const double y = g.dimension == 3 ? g.center(j) : 0.0;
           external_source(t, x, y, g.center(k), extra);
           for (int v = 0; v < variable_count; ++v) dUdt.q[v][c] += extra[v];
         }
-      }
+  }
   // Per unit plate area: a cell holds h / (nx ny) of the column (1D: nx = ny = 1).
   const double per_area = g.h / (static_cast<double>(g.nx) * g.ny);
   source_power_ = SourcePower{body * per_area, lost * per_area};

@@ -17,26 +17,35 @@ TimeIntegrator::TimeIntegrator(const Grid& grid, const PhysicsSettings& physics,
 void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y,
                           double c, const State& k) const {
   const Grid& g = op_.grid();
-#pragma omp parallel for schedule(dynamic, 2) if (g.interior_cells() > 4096)
-  for (int kz = 0; kz < g.nz; ++kz)
-    for (int j = 0; j < g.ny; ++j) {
-      const std::ptrdiff_t first = g.index(0, j, kz);
-      for (int v = 0; v < variable_count; ++v) {
-        const double* X = x.q[v].data() + first;
-        const double* Y = y.q[v].data() + first;
-        const double* Kv = k.q[v].data() + first;
-        double* O = out.q[v].data() + first;
-        for (int i = 0; i < g.nx; ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
-      }
+  const int length = g.row_length();
+  // One contiguous run of interior cells (a whole 1D column, or one x row in 3D).
+  const auto run = [&](int row) {
+    const std::ptrdiff_t first = g.row_start(row);
+    for (int v = 0; v < variable_count; ++v) {
+      const double* X = x.q[v].data() + first;
+      const double* Y = y.q[v].data() + first;
+      const double* Kv = k.q[v].data() + first;
+      double* O = out.q[v].data() + first;
+      for (int i = 0; i < length; ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
     }
+  };
+  const int rows = g.interior_rows();
+  if (g.interior_cells() > 4096) {
+#pragma omp parallel for schedule(dynamic, 2 * g.ny)
+    for (int row = 0; row < rows; ++row) run(row);
+  } else {
+    for (int row = 0; row < rows; ++row) run(row);
+  }
 }
 
 double TimeIntegrator::total_energy() const {
   const Grid& g = op_.grid();
   double sum = 0.0;
-  for (int k = 0; k < g.nz; ++k)
-    for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) sum += U_.q[energy][g.index(i, j, k)];
+  const double* E = U_.q[energy].data();
+  for (int row = 0; row < g.interior_rows(); ++row) {
+    const std::ptrdiff_t first = g.row_start(row);
+    for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) sum += E[c];
+  }
   return sum * g.h / (static_cast<double>(g.nx) * g.ny);
 }
 
@@ -45,28 +54,37 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
   const double floor = settings_.temperature_floor;
   std::int64_t floors = 0;
   double raised = 0.0;
-  for (int k = 0; k < g.nz; ++k)
-    for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) {
-        const std::ptrdiff_t c = g.index(i, j, k);
-        const double n = s.q[density][c];
-        bool finite = std::isfinite(n) && std::isfinite(s.q[energy][c]);
-        for (int v = momentum_x; v <= momentum_z; ++v) finite = finite && std::isfinite(s.q[v][c]);
-        if (!finite || !(n > 0.0) || !(volume_fraction(n) < nu_max)) {
-          failure = fmt::format("t = {:.10g}, cell (i, j, k) = ({}, {}, {}) at z = {:.6g}: n = {:.6g}, "
-                                "E = {:.6g} (need 0 < nu < nu_max and finite values)",
-                                t, i, j, k, g.center(k), n, s.q[energy][c]);
-          return false;
-        }
-        const double kinetic = 0.5 * (s.q[momentum_x][c] * s.q[momentum_x][c] +
-                                      s.q[momentum_y][c] * s.q[momentum_y][c] +
-                                      s.q[momentum_z][c] * s.q[momentum_z][c]) / n;
-        if (s.q[energy][c] - kinetic < 1.5 * n * floor) {
-          raised += kinetic + 1.5 * n * floor - s.q[energy][c];
-          s.q[energy][c] = kinetic + 1.5 * n * floor;
-          ++floors;
-        }
+  double* N = s.q[density].data();
+  double* Mx = s.q[momentum_x].data();
+  double* My = s.q[momentum_y].data();
+  double* Mz = s.q[momentum_z].data();
+  double* E = s.q[energy].data();
+  // Storage order is (k, j, i) order: the first failing cell and the floor sums are those of
+  // the triple loop.
+  for (int row = 0; row < g.interior_rows(); ++row) {
+    const std::ptrdiff_t first = g.row_start(row);
+    for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) {
+      const double n = N[c];
+      const bool finite = std::isfinite(n) && std::isfinite(E[c]) && std::isfinite(Mx[c]) &&
+                          std::isfinite(My[c]) && std::isfinite(Mz[c]);
+      if (!finite || !(n > 0.0) || !(volume_fraction(n) < nu_max)) {
+        const std::ptrdiff_t from_plane = c - g.index(0, 0, 0);
+        const auto k = static_cast<int>(from_plane / g.stride_z());
+        const auto j = static_cast<int>((c - g.index(0, 0, k)) / g.stride_y());
+        const auto i = static_cast<int>(c - g.index(0, j, k));
+        failure = fmt::format("t = {:.10g}, cell (i, j, k) = ({}, {}, {}) at z = {:.6g}: n = {:.6g}, "
+                              "E = {:.6g} (need 0 < nu < nu_max and finite values)",
+                              t, i, j, k, g.center(k), n, E[c]);
+        return false;
       }
+      const double kinetic = 0.5 * (Mx[c] * Mx[c] + My[c] * My[c] + Mz[c] * Mz[c]) / n;
+      if (E[c] - kinetic < 1.5 * n * floor) {
+        raised += kinetic + 1.5 * n * floor - E[c];
+        E[c] = kinetic + 1.5 * n * floor;
+        ++floors;
+      }
+    }
+  }
   counters_.temperature_floor_uses += floors;
   if (added) *added = raised * g.h / (static_cast<double>(g.nx) * g.ny);
   return true;

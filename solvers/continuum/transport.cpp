@@ -5,32 +5,99 @@
 // their 1/G terms (the model functions do that) and adds the artificial dissipation of
 // ArtificialDissipation (operator.hpp), which acts only where nu is well below
 // artificial.volume_fraction.
+//
+// Speed: the closure is a chain of divisions, square roots and a pow per cell, whose latency
+// dominated a cell update when evaluated cell by cell. The model's functions are templates
+// over the scalar type, so the same definitions are evaluated here on Lanes, a few cells at
+// once: every lane does exactly the arithmetic of the double version (the same operations in
+// the same order, pow and sqrt per lane), so the values are bit for bit those of a cell-by-cell
+// evaluation, while the lanes' independent chains overlap and the arithmetic vectorises.
+// A group of cells any of which is outside the model's domain is evaluated cell by cell
+// instead, which throws the model's own DomainError for the first such cell.
+#include <algorithm>
 #include <cmath>
 #include <exception>
+#include <type_traits>
 
 #include "continuum/operator.hpp"
 
 namespace shaker::continuum {
 
 namespace {
-struct CellClosure {
-  double p, c, mu, lambda, kappa, loss;
+
+/// W cells' values of one scalar; the arithmetic the model templates use, lane by lane.
+template <int W> struct Lanes {
+  double v[W];
+  Lanes() = default;
+  Lanes(double x) {  // NOLINT: implicit, like the double operands of the model's formulas
+    for (double& e : v) e = x;
+  }
+  /// The model's domain checks look at value_of(x); every lane is checked before evaluation.
+  double value() const { return v[0]; }
+  friend Lanes operator+(const Lanes& a, const Lanes& b) {
+    Lanes r;
+    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] + b.v[l];
+    return r;
+  }
+  friend Lanes operator-(const Lanes& a, const Lanes& b) {
+    Lanes r;
+    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] - b.v[l];
+    return r;
+  }
+  friend Lanes operator*(const Lanes& a, const Lanes& b) {
+    Lanes r;
+    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] * b.v[l];
+    return r;
+  }
+  friend Lanes operator/(const Lanes& a, const Lanes& b) {
+    Lanes r;
+    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] / b.v[l];
+    return r;
+  }
+  Lanes& operator+=(const Lanes& b) { return *this = *this + b; }
+  friend Lanes sqrt(const Lanes& a) {
+    Lanes r;
+    for (int l = 0; l < W; ++l) r.v[l] = std::sqrt(a.v[l]);
+    return r;
+  }
+  friend Lanes pow(const Lanes& a, double b) {
+    Lanes r;
+    for (int l = 0; l < W; ++l) r.v[l] = std::pow(a.v[l], b);
+    return r;
+  }
 };
+constexpr int lane_count = 4;
+using Cells = Lanes<lane_count>;
+
+template <class S> struct CellClosure {
+  S p, c, mu, lambda, kappa, loss;
+};
+
+/// Whether evaluate() calls the model (and so requires 0 < nu < nu_max).
+bool needs_model(const PhysicsSettings& s, bool need_transport) {
+  const Terms& terms = s.terms;
+  const bool ideal = s.eos == EquationOfState::ideal_gas;
+  const bool transport = need_transport && (terms.shear_viscosity || terms.bulk_viscosity || terms.conduction);
+  return (terms.pressure && !ideal) || terms.collisional_loss || transport;
+}
 
 // One fused evaluation of the model per cell (model::constitutive_values: G once), and only
 // when some enabled term needs it.
-CellClosure evaluate(const PhysicsSettings& s, double n, double T, double h, bool need_transport) {
-  CellClosure r{0, 0, 0, 0, 0, 0};
+template <class S>
+CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double h, bool need_transport) {
+  using std::sqrt;
+  CellClosure<S> r{0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   const Terms& terms = s.terms;
   const bool ideal = s.eos == EquationOfState::ideal_gas;
   if (ideal && terms.pressure) {
-    if (!(T >= 0.0)) model::detail::domain_failure("ideal gas", "T", T, "T >= 0");
+    if constexpr (std::is_arithmetic_v<S>) {
+      if (!(T >= 0.0)) model::detail::domain_failure("ideal gas", "T", T, "T >= 0");
+    }
     r.p = n * T;
-    r.c = std::sqrt(5.0 / 3.0 * T);
+    r.c = sqrt(5.0 / 3.0 * T);
   }
-  const bool transport = need_transport && (terms.shear_viscosity || terms.bulk_viscosity || terms.conduction);
-  if (!((terms.pressure && !ideal) || terms.collisional_loss || transport)) return r;
-  const model::ConstitutiveValues<double> m = model::constitutive_values(n, T, s.e, s.transport);
+  if (!needs_model(s, need_transport)) return r;
+  const model::ConstitutiveValues<S> m = model::constitutive_values(n, T, s.e, s.transport);
   if (terms.pressure && !ideal) {
     r.p = m.pressure;
     r.c = m.sound_speed;
@@ -41,9 +108,9 @@ CellClosure evaluate(const PhysicsSettings& s, double n, double T, double h, boo
   if (terms.bulk_viscosity) r.lambda = m.bulk_viscosity;
   if (terms.conduction) r.kappa = m.thermal_conductivity;
   if (s.transport == model::Transport::paper && terms.artificial_dissipation) {
-    const double x = volume_fraction(n) / s.artificial.volume_fraction;
-    const double x2 = x * x;
-    const double weight = n * h * r.c / (1.0 + x2 * x2);
+    const S x = volume_fraction(n) / s.artificial.volume_fraction;
+    const S x2 = x * x;
+    const S weight = n * h * r.c / (1.0 + x2 * x2);
     if (terms.shear_viscosity) r.mu += s.artificial.viscosity * weight;
     if (terms.conduction) r.kappa += s.artificial.conductivity * weight;
   }
@@ -55,37 +122,85 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
   const Grid& g = grid_;
   const double h = g.h;
   transport_evaluated_ = need_transport;
-  // Interior cells only (ghosts copy theirs afterwards), row by row along x. Dynamic
-  // scheduling: on a shared machine a thread that is held up does not hold up the other.
-  const int rows = g.ny * g.nz;
-  // An exception must not leave an OpenMP region: the first failure is kept and rethrown.
-  std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic, 16) if (g.interior_cells() > 4096)
-  for (int row = 0; row < rows; ++row) {
-    const std::ptrdiff_t first = g.index(0, row % g.ny, row / g.ny);
-    for (std::ptrdiff_t c = first; c < first + g.nx; ++c) {
+  const bool model_needed = needs_model(settings_, need_transport);
+  const bool e_valid = settings_.e >= 0.0 && settings_.e <= 1.0;
+  const double* N = U.q[density].data();
+  const double* Mx = U.q[momentum_x].data();
+  const double* My = U.q[momentum_y].data();
+  const double* Mz = U.q[momentum_z].data();
+  const double* E = U.q[energy].data();
+  double* wn = w_[0].data();
+  double* wx = w_[1].data();
+  double* wy = w_[2].data();
+  double* wz = w_[3].data();
+  double* wT = w_[4].data();
+  Closure& cl = closure_;
+  const auto store = [&](std::ptrdiff_t c, const CellClosure<double>& r) {
+    cl.p[c] = r.p;
+    cl.c[c] = r.c;
+    cl.chi[c] = wT[c] > 0.0 ? r.p / (wn[c] * wT[c]) : 1.0;
+    cl.mu[c] = r.mu;
+    cl.lambda[c] = r.lambda;
+    cl.kappa[c] = r.kappa;
+    cl.loss[c] = r.loss;
+  };
+  // One contiguous run of interior cells (ghosts copy theirs afterwards): the primitives
+  // (what to_primitive computes, as one vectorisable loop), then the closure lane group by
+  // lane group.
+  const int length = g.row_length();
+  const auto run = [&](int row) {
+    const std::ptrdiff_t first = g.row_start(row), end = first + length;
+    for (std::ptrdiff_t c = first; c < end; ++c) {
+      const double n = N[c];
+      const double inv = 1.0 / n;
+      const double ux = Mx[c] * inv, uy = My[c] * inv, uz = Mz[c] * inv;
+      const double kinetic = 0.5 * (Mx[c] * ux + My[c] * uy + Mz[c] * uz);
+      wn[c] = n;
+      wx[c] = ux;
+      wy[c] = uy;
+      wz[c] = uz;
+      // E - kinetic loses digits in fast, cold, dilute cells: a round-off negative is zero.
+      wT[c] = std::max(0.0, (E[c] - kinetic) * inv / 1.5);
+    }
+    for (std::ptrdiff_t c = first; c < end; c += lane_count) {
+      const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(lane_count, end - c));
+      Cells n, T;
+      bool valid = e_valid;
+      for (int l = 0; l < lane_count; ++l) {
+        const std::ptrdiff_t cell = c + std::min(l, lanes - 1);  // a short group repeats its last cell
+        n.v[l] = wn[cell];
+        T.v[l] = wT[cell];
+        const double nu = volume_fraction(n.v[l]);
+        valid = valid && T.v[l] >= 0.0 && (!model_needed || (nu > 0.0 && nu < nu_max));
+      }
+      if (!valid) {  // cell by cell: the first cell outside the domain throws
+        for (int l = 0; l < lanes; ++l) store(c + l, evaluate(settings_, wn[c + l], wT[c + l], h, need_transport));
+        continue;
+      }
+      const CellClosure<Cells> r = evaluate(settings_, n, T, h, need_transport);
+      for (int l = 0; l < lanes; ++l)
+        store(c + l, CellClosure<double>{r.p.v[l], r.c.v[l], r.mu.v[l], r.lambda.v[l], r.kappa.v[l], r.loss.v[l]});
+    }
+  };
+  const int rows = g.interior_rows();
+  if (g.interior_cells() > 4096) {
+    // Rows of x; dynamic scheduling: on a shared machine a thread that is held up does not
+    // hold up the other. An exception must not leave an OpenMP region: the first failure is
+    // kept and rethrown.
+    std::exception_ptr failure;
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int row = 0; row < rows; ++row) {
       try {
-        const Primitive w = to_primitive(U, static_cast<std::size_t>(c));
-        w_[0][c] = w.n;
-        w_[1][c] = w.ux;
-        w_[2][c] = w.uy;
-        w_[3][c] = w.uz;
-        w_[4][c] = w.T;
-        const CellClosure r = evaluate(settings_, w.n, w.T, h, need_transport);
-        closure_.p[c] = r.p;
-        closure_.c[c] = r.c;
-        closure_.chi[c] = w.T > 0.0 ? r.p / (w.n * w.T) : 1.0;
-        closure_.mu[c] = r.mu;
-        closure_.lambda[c] = r.lambda;
-        closure_.kappa[c] = r.kappa;
-        closure_.loss[c] = r.loss;
+        run(row);
       } catch (...) {
 #pragma omp critical(shaker_closure_failure)
         if (!failure) failure = std::current_exception();
       }
     }
+    if (failure) std::rethrow_exception(failure);
+  } else {
+    for (int row = 0; row < rows; ++row) run(row);
   }
-  if (failure) std::rethrow_exception(failure);
   copy_closure_to_ghosts();
 }
 
