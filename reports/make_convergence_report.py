@@ -50,7 +50,9 @@ import glob
 import math
 import os
 import re
+import shutil
 import sys
+import tempfile
 
 import matplotlib
 
@@ -104,6 +106,30 @@ def read_csv(path, header):
                     raise InputProblem(f"{path}:{number}: {key} = '{cell}' is not a number")
         records.append(record)
     return records
+
+
+TABLES_DIRECTORY = "convergence-tables"
+
+
+def copy_tables(input_dir, files, tables):
+    """Replaces `tables` by a flat copy of the input CSV files, filled aside and renamed into
+    place, so a reader never sees a half-copied set."""
+    parent = os.path.dirname(tables)
+    staging = tempfile.mkdtemp(dir=parent, prefix=".partial-tables-")
+    try:
+        for name in files:
+            shutil.copyfile(os.path.join(input_dir, name),
+                            os.path.join(staging, os.path.basename(name)))
+        old = None
+        if os.path.exists(tables):
+            old = tempfile.mkdtemp(dir=parent, prefix=".old-tables-")
+            os.replace(tables, os.path.join(old, "tables"))
+        os.replace(staging, tables)
+        if old:
+            shutil.rmtree(old)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
 
 
 def read_inputs(directory):
@@ -446,7 +472,11 @@ def main(argv=None):
         lines += ["", "Failing checks (measured values):", ""] + [f"- {f}" for f in failures]
     lines.append("")
     lines += order_lines + gci_lines + sampling_lines + error_tables(series) + plot_lines
-    lines += ["## Input files", ""] + [f"- {f}" for f in files] + [""]
+    tables = os.path.join(out_dir, TABLES_DIRECTORY)
+    lines += ["## Input files", "",
+              f"Copied beside this report into {TABLES_DIRECTORY}/ (the validation report reads "
+              "the real-problem GCI table from there).", ""] + [f"- {f}" for f in files] + [""]
+    copy_tables(args.input, files, tables)
     rc.write_text_atomically(args.output, "\n".join(lines))
     print(f"wrote {args.output}: {checks} checks, {len(failures)} failing")
     return 1 if (args.strict and failures) else 0

@@ -24,6 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 STYLE = {"md": dict(marker="o", ms=3, ls="none"), "continuum": dict(ls="-", lw=1.2)}
 FIG1_PHASES = (0.0, 0.15, 0.22, 0.40)
 FIG2_CASES = (("single_shock_e0p99", "e = 0.99"), ("single_shock_e0p90", "e = 0.90"),
@@ -34,10 +35,26 @@ DEPTHS = (("depth_h4p5", "H = 4.5"), ("base", "H = 9"), ("depth_h13p5", "H = 13.
 # ---- reading -------------------------------------------------------------------------------
 
 class Results:
-    def __init__(self, path):
+    def __init__(self, path, gci_path=None):
         with open(path) as f:
             self.data = json.load(f)
         self.views = self.data["views"]
+        self.gci_path = gci_path
+        self.gci_rows = []
+        if gci_path and os.path.exists(gci_path):
+            with open(gci_path) as f:
+                self.gci_rows = [dict(r) for r in csv.DictReader(f)]
+
+    def gci(self, quantity, cell_size):
+        """The GCI row of the real-problem study whose finest grid is the validation run's
+        cell size (so GCI21 is the discretisation uncertainty of that run's value)."""
+        if cell_size is None:
+            return None
+        for r in self.gci_rows:
+            if r["quantity"] == quantity and math.isclose(float(r["h1"]), cell_size,
+                                                          rel_tol=1e-9):
+                return r
+        return None
 
     def view(self, case, solver):
         v = self.views.get(f"{case}/{solver}")
@@ -394,6 +411,27 @@ def mark(status):
     return {"pass": "pass", "fail": "**FAIL**", "inconclusive": "inconclusive"}.get(status, status)
 
 
+def gci_text(results, claim, value):
+    """The continuum value's grid uncertainty: |value| GCI21 of the real-problem study at
+    the validation run's cell size, for claims whose continuum value that study computes
+    (the claim's `continuum_gci` in reference-data/claims.toml)."""
+    quantity = claim.get("continuum_gci")
+    if not quantity or not isinstance(value, (int, float)):
+        return ""
+    view = results.views.get(f"{claim['cases'][0]}/continuum") or {}
+    cell = view.get("continuum_cell_size")
+    row = results.gci(quantity, cell)
+    if row is None:
+        return f" (GCI: no {quantity} row at cell {cell} in the convergence tables)"
+    gci = float(row["gci21"])
+    if math.isnan(gci):
+        return f" (GCI n/a: {row['convergence']} on cells {row['h1']}, {row['h2']}, {row['h3']})"
+    asymptotic = "asymptotic" if row["pass"].strip() == "1" \
+        else f"not asymptotic, {row['convergence']}"
+    return (f" ± {fmt(abs(value) * gci, 2)} (GCI {fmt(100 * gci, 2)} %, cells {row['h1']}, "
+            f"{row['h2']}, {row['h3']}; {asymptotic})")
+
+
 def solver_cell(results, claim, solver):
     r = claim["per_solver"].get(solver)
     if r is None:
@@ -408,17 +446,25 @@ def solver_cell(results, claim, solver):
                          else f"not measured: {ev['reason']}")
         else:
             bound = " (lower bound)" if ev.get("bound") == "lower" else ""
-            parts.append(f"{value_text(ev['value'], ev.get('error'))}{bound} "
+            grid = gci_text(results, claim, ev["value"]) if solver == "continuum" else ""
+            parts.append(f"{value_text(ev['value'], ev.get('error'))}{grid}{bound} "
                          f"({mark(ev['status'])})")
     return "; ".join(parts)
 
 
 def claims_section(results):
+    gci_source = os.path.relpath(results.gci_path, ROOT) if results.gci_rows else "none found"
     lines = ["## Claims C1 to C20", "",
              "Bands and claims from reference-data/claims.toml. MD uncertainty: jackknife over "
              "the pooled single-shock runs, or the spread of a parametric bootstrap of the "
              "periodic MD profiles over their standard errors (one standard deviation). "
-             "Continuum uncertainty: no grid-convergence index is available to this report yet.",
+             "Continuum uncertainty: Roache's grid-convergence index (Fs = 1.25) of the "
+             "1D base-case grid study (verification/mms/test_real_problem.cpp, tables in "
+             f"{gci_source}) at the validation run's cell "
+             "size, for the claims whose continuum value that study computes (field "
+             "continuum_gci of the claim); the study's shortened run (5 transient cycles, "
+             "one sampled) estimates the discretisation error only. Other continuum values "
+             "carry no uncertainty here.",
              "", "| id | claim | paper | MD | continuum | band | result |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     counts = {}
@@ -487,8 +533,12 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--results", required=True)
     parser.add_argument("--output", required=True)
+    parser.add_argument("--gci", default=os.path.join(ROOT, "reports", "convergence-tables",
+                                                      "real-1d-base.gci.csv"),
+                        help="GCI table of the real-problem grid study (the convergence "
+                             "report copies it there)")
     args = parser.parse_args()
-    results = Results(args.results)
+    results = Results(args.results, args.gci)
     out_dir = os.path.splitext(args.output)[0]
     link = os.path.basename(out_dir)
     body = []

@@ -542,6 +542,9 @@ def main(argv=None):
                         help="where runs, analyses and derived files go (reused across calls)")
     parser.add_argument("--report", default=os.path.join(ROOT, "reports", "validation.md"))
     parser.add_argument("--claims", default=os.path.join(ROOT, "reference-data", "claims.toml"))
+    parser.add_argument("--gci", default=os.path.join(ROOT, "reports", "convergence-tables",
+                                                      "real-1d-base.gci.csv"),
+                        help="GCI table of the base-case grid study (continuum uncertainty)")
     parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
     parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
     parser.add_argument("--bootstrap", type=int, help="bootstrap replicates of MD profiles")
@@ -615,6 +618,8 @@ def main(argv=None):
                                 None,
                                 replicate_kind=v.replicate_kind, replicates=len(v.replicates),
                                 switch_e=v.config.get("run", {}).get("switch_e"),
+                                continuum_cell_size=v.config.get("continuum", {}).get(
+                                    "cell_size") if s == "continuum" else None,
                                 protocol=v.config.get("run", {}).get("protocol"),
                                 collisions_per_second=collisions_per_second(v),
                                 notes=sorted(v.notes))
@@ -626,7 +631,8 @@ def main(argv=None):
 
     report = subprocess.run([sys.executable, os.path.join(ROOT, "reports",
                                                           "make_validation_report.py"),
-                             "--results", results_path, "--output", args.report])
+                             "--results", results_path, "--output", args.report,
+                             "--gci", args.gci])
     if report.returncode != 0:
         log("the report generator failed")
         return 1

@@ -40,11 +40,11 @@ struct ShockCriteria {
 };
 
 struct Shock {
-  double location = 0.0;         ///< height of steepest temperature decrease
+  double location = 0.0;         ///< height of steepest temperature decrease, sub-bin
   double compressed_top = 0.0;   ///< height of the temperature maximum
   double undisturbed_bottom = 0.0;  ///< height of the temperature minimum above it
   double width = 0.0;            ///< d = undisturbed_bottom - compressed_top
-  double mean_free_path = 0.0;   ///< xi at the shock location
+  double mean_free_path = 0.0;   ///< xi at the shock location (n interpolated there)
   double width_over_mfp() const { return width / mean_free_path; }
 };
 /// The shock of physics.md ("Analysis quantities"), or nothing if the profile has none. It is

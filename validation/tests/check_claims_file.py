@@ -87,6 +87,12 @@ def validate(claims, studies):
         if "Sec." not in claim.get("provenance", "") and "Fig." not in claim.get("provenance",
                                                                                    ""):
             errors.append(f"{where}: provenance names no section or figure of the paper")
+        if "continuum_gci" in claim and not (
+                isinstance(claim["continuum_gci"], str) and claim["continuum_gci"]
+                and claim.get("solvers") in ("continuum", "both")
+                and claim.get("cases") == ["base"]):
+            errors.append(f"{where}: continuum_gci must name a quantity of the base-case grid "
+                          "study, for a claim on the base case with a continuum value")
         check_one(claim, claim, where, errors)
         for i, extra_check in enumerate(claim.get("also", [])):
             check_one(extra_check, claim, f"{where} (also #{i + 1})", errors)
@@ -107,6 +113,8 @@ def broken_copies(claims):
         ("case nobody runs", edit(lambda c: c[0].update(cases=["no_such_case"]))),
         ("missing parameter", edit(lambda c: c[4].update(parameters={}))),
         ("unknown comparison", edit(lambda c: c[1].update(comparison="about"))),
+        ("GCI for a claim without one base-case continuum value",
+         edit(lambda c: c[16].update(continuum_gci="max_mach"))),
     ]
 
 

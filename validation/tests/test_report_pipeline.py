@@ -8,8 +8,9 @@ reuses; run_validation.py --reuse-only then analyses them with the real `shaker 
 Checks: every claim id C1..C20 in the claims table, pass, FAIL and "not measured" marks all
 present, the seven figure PNGs exist and are non-empty, no run was re-simulated, values the
 cartoon fixes exactly (particles per cycle above z = 80 from the crossings column: 0.3 and 5;
-the collapse detected from the recorded exit status) come out exactly, and --require sets the
-exit status (0 for a passing claim, 1 for a failing one).
+the collapse detected from the recorded exit status) come out exactly, the continuum GCI of a
+synthetic grid-study table reaches the claims table (C6) or its absence is said (C5), and
+--require sets the exit status (0 for a passing claim, 1 for a failing one).
 
     test_report_pipeline.py --shaker SHAKER
 """
@@ -30,10 +31,25 @@ FIGURES = ("fig1-profiles.png", "fig2-single-shock.png", "fig3-mach.png", "fig4-
            "fig5-shock-speed.png", "fig6-restitution-models.png", "fig7-depths.png")
 
 
-def run_validation(shaker, workdir, report, require):
+GCI_HEADER = ("study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,"
+              "relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,"
+              "convergence,asymptotic_tolerance,pass")
+
+
+def write_gci_table(path):
+    """A GCI of 2 % for C6's quantity at every cell size the quick cases might use, and no row
+    for C5's, so the report must show one uncertainty and say why the other is missing."""
+    with open(path, "w") as f:
+        f.write(GCI_HEADER + "\n")
+        for h in (0.05, 0.1, 0.2, 0.25, 0.4, 0.5, 1.0):
+            f.write(f"synthetic,max_mach_ft0.08-0.13,{h},{2 * h},{4 * h},11,11.1,11.3,2,10.97,"
+                    "0.009,0.003,0.02,0.04,1.0,monotonic,0.1,1\n")
+
+
+def run_validation(shaker, workdir, report, require, gci):
     cmd = [sys.executable, os.path.join(VALIDATION, "run_validation.py"), "--shaker", shaker,
            "--workdir", workdir, "--report", report, "--cases", CASES, "--quick",
-           "--reuse-only", "--require", require]
+           "--reuse-only", "--require", require, "--gci", gci]
     result = subprocess.run(cmd, capture_output=True, text=True)
     return result.returncode, result.stdout + result.stderr
 
@@ -56,7 +72,9 @@ def main():
                           capture_output=True, text=True)
     expect(made.returncode == 0, f"synthetic run files written ({made.stderr.strip()[-300:]})")
 
-    rc, output = run_validation(shaker, workdir, report, "C18")
+    gci = os.path.join(tmp, "real-1d-base.gci.csv")
+    write_gci_table(gci)
+    rc, output = run_validation(shaker, workdir, report, "C18", gci)
     expect(rc == 0, f"--require C18 (a passing claim) exits 0 (got {rc})")
     if rc not in (0, 1):
         print(output)
@@ -97,7 +115,17 @@ def main():
     expect(claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None,
            "C14 has a jackknife error from the pooled runs")
 
-    rc, _ = run_validation(shaker, workdir, report, "C3")
+    c6, c5 = rows.get("C6", "").split(" | "), rows.get("C5", "").split(" | ")
+    c6_continuum = c6[4] if len(c6) > 4 else ""
+    shown = re.search(r"([0-9.eE+-]+) ± ([0-9.eE+-]+) \(GCI 2 %", c6_continuum)
+    expect(shown is not None and abs(float(shown.group(2)) - 0.02 * abs(float(shown.group(1))))
+           <= 0.01 * abs(float(shown.group(1))),
+           f"C6 continuum value carries its GCI, 2 % of the value: '{c6_continuum}'")
+    expect(len(c5) > 4 and "no shock_width_ft0.22 row" in c5[4],
+           f"C5 says its GCI row is missing: '{c5[4] if len(c5) > 4 else ''}'")
+    expect("GCI" not in (c6[3] if len(c6) > 3 else "GCI"), "the MD value carries no GCI")
+
+    rc, _ = run_validation(shaker, workdir, report, "C3", gci)
     expect(rc == 1, f"--require C3 (failing on the cartoon) exits 1 (got {rc})")
 
     if problems:

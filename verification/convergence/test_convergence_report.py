@@ -8,6 +8,7 @@ sampling section (slope fits against K^-1/2, the se table, its plot, the bin-siz
 a synthetic sampling study.
 """
 import math
+import glob
 import os
 import re
 import shutil
@@ -170,8 +171,21 @@ try:
     check(os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
           and os.path.getsize(png) > 5000, "PNG plot missing or not a PNG")
     check("![synthetic-1d-space](convergence-synthetic-1d-space.png)" in text, "plot not linked")
-    leftovers = [f for f in os.listdir(out_dir) if f.startswith(".partial")]
+    leftovers = [f for f in os.listdir(out_dir) if f.startswith((".partial", ".old"))]
     check(not leftovers, f"temporary files left: {leftovers}")
+    # Every input table is kept beside the report, flat (the nested GCI table too), byte for
+    # byte; a second run replaces the set rather than mixing old and new files.
+    tables = os.path.join(out_dir, "convergence-tables")
+    copied = sorted(os.listdir(tables)) if os.path.isdir(tables) else []
+    expected = sorted(os.path.basename(p) for p in glob.glob(os.path.join(inputs, "**", "*.csv"),
+                                                              recursive=True))
+    check(copied == expected, f"tables copied {copied}, expected {expected}")
+    check(open(os.path.join(tables, "qoi.gci.csv")).read()
+          == open(os.path.join(inputs, "nested", "qoi.gci.csv")).read(), "GCI table altered")
+    open(os.path.join(tables, "stale.errors.csv"), "w").close()
+    check(run("--input", inputs, "--output", report).returncode == 0, "second report run failed")
+    check(not os.path.exists(os.path.join(tables, "stale.errors.csv")),
+          "a stale table survived the second run")
 
     strict = run("--input", inputs, "--output", os.path.join(work, "strict", "c.md"), "--strict")
     check(strict.returncode == 1, f"--strict with failures must exit 1, got {strict.returncode}")
