@@ -16,6 +16,8 @@ Operator::Operator(const Grid& grid, const PhysicsSettings& settings)
   for (auto& v : w_) v.assign(cells, 0.0);
   for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa, &closure_.loss})
     v->assign(cells, 0.0);
+  pow_argument_.assign(cells, std::numeric_limits<double>::quiet_NaN());  // matches nothing
+  pow_value_.assign(cells, 0.0);
 }
 
 void Operator::rhs(double t, State& U, State& dUdt, Part part) {

@@ -114,6 +114,8 @@ class Operator {
   std::array<std::vector<double>, variable_count> w_;  ///< n, ux, uy, uz, T
   Closure closure_;
   bool transport_evaluated_ = false;
+  /// Per cell: the last argument of the closure's pow and its value (transport.cpp).
+  std::vector<double> pow_argument_, pow_value_;
   SourcePower source_power_;
 };
 

@@ -59,6 +59,25 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
   double* My = s.q[momentum_y].data();
   double* Mz = s.q[momentum_z].data();
   double* E = s.q[energy].data();
+  // Almost always every cell is admissible and above the floor: one branch-free scan (which
+  // vectorises) establishes that, and only otherwise the cell-by-cell pass below runs.
+  bool suspect = false;
+  for (int row = 0; row < g.interior_rows(); ++row) {
+    const std::ptrdiff_t first = g.row_start(row);
+    for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) {
+      const double n = N[c];
+      const double kinetic = 0.5 * (Mx[c] * Mx[c] + My[c] * My[c] + Mz[c] * Mz[c]) / n;
+      // NaN and infinities fail the comparisons: a non-finite n, E or momentum makes the cell
+      // suspect through n or through E - kinetic.
+      const bool fine = n > 0.0 && volume_fraction(n) < nu_max && E[c] - kinetic >= 1.5 * n * floor &&
+                        E[c] - kinetic < std::numeric_limits<double>::infinity();
+      suspect = suspect || !fine;
+    }
+  }
+  if (!suspect) {
+    if (added) *added = 0.0;
+    return true;
+  }
   // Storage order is (k, j, i) order: the first failing cell and the floor sums are those of
   // the triple loop.
   for (int row = 0; row < g.interior_rows(); ++row) {

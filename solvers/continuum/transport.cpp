@@ -60,12 +60,35 @@ template <int W> struct Lanes {
     for (int l = 0; l < W; ++l) r.v[l] = std::sqrt(a.v[l]);
     return r;
   }
-  friend Lanes pow(const Lanes& a, double b) {
-    Lanes r;
-    for (int l = 0; l < W; ++l) r.v[l] = std::pow(a.v[l], b);
-    return r;
-  }
 };
+
+/// pow remembered per cell. The model's only pow is (nu / nu_max)^(4 nu_max / 3), a function
+/// of the density alone, and the split integrators evaluate the closure twice at the same
+/// density (the diffusive half steps change u and T only): a lane whose argument equals the
+/// one remembered for its cell takes the remembered value (the same bits), the others call
+/// std::pow and remember. The memo of the lane group being evaluated, per thread.
+struct PowMemo {
+  double argument[4], value[4];
+};
+thread_local PowMemo* pow_memo = nullptr;
+
+template <int W> Lanes<W> pow(const Lanes<W>& a, double b) {
+  static_assert(W == 4, "PowMemo holds four lanes");
+  Lanes<W> r;
+  PowMemo* memo = b == model::detail::g0_exponent ? pow_memo : nullptr;
+  for (int l = 0; l < W; ++l) {
+    if (memo && a.v[l] == memo->argument[l]) {
+      r.v[l] = memo->value[l];
+    } else {
+      r.v[l] = std::pow(a.v[l], b);
+      if (memo) {
+        memo->argument[l] = a.v[l];
+        memo->value[l] = r.v[l];
+      }
+    }
+  }
+  return r;
+}
 constexpr int lane_count = 4;
 using Cells = Lanes<lane_count>;
 
@@ -166,10 +189,22 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
       const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(lane_count, end - c));
       Cells n, T;
       bool valid = e_valid;
+      PowMemo memo;
+      if (lanes == lane_count) {  // whole-group copies (no scalar stores read back as pairs)
+        std::copy_n(wn + c, lane_count, n.v);
+        std::copy_n(wT + c, lane_count, T.v);
+        std::copy_n(pow_argument_.data() + c, lane_count, memo.argument);
+        std::copy_n(pow_value_.data() + c, lane_count, memo.value);
+      } else {
+        for (int l = 0; l < lane_count; ++l) {
+          const std::ptrdiff_t cell = c + std::min(l, lanes - 1);  // a short group repeats its last cell
+          n.v[l] = wn[cell];
+          T.v[l] = wT[cell];
+          memo.argument[l] = pow_argument_[cell];
+          memo.value[l] = pow_value_[cell];
+        }
+      }
       for (int l = 0; l < lane_count; ++l) {
-        const std::ptrdiff_t cell = c + std::min(l, lanes - 1);  // a short group repeats its last cell
-        n.v[l] = wn[cell];
-        T.v[l] = wT[cell];
         const double nu = volume_fraction(n.v[l]);
         valid = valid && T.v[l] >= 0.0 && (!model_needed || (nu > 0.0 && nu < nu_max));
       }
@@ -177,7 +212,13 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
         for (int l = 0; l < lanes; ++l) store(c + l, evaluate(settings_, wn[c + l], wT[c + l], h, need_transport));
         continue;
       }
+      pow_memo = &memo;
       const CellClosure<Cells> r = evaluate(settings_, n, T, h, need_transport);
+      pow_memo = nullptr;
+      for (int l = 0; l < lanes; ++l) {
+        pow_argument_[c + l] = memo.argument[l];
+        pow_value_[c + l] = memo.value[l];
+      }
       for (int l = 0; l < lanes; ++l)
         store(c + l, CellClosure<double>{r.p.v[l], r.c.v[l], r.mu.v[l], r.lambda.v[l], r.kappa.v[l], r.loss.v[l]});
     }
