@@ -35,32 +35,39 @@ class CellList {
   /// Calls f(j, shift) for every particle j in the 27 cells around cell c; shift is the
   /// periodic image offset to add to j's position.
   template <class F> void for_each_neighbor(int c, F&& f) const {
+    for_each_neighbor_cell(c, [&](int cell, const Vec3& shift) {
+      for (std::int32_t j = head_[cell]; j >= 0; j = next_[j]) f(j, shift);
+    });
+  }
+  /// Calls f(cell, shift) for the 27 cells around cell c, in the order for_each_neighbor
+  /// visits their particles.
+  template <class F> void for_each_neighbor_cell(int c, F&& f) const {
     const int cx = ix(c), cy = iy(c), cz = iz(c);
     if (cx > 0 && cx < nx_ - 1 && cy > 0 && cy < ny_ - 1 && cz > 0 && cz < nz_ - 1) {
       // Away from the box faces no index wraps and no image shift applies; the cells are
-      // visited in the same order as for_each_in_block visits them.
+      // visited in the same order as for_each_cell_in_block visits them.
       const Vec3 none{};
       const int plane = nx_ * ny_;
       for (int dz = -plane; dz <= plane; dz += plane)  // the nine rows are far apart in memory
         for (int dy = -nx_; dy <= nx_; dy += nx_) __builtin_prefetch(&head_[c + dz + dy - 1]);
       for (int dz = -plane; dz <= plane; dz += plane)
         for (int dy = -nx_; dy <= nx_; dy += nx_)
-          for (int dx = -1; dx <= 1; ++dx)
-            for (std::int32_t j = head_[c + dz + dy + dx]; j >= 0; j = next_[j]) f(j, none);
+          for (int dx = -1; dx <= 1; ++dx) f(c + dz + dy + dx, none);
       return;
     }
-    for_each_in_block(c, -1, 1, -1, 1, -1, 1, f);
+    for_each_cell_in_block(c, -1, 1, -1, 1, -1, 1, f);
   }
-  /// The same for the 9 cells that became neighbours when a particle entered cell c by a
-  /// crossing along `axis` (0, 1, 2) in direction `step` (+1 or -1).
-  template <class F> void for_each_in_new_face(int c, int axis, int step, F&& f) const {
+  /// Calls f(cell, shift) for the 9 cells that became neighbours when a particle entered cell c
+  /// by a crossing along `axis` (0, 1, 2) in direction `step` (+1 or -1).
+  template <class F> void for_each_cell_in_new_face(int c, int axis, int step, F&& f) const {
     const int lo[3] = {axis == 0 ? step : -1, axis == 1 ? step : -1, axis == 2 ? step : -1};
     const int hi[3] = {axis == 0 ? step : 1, axis == 1 ? step : 1, axis == 2 ? step : 1};
-    for_each_in_block(c, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], f);
+    for_each_cell_in_block(c, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], f);
   }
-  /// Visits the particles of cells c + (dx, dy, dz) for offsets in the given ranges.
+  /// Calls f(cell, shift) for the cells c + (dx, dy, dz) with offsets in the given ranges
+  /// (z outermost, x innermost); cells beyond a non-periodic face are skipped.
   template <class F>
-  void for_each_in_block(int c, int x0, int x1, int y0, int y1, int z0, int z1, F&& f) const;
+  void for_each_cell_in_block(int c, int x0, int x1, int y0, int y1, int z0, int z1, F&& f) const;
 
   // Raw lists, stored in checkpoints so that a restart visits neighbours in the same order.
   std::vector<std::int32_t> head_, next_, prev_, cell_;
@@ -73,7 +80,7 @@ class CellList {
 };
 
 template <class F>
-void CellList::for_each_in_block(int c, int x0, int x1, int y0, int y1, int z0, int z1, F&& f) const {
+void CellList::for_each_cell_in_block(int c, int x0, int x1, int y0, int y1, int z0, int z1, F&& f) const {
   const int cx = ix(c), cy = iy(c), cz = iz(c);
   for (int dz = z0; dz <= z1; ++dz) {
     int z = cz + dz;
@@ -93,8 +100,7 @@ void CellList::for_each_in_block(int c, int x0, int x1, int y0, int y1, int z0, 
         double sx = 0.0;
         if (x < 0) { x += nx_; sx = -width_; }
         else if (x >= nx_) { x -= nx_; sx = width_; }
-        const Vec3 shift{sx, sy, sz};
-        for (std::int32_t j = head_[index(x, y, z)]; j >= 0; j = next_[j]) f(j, shift);
+        f(index(x, y, z), Vec3{sx, sy, sz});
       }
     }
   }

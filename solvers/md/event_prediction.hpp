@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "md/geometry.hpp"
@@ -29,21 +30,27 @@ inline double pair_contact_delay(const Vec3& r, const Vec3& v, double bound = ne
   return c / (-b + std::sqrt(discriminant));  // the smaller root, free of cancellation
 }
 
-/// The hot-loop form of pair_contact_delay: if the two spheres touch earlier than `best`, sets
-/// best to exactly the delay pair_contact_delay gives and returns true. Whether a neighbour
-/// approaches is a coin toss, so the tests are combined without branches (a mispredicted
-/// branch costs more than the square root and division it would save); the values are the
-/// same, so trajectories do not change.
-inline bool pair_contact_before(const Vec3& r, const Vec3& v, double& best) {
-  const double b = dot(r, v);
-  const double c = dot(r, r) - 1.0;
-  const double discriminant = b * b - dot(v, v) * c;
-  const double root = c / (-b + std::sqrt(std::max(discriminant, 0.0)));
-  const double dt = c <= 0.0 ? 0.0 : root;  // approaching while overlapping by rounding: now
-  const bool earlier = (b < 0.0) & (discriminant >= 0.0) & (dt < best);
-  best = earlier ? dt : best;
-  return earlier;
-}
+/// Candidate partners of one particle in structure-of-arrays form: their ids and periodic image
+/// shifts, then relative positions and velocities (particle minus candidate, shift included)
+/// for up to `capacity` candidates. The arrays are left uninitialised (a prediction fills only
+/// what it uses).
+struct PairBatch {
+  static constexpr int capacity = 64;
+  int count = 0;
+  std::int32_t id[capacity];
+  double shift_x[capacity], shift_y[capacity], shift_z[capacity];
+  double rx[capacity], ry[capacity], rz[capacity];
+  double vx[capacity], vy[capacity], vz[capacity];
+  double delay[capacity];
+};
+
+/// pair_contact_delay for every candidate of the batch at once: delay[k] is the contact delay
+/// of candidate k (exactly the value pair_contact_delay gives), `never` if it does not touch.
+/// Whether a neighbour approaches is a coin toss, so the tests are combined without branches (a
+/// mispredicted branch costs more than the square root and division it would save); the loop
+/// vectorises (an AVX2 clone where the CPU has it; no FMA, so every value is rounded exactly as
+/// in the scalar form).
+void pair_contact_delays(PairBatch& batch);
 
 /// Time until z(t) = z + vz t - g t^2/2 reaches `level` from below (moving up), or `never`.
 inline double rise_delay(double z, double vz, double g, double level) {

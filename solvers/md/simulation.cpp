@@ -259,41 +259,91 @@ void Simulation::cross_cell(std::int32_t i, std::int32_t direction) {
   cells_.insert(i, cells_.index(x, y, z));
 }
 
+namespace {
+
+/// Appends the particles of one cell (except `self`) to the batch, prefetching their states;
+/// calls flush() whenever the batch is full. A cell of the gas holds 0.6 particles on average,
+/// so whether it is empty, or holds a second one, is a coin toss for the branch predictor: the
+/// first two are taken without branches (a slot is written and kept only if the id is a
+/// particle), only a third and later ones loop.
+template <class Flush>
+[[gnu::always_inline]] inline void collect_cell(PairBatch& batch, const CellList& cells, const Particle* particles, int cell,
+                  const Vec3& shift, std::int32_t self, Flush&& flush) {
+  if (batch.count > PairBatch::capacity - 2) flush();
+  int k = batch.count;
+  auto put = [&](std::int32_t j) {  // writes slot k; kept if j is a particle other than self
+    __builtin_prefetch(particles + (j < 0 ? 0 : j));
+    batch.id[k] = j;
+    batch.shift_x[k] = shift.x;
+    batch.shift_y[k] = shift.y;
+    batch.shift_z[k] = shift.z;
+    k += (j >= 0) & (j != self);
+  };
+  const std::int32_t first = cells.head_[static_cast<std::size_t>(cell)];
+  const std::int32_t after_first = cells.next_[static_cast<std::size_t>(first < 0 ? 0 : first)];
+  const std::int32_t second = after_first | (first >> 31);  // -1 if the cell is empty
+  put(first);
+  put(second);
+  batch.count = k;
+  if (second < 0) return;
+  for (std::int32_t j = cells.next_[static_cast<std::size_t>(second)]; j >= 0; j = cells.next_[static_cast<std::size_t>(j)]) {
+    if (batch.count == PairBatch::capacity) flush();
+    k = batch.count;
+    put(j);
+    batch.count = k;
+  }
+}
+
+}  // namespace
+
+std::int32_t Simulation::earliest_partner(const Particle& p, PairBatch& batch, double& best) const {
+  const double now = data_.time, g = geometry_.gravity;
+  const int n = batch.count;
+  for (int k = 0; k < n; ++k) {
+    Vec3 rj, vj;
+    state_at(data_.particles[static_cast<std::size_t>(batch.id[k])], now, g, rj, vj);
+    const Vec3 shift{batch.shift_x[k], batch.shift_y[k], batch.shift_z[k]};
+    const Vec3 r = p.r - rj - shift, v = p.v - vj;
+    batch.rx[k] = r.x;
+    batch.ry[k] = r.y;
+    batch.rz[k] = r.z;
+    batch.vx[k] = v.x;
+    batch.vy[k] = v.y;
+    batch.vz[k] = v.z;
+  }
+  pair_contact_delays(batch);
+  std::int32_t partner = -1;
+  for (int k = 0; k < n; ++k) {
+    const bool earlier = batch.delay[k] < best;
+    best = earlier ? batch.delay[k] : best;
+    partner = earlier ? batch.id[k] : partner;
+  }
+  batch.count = 0;
+  return partner;
+}
+
 void Simulation::predict(std::int32_t i) {
   const Particle& p = data_.particles[i];
-  const double now = data_.time, g = geometry_.gravity;
+  const double now = data_.time;
   const int c = cells_.cell(i);
   Event event;
   std::int32_t direction = 0;
   const double cell_delay = cell_crossing_delay(p, c, direction);
   event.cell_direction = static_cast<std::int8_t>(direction);
   double best = never;
-  // Two passes: collect the neighbours (prefetching their states), then test them in the same
-  // order. The states are then fetched from memory in parallel rather than one after another
-  // (at large N each is a cache miss); the results are those of a single pass.
-  constexpr int chunk = 64;
-  std::int32_t ids[chunk];
-  double shift_x[chunk], shift_y[chunk], shift_z[chunk];  // no initialisation per call
-  int count = 0;
-  auto test_collected = [&] {
-    for (int k = 0; k < count; ++k) {
-      Vec3 rj, vj;
-      state_at(data_.particles[ids[k]], now, g, rj, vj);
-      const Vec3 shift{shift_x[k], shift_y[k], shift_z[k]};
-      if (pair_contact_before(p.r - rj - shift, p.v - vj, best)) event.partner = ids[k];
-    }
-    count = 0;
+  // Three passes: collect the neighbours (prefetching their states), bring them to now in
+  // structure-of-arrays form, then test them all at once (pair_contact_delays vectorises). The
+  // states are fetched from memory in parallel (at large N each is a cache miss), and the
+  // earliest contact in visiting order is the one a single pass would find.
+  PairBatch batch;
+  auto flush = [&] {
+    const std::int32_t found = earliest_partner(p, batch, best);
+    if (found >= 0) event.partner = found;
   };
-  cells_.for_each_neighbor(c, [&](std::int32_t j, const Vec3& shift) {
-    if (j == i) return;
-    __builtin_prefetch(&data_.particles[j]);
-    ids[count] = j;
-    shift_x[count] = shift.x;
-    shift_y[count] = shift.y;
-    shift_z[count] = shift.z;
-    if (++count == chunk) test_collected();
+  cells_.for_each_neighbor_cell(c, [&](int cell, const Vec3& shift) {
+    collect_cell(batch, cells_, data_.particles.data(), cell, shift, i, flush);
   });
-  test_collected();
+  flush();
   if (best < never) event.partner_counter = data_.counters[event.partner];
   predict_walls(i, event, best, cell_delay);
   event.time = now + best;
@@ -325,23 +375,28 @@ void Simulation::predict_walls(std::int32_t i, Event& event, double& best, doubl
 // cells that just became neighbours, and the walls near the new cell, can add an earlier one.
 void Simulation::predict_after_crossing(std::int32_t i, int direction) {
   const Particle& p = data_.particles[i];
-  const double now = data_.time, g = geometry_.gravity;
+  const double now = data_.time;
   const int c = cells_.cell(i);
   Event event = data_.events[i];
   std::int32_t next_direction = 0;
   const double cell_delay = cell_crossing_delay(p, c, next_direction);
   event.cell_direction = static_cast<std::int8_t>(next_direction);
   double best = event.time - now;
-  cells_.for_each_in_new_face(c, direction / 2, (direction & 1) ? 1 : -1,
-                              [&](std::int32_t j, const Vec3& shift) {
-    Vec3 rj, vj;
-    state_at(data_.particles[j], now, g, rj, vj);
-    if (pair_contact_before(p.r - rj - shift, p.v - vj, best)) {
+  PairBatch batch;
+  auto flush = [&] {
+    const std::int32_t found = earliest_partner(p, batch, best);
+    if (found >= 0) {
       event.kind = EventKind::pair;
-      event.partner = j;
-      event.partner_counter = data_.counters[j];
+      event.partner = found;
+      event.partner_counter = data_.counters[found];
     }
+  };
+  // (i itself is in none of the new cells: the box is at least three cells across.)
+  cells_.for_each_cell_in_new_face(c, direction / 2, (direction & 1) ? 1 : -1,
+                                   [&](int cell, const Vec3& shift) {
+    collect_cell(batch, cells_, data_.particles.data(), cell, shift, -1, flush);
   });
+  flush();
   if (!(event.kind == EventKind::plate && event.time < never)) predict_walls(i, event, best, cell_delay);
   event.time = now + best;
   event.cell_time = now + cell_delay;

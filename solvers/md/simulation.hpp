@@ -115,6 +115,10 @@ class Simulation {
   void initialise_queue();
   void predict(std::int32_t i);
   void predict_after_crossing(std::int32_t i, int direction);
+  /// Tests p against the collected candidates (brought to now here, with their image shifts);
+  /// returns the first candidate whose contact is earlier than best and sets best, or -1.
+  /// Empties the batch.
+  std::int32_t earliest_partner(const Particle& p, PairBatch& batch, double& best) const;
   /// Finds wall contacts of i earlier than `best` (a delay); updates event and best.
   void predict_walls(std::int32_t i, Event& event, double& best, double cell_delay);
   double cell_crossing_delay(const Particle& p, int cell, std::int32_t& direction) const;
