@@ -7,8 +7,8 @@
 // Phi the viscous dissipation of the implicit momentum step (discrete, face by face, plus
 // n |u* - u|^2 / (2 dt)), which makes the step conserve total energy exactly (to the linear
 // solver's tolerance). Each system is symmetric positive definite and diagonally dominant.
-// A 1D column between walls gives a tridiagonal system, solved directly by the Thomas
-// algorithm (O(n), no pivoting needed, nothing allocated per step); other grids use Eigen
+// A 1D column between walls gives a tridiagonal system, solved directly by two-sided
+// (twisted) Gaussian elimination (O(n), no pivoting needed, nothing allocated per step); other grids use Eigen
 // (LDLT for a periodic column, preconditioned conjugate gradients in 3D). Mass is untouched.
 // The mixed-derivative viscous terms of 3D (d_i (mu d_j u_i), i != j) are not part of this
 // operator; in 3D the full variant keeps only the terms above (stated in the report).
@@ -45,7 +45,9 @@ class ImplicitDiffusion {
   // Work vectors, sized once (on the first advance).
   Eigen::VectorXd rhs_, dissipation_, temperature_;
   std::array<Eigen::VectorXd, 3> velocity_;
-  std::vector<double> face_, forward_;  ///< column: face coefficients (face m between m, m+1), Thomas c'
+  /// column: face coefficients (face m between m, m + 1), diagonal, and the eliminated
+  /// off-diagonals from the top (forward_) and from the bottom (backward_)
+  std::vector<double> face_, diagonal_, forward_, backward_;
   // Sparse path.
   std::vector<Eigen::Triplet<double>> triplets_;
   Matrix matrix_;
