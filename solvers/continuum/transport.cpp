@@ -139,6 +139,14 @@ CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double
   }
   return r;
 }
+
+/// A lane group, with everything inlined (flatten): the model's values that the settings and
+/// need_transport leave unused are then never computed (transport coefficients in the
+/// hyperbolic stages of a split step).
+template <bool need_transport>
+[[gnu::flatten]] CellClosure<Cells> evaluate_cells(const PhysicsSettings& s, const Cells& n, const Cells& T, double h) {
+  return evaluate(s, n, T, h, need_transport);
+}
 }  // namespace
 
 void Operator::update_primitives_and_closure(const State& U, bool need_transport) {
@@ -213,7 +221,8 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
         continue;
       }
       pow_memo = &memo;
-      const CellClosure<Cells> r = evaluate(settings_, n, T, h, need_transport);
+      const CellClosure<Cells> r = need_transport ? evaluate_cells<true>(settings_, n, T, h)
+                                                  : evaluate_cells<false>(settings_, n, T, h);
       pow_memo = nullptr;
       for (int l = 0; l < lanes; ++l) {
         pow_argument_[c + l] = memo.argument[l];
