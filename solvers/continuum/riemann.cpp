@@ -107,11 +107,16 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
         FaceStates minus, plus;
         for (int v = 0; v < 7; ++v) {
           const double* x = fields[v];
+          if (s == 1) {  // a contiguous pencil: two cells per instruction
+            reconstruct_run<L>(x + c0, cells, minus[v], plus[v]);
+            continue;
+          }
           for (int q = 0; q < cells; ++q) {
             const std::ptrdiff_t c = c0 + q * s;
             reconstruct<L>(x[c - s], x[c], x[c + s], minus[v][q], plus[v][q]);
           }
         }
+        double change[variable_count][face_block];  // flux / h of face f0 + b
         if (pressure)
           for (int q = 0; q < cells; ++q) characteristic(c0 + q * s, s, un_index, q, minus, plus);
         for (int f = f0; f < f1; ++f) {
@@ -191,17 +196,22 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
           double F[5];
           riemann_flux<R>(SL, SR, F);
           if (walls && (f == 0 || f == P.length)) F[0] = F[2] = F[3] = F[4] = 0.0;
-          double global[variable_count];
-          global[density] = F[0];
-          global[energy] = F[4];
-          global[normal] = F[1];
-          global[tangential1] = F[2];
-          global[tangential2] = F[3];
-          for (int v = 0; v < variable_count; ++v) {
-            const double change = global[v] * inv_h;
-            if (f < P.length) dUdt.q[v][cR] += change;
-            if (f > 0) dUdt.q[v][cL] -= change;
-          }
+          const int b = f - f0;
+          change[density][b] = F[0] * inv_h;
+          change[energy][b] = F[4] * inv_h;
+          change[normal][b] = F[1] * inv_h;
+          change[tangential1][b] = F[2] * inv_h;
+          change[tangential2][b] = F[3] * inv_h;
+        }
+        // Face f adds to cell f (its high side) and subtracts from cell f - 1. Each cell
+        // receives its low face first, then its high face (in this block or the next), as in
+        // a face-by-face loop; the two loops have no dependence from one face to the next.
+        const int add_end = std::min(f1, P.length), subtract_begin = std::max(f0, 1);
+        for (int v = 0; v < variable_count; ++v) {
+          double* dU = dUdt.q[v].data() + base;
+          const double* ch = change[v];  // ch[f - f0]: face f
+          for (int f = f0; f < add_end; ++f) dU[f * s] += ch[f - f0];
+          for (int f = subtract_begin; f < f1; ++f) dU[(f - 1) * s] -= ch[f - f0];
         }
       }
     }
