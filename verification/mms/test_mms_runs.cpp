@@ -326,19 +326,4 @@ INSTANTIATE_TEST_SUITE_P(Variants, NightlyMmsSpace3D,
                          ::testing::Values(Transport::full, Transport::paper),
                          transport_name);
 
-// --- Nightly: finer 1D study (5 grids), both variants, walls.
-class NightlyMmsSpace1DFine : public ::testing::TestWithParam<Transport> {};
-
-TEST_P(NightlyMmsSpace1DFine, EveryFieldAndNormAtSecondOrder) {
-  mms::MmsCase c;
-  c.transport = GetParam();
-  c.t_end = 2.0;
-  conv::ErrorTable table;
-  mms::spatial_study(c, {20, 40, 80, 160, 320, 640}, study_name(), table);
-  check_and_write(table, design_space_order);
-}
-INSTANTIATE_TEST_SUITE_P(Variants, NightlyMmsSpace1DFine,
-                         ::testing::Values(Transport::full, Transport::paper),
-                         transport_name);
-
 }  // namespace
