@@ -4,6 +4,7 @@
 // so positive fields (n, T, p, c) stay positive at faces.
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "continuum/operator.hpp"
 
@@ -65,6 +66,24 @@ template <Limiter L> inline Pair limited_slope(Pair backward, Pair forward) {
     const Pair product = backward * forward;
     return product <= 0.0 ? zero : 2.0 * product / (backward + forward);
   }
+}
+
+/// Loads one value (double) or two adjacent ones (Pair); stores where a mask or flag is set.
+template <class S> inline S load_lanes(const double* x) {
+  if constexpr (std::is_same_v<S, double>) {
+    return *x;
+  } else {
+    S v;
+    __builtin_memcpy(&v, x, sizeof v);
+    return v;
+  }
+}
+inline void store_lanes_where(bool keep, double* to, double value) {
+  if (keep) *to = value;
+}
+template <class Mask> inline void store_lanes_where(Mask keep, double* to, Pair value) {
+  const Pair kept = keep ? value : load_lanes<Pair>(to);
+  __builtin_memcpy(to, &kept, sizeof kept);
 }
 
 /// Values at the low (minus) and high (plus) faces of the middle cell.

@@ -58,28 +58,32 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
   const double* fc = closure.c.data();
   // minus[v][q], plus[v][q]: face states of the block's cell q at its low and high face.
   using FaceStates = double[7][face_block + 1];
+  // S = double: cell c; S = Pair: cells c and c + 1 of a contiguous pencil (s = 1), every
+  // lane doing the scalar arithmetic, the early returns of the scalar code as a mask.
   const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, int q,
-                                  FaceStates& minus, FaceStates& plus) {
-    const double n0 = fn[c], c0 = fc[c];
-    if (!(c0 > 0.0)) return;
+                                  FaceStates& minus, FaceStates& plus, auto lanes) {
+    using S = decltype(lanes);
+    const auto at = [](const double* x) { return load_lanes<S>(x); };
     const double* u = w[un].data();
-    const double impedance = n0 * c0, inv_c2 = 1.0 / (c0 * c0);
-    const double dn_b = n0 - fn[c - s], dn_f = fn[c + s] - n0;
-    const double du_b = u[c] - u[c - s], du_f = u[c + s] - u[c];
-    const double dp_b = fp[c] - fp[c - s], dp_f = fp[c + s] - fp[c];
-    const double w1 = limited_slope<L>(dp_b - impedance * du_b, dp_f - impedance * du_f);
-    const double w2 = limited_slope<L>(dn_b - dp_b * inv_c2, dn_f - dp_f * inv_c2);
-    const double w3 = limited_slope<L>(dp_b + impedance * du_b, dp_f + impedance * du_f);
-    const double dp = 0.5 * (w1 + w3), du = 0.5 * (w3 - w1) / impedance, dn = w2 + dp * inv_c2;
-    const double n_plus = n0 + 0.5 * dn, p_plus = fp[c] + 0.5 * dp;
-    const double n_minus = n0 - 0.5 * dn, p_minus = fp[c] - 0.5 * dp;
-    if (!(n_plus > 0.0 && p_plus > 0.0 && n_minus > 0.0 && p_minus > 0.0)) return;
-    plus[0][q] = n_plus;
-    plus[un][q] = u[c] + 0.5 * du;
-    plus[4][q] = p_plus;
-    minus[0][q] = n_minus;
-    minus[un][q] = u[c] - 0.5 * du;
-    minus[4][q] = p_minus;
+    const S n0 = at(fn + c), c0 = at(fc + c), p0 = at(fp + c), u0 = at(u + c);
+    const S impedance = n0 * c0, inv_c2 = 1.0 / (c0 * c0);
+    const S dn_b = n0 - at(fn + c - s), dn_f = at(fn + c + s) - n0;
+    const S du_b = u0 - at(u + c - s), du_f = at(u + c + s) - u0;
+    const S dp_b = p0 - at(fp + c - s), dp_f = at(fp + c + s) - p0;
+    const S w1 = limited_slope<L>(dp_b - impedance * du_b, dp_f - impedance * du_f);
+    const S w2 = limited_slope<L>(dn_b - dp_b * inv_c2, dn_f - dp_f * inv_c2);
+    const S w3 = limited_slope<L>(dp_b + impedance * du_b, dp_f + impedance * du_f);
+    const S dp = 0.5 * (w1 + w3), du = 0.5 * (w3 - w1) / impedance, dn = w2 + dp * inv_c2;
+    const S n_plus = n0 + 0.5 * dn, p_plus = p0 + 0.5 * dp;
+    const S n_minus = n0 - 0.5 * dn, p_minus = p0 - 0.5 * dp;
+    // (no sound speed, or a face value that is not positive: keep the component-wise values)
+    const auto keep = (c0 > 0.0) & (n_plus > 0.0) & (p_plus > 0.0) & (n_minus > 0.0) & (p_minus > 0.0);
+    store_lanes_where(keep, &plus[0][q], n_plus);
+    store_lanes_where(keep, &plus[un][q], u0 + 0.5 * du);
+    store_lanes_where(keep, &plus[4][q], p_plus);
+    store_lanes_where(keep, &minus[0][q], n_minus);
+    store_lanes_where(keep, &minus[un][q], u0 - 0.5 * du);
+    store_lanes_where(keep, &minus[4][q], p_minus);
   };
   for (int d = g.first_direction(); d < 3; ++d) {
     const std::ptrdiff_t s = g.stride(d);
@@ -117,8 +121,12 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
           }
         }
         double change[variable_count][face_block];  // flux / h of face f0 + b
-        if (pressure)
-          for (int q = 0; q < cells; ++q) characteristic(c0 + q * s, s, un_index, q, minus, plus);
+        if (pressure) {
+          int q = 0;
+          if (s == 1)
+            for (; q + 2 <= cells; q += 2) characteristic(c0 + q, s, un_index, q, minus, plus, Pair{});
+          for (; q < cells; ++q) characteristic(c0 + q * s, s, un_index, q, minus, plus, 0.0);
+        }
         for (int f = f0; f < f1; ++f) {
           const int q = f - f0 + 1;  // the block index of cell f
           const std::ptrdiff_t cR = base + f * s, cL = cR - s;
