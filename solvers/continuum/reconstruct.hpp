@@ -4,9 +4,9 @@
 // so positive fields (n, T, p, c) stay positive at faces.
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 
 #include "continuum/operator.hpp"
+#include "continuum/simd_pair.hpp"
 
 namespace shaker::continuum {
 
@@ -32,23 +32,7 @@ template <Limiter L> inline double limited_slope(double backward, double forward
   }
 }
 
-/// Two cells at once (a GCC vector: element-wise IEEE arithmetic, one SSE2 instruction per
-/// operation). The limiters below compute per lane exactly what limited_slope computes for
-/// one cell (selects in place of its early returns, the same operations otherwise), so a
-/// pencil reconstructed pair by pair has the same face values bit for bit.
-using Pair = double __attribute__((vector_size(2 * sizeof(double))));
-using PairMask = long long __attribute__((vector_size(2 * sizeof(double))));
-
-namespace pair_detail {
-inline constexpr PairMask sign_bit = {static_cast<long long>(0x8000000000000000ULL),
-                                      static_cast<long long>(0x8000000000000000ULL)};
-inline Pair magnitude(Pair x) { return (Pair)((PairMask)x & ~sign_bit); }
-inline Pair with_sign_of(Pair x, Pair sign) {
-  return (Pair)(((PairMask)x & ~sign_bit) | ((PairMask)sign & sign_bit));
-}
-inline Pair smaller(Pair a, Pair b) { return b < a ? b : a; }  // std::min(a, b) per lane
-}  // namespace pair_detail
-
+/// The same limiters for two cells at once (simd_pair.hpp): per lane the values above.
 template <Limiter L> inline Pair limited_slope(Pair backward, Pair forward) {
   using namespace pair_detail;
   const Pair zero = {0.0, 0.0};
@@ -66,24 +50,6 @@ template <Limiter L> inline Pair limited_slope(Pair backward, Pair forward) {
     const Pair product = backward * forward;
     return product <= 0.0 ? zero : 2.0 * product / (backward + forward);
   }
-}
-
-/// Loads one value (double) or two adjacent ones (Pair); stores where a mask or flag is set.
-template <class S> inline S load_lanes(const double* x) {
-  if constexpr (std::is_same_v<S, double>) {
-    return *x;
-  } else {
-    S v;
-    __builtin_memcpy(&v, x, sizeof v);
-    return v;
-  }
-}
-inline void store_lanes_where(bool keep, double* to, double value) {
-  if (keep) *to = value;
-}
-template <class Mask> inline void store_lanes_where(Mask keep, double* to, Pair value) {
-  const Pair kept = keep ? value : load_lanes<Pair>(to);
-  __builtin_memcpy(to, &kept, sizeof kept);
 }
 
 /// Values at the low (minus) and high (plus) faces of the middle cell.
