@@ -38,6 +38,7 @@ template <class Mask> inline void store_lanes_where(Mask keep, double* to, Pair 
   __builtin_memcpy(to, &kept, sizeof kept);
 }
 
+inline void store_lanes(double* to, double value) { *to = value; }
 inline void store_lanes(double* to, Pair value) { __builtin_memcpy(to, &value, sizeof value); }
 
 }  // namespace shaker::continuum

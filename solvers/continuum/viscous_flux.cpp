@@ -11,6 +11,7 @@
 #include <algorithm>
 
 #include "continuum/operator.hpp"
+#include "continuum/simd_pair.hpp"
 
 namespace shaker::continuum {
 
@@ -18,6 +19,10 @@ namespace {
 inline double harmonic_mean(double a, double b) {
   const double sum = a + b;
   return sum > 0.0 ? 2.0 * a * b / sum : 0.0;
+}
+inline Pair harmonic_mean(Pair a, Pair b) {  // per lane the above
+  const Pair sum = a + b, zero = {0.0, 0.0};
+  return sum > 0.0 ? 2.0 * a * b / sum : zero;
 }
 }  // namespace
 
@@ -43,40 +48,47 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
   for (int f0 = 0; f0 <= length; f0 += block) {
     const int f1 = std::min(f0 + block, length + 1);
     double change[4][block];  // per unit time: momentum x, y, z, energy of face f0 + b
-    for (int b = 0; b < f1 - f0; ++b) {
+    // Faces f0 + b (S = double) or f0 + b and f0 + b + 1 (S = Pair, the same arithmetic per
+    // lane).
+    const auto faces = [&](int b, auto lanes) {
+      using S = decltype(lanes);
+      const auto at = [](const double* x) { return load_lanes<S>(x); };
       const std::ptrdiff_t cR = base + f0 + b, cL = cR - 1;
-      const double mu_f = harmonic_mean(mu[cL], mu[cR]);
-      const double lambda_f = harmonic_mean(lambda[cL], lambda[cR]);
-      const double kappa_f = harmonic_mean(kappa[cL], kappa[cR]);
-      const double gx = (u[0][cR] - u[0][cL]) * inv_h;
-      const double gy = (u[1][cR] - u[1][cL]) * inv_h;
-      const double gz = (u[2][cR] - u[2][cL]) * inv_h;
-      const double divergence = 0.0 + 0.0 + gz;
-      const double tx = mu_f * (gx + 0.0), ty = mu_f * (gy + 0.0);
-      double tz = mu_f * (gz + gz);
+      const S mu_f = harmonic_mean(at(mu + cL), at(mu + cR));
+      const S lambda_f = harmonic_mean(at(lambda + cL), at(lambda + cR));
+      const S kappa_f = harmonic_mean(at(kappa + cL), at(kappa + cR));
+      const S u_L[3] = {at(u[0] + cL), at(u[1] + cL), at(u[2] + cL)};
+      const S u_R[3] = {at(u[0] + cR), at(u[1] + cR), at(u[2] + cR)};
+      const S gx = (u_R[0] - u_L[0]) * inv_h;
+      const S gy = (u_R[1] - u_L[1]) * inv_h;
+      const S gz = (u_R[2] - u_L[2]) * inv_h;
+      const S divergence = 0.0 + 0.0 + gz;
+      const S tx = mu_f * (gx + 0.0), ty = mu_f * (gy + 0.0);
+      S tz = mu_f * (gz + gz);
       tz += (lambda_f - 2.0 / 3.0 * mu_f) * divergence;
-      double work = 0.0;
-      work += tx * 0.5 * (u[0][cL] + u[0][cR]);
-      work += ty * 0.5 * (u[1][cL] + u[1][cR]);
-      work += tz * 0.5 * (u[2][cL] + u[2][cR]);
-      change[0][b] = -tx * inv_h;
-      change[1][b] = -ty * inv_h;
-      change[2][b] = -tz * inv_h;
-      change[3][b] = (-work - kappa_f * (T[cR] - T[cL]) * inv_h) * inv_h;
-    }
+      S work = S{};
+      work += tx * 0.5 * (u_L[0] + u_R[0]);
+      work += ty * 0.5 * (u_L[1] + u_R[1]);
+      work += tz * 0.5 * (u_L[2] + u_R[2]);
+      store_lanes(&change[0][b], -tx * inv_h);
+      store_lanes(&change[1][b], -ty * inv_h);
+      store_lanes(&change[2][b], -tz * inv_h);
+      store_lanes(&change[3][b], (-work - kappa_f * (at(T + cR) - at(T + cL)) * inv_h) * inv_h);
+    };
+    int paired = 0;
+    for (; paired + 2 <= f1 - f0; paired += 2) faces(paired, Pair{});
+    for (; paired < f1 - f0; ++paired) faces(paired, 0.0);
     if (walls && f0 == 0) change[0][0] = change[1][0] = change[3][0] = 0.0;
     if (walls && f1 == length + 1) change[0][f1 - 1 - f0] = change[1][f1 - 1 - f0] = change[3][f1 - 1 - f0] = 0.0;
-    // Face f adds to cell f (its high side) and subtracts from cell f - 1, in the order of
-    // the face loop: each cell receives its low face, then its high face.
-    for (int b = 0; b < f1 - f0; ++b) {
-      const int f = f0 + b;
-      const std::ptrdiff_t cR = base + f, cL = cR - 1;
-      for (int i = 0; i < 3; ++i) {
-        if (f < length) dU[i][cR] += change[i][b];
-        if (f > 0) dU[i][cL] -= change[i][b];
-      }
-      if (f < length) dE[cR] += change[3][b];
-      if (f > 0) dE[cL] -= change[3][b];
+    // Face f adds to cell f (its high side) and subtracts from cell f - 1. Each cell
+    // receives its low face first, then its high face (in this block or the next), as in a
+    // face-by-face loop; the two loops have no dependence from one face to the next.
+    const int add_end = std::min(f1, length), subtract_begin = std::max(f0, 1);
+    double* const targets[4] = {dU[0], dU[1], dU[2], dE};
+    for (int v = 0; v < 4; ++v) {
+      double* to = targets[v] + base;
+      for (int f = f0; f < add_end; ++f) to[f] += change[v][f - f0];
+      for (int f = subtract_begin; f < f1; ++f) to[f - 1] -= change[v][f - f0];
     }
   }
 }
