@@ -423,13 +423,13 @@ def gci_text(results, claim, value):
     row = results.gci(quantity, cell)
     if row is None:
         return f" (GCI: no {quantity} row at cell {cell} in the convergence tables)"
+    cells = ", ".join(f"{float(row[h]):g}" for h in ("h1", "h2", "h3"))
     gci = float(row["gci21"])
     if math.isnan(gci):
-        return f" (GCI n/a: {row['convergence']} on cells {row['h1']}, {row['h2']}, {row['h3']})"
+        return f" (GCI n/a: {row['convergence']} on cells {cells})"
     asymptotic = "asymptotic" if row["pass"].strip() == "1" \
         else f"not asymptotic, {row['convergence']}"
-    return (f" ± {fmt(abs(value) * gci, 2)} (GCI {fmt(100 * gci, 2)} %, cells {row['h1']}, "
-            f"{row['h2']}, {row['h3']}; {asymptotic})")
+    return f" ± {fmt(abs(value) * gci, 2)} (GCI {fmt(100 * gci, 2)} %, cells {cells}; {asymptotic})"
 
 
 def solver_cell(results, claim, solver):

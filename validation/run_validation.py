@@ -602,7 +602,9 @@ def main(argv=None):
                  fallback=r["record"].get("fallback"), program=run_program(r["record"]),
                  stderr=r["record"].get("stderr", "")[-600:]) for r in plan]
     summary = dict(
-        commit=git("rev-parse", "HEAD"), dirty=bool(git("status", "--porcelain", "--", ".")),
+        commit=git("rev-parse", "HEAD"),
+        # reports/ is where this study writes: its own outputs do not make the commit dirty
+        dirty=bool(git("status", "--porcelain", "--", ".", ":(exclude)reports")),
         date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         quick=args.quick, cases=names, shaker=shaker,
         shaker_version=subprocess.run([shaker, "--version"], capture_output=True,
