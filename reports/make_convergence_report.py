@@ -132,6 +132,15 @@ def copy_tables(input_dir, files, tables):
         raise
 
 
+def remove_stale_plots(out_dir, report_text):
+    """Deletes the plots this generator made for studies that are no longer in its input
+    (a renamed or removed test), so the directory holds only what the report links."""
+    for path in glob.glob(os.path.join(out_dir, "convergence-*.png")) + \
+            glob.glob(os.path.join(out_dir, "sampling-*.png")):
+        if f"({os.path.basename(path)})" not in report_text:
+            os.unlink(path)
+
+
 def read_inputs(directory):
     found = {"errors": [], "orders": [], "gci": [], "sampling": [], "sampling-fit": [],
              "bin-size": []}
@@ -477,7 +486,9 @@ def main(argv=None):
               f"Copied beside this report into {TABLES_DIRECTORY}/ (the validation report reads "
               "the real-problem GCI table from there).", ""] + [f"- {f}" for f in files] + [""]
     copy_tables(args.input, files, tables)
-    rc.write_text_atomically(args.output, "\n".join(lines))
+    text = "\n".join(lines)
+    rc.write_text_atomically(args.output, text)
+    remove_stale_plots(out_dir, text)
     print(f"wrote {args.output}: {checks} checks, {len(failures)} failing")
     return 1 if (args.strict and failures) else 0
 

@@ -183,9 +183,13 @@ try:
     check(open(os.path.join(tables, "qoi.gci.csv")).read()
           == open(os.path.join(inputs, "nested", "qoi.gci.csv")).read(), "GCI table altered")
     open(os.path.join(tables, "stale.errors.csv"), "w").close()
+    open(os.path.join(out_dir, "convergence-removed-study.png"), "w").close()
     check(run("--input", inputs, "--output", report).returncode == 0, "second report run failed")
     check(not os.path.exists(os.path.join(tables, "stale.errors.csv")),
           "a stale table survived the second run")
+    check(not os.path.exists(os.path.join(out_dir, "convergence-removed-study.png")),
+          "the plot of a study no longer in the input survived the second run")
+    check(os.path.exists(png), "the second run removed a plot the report links")
 
     strict = run("--input", inputs, "--output", os.path.join(work, "strict", "c.md"), "--strict")
     check(strict.returncode == 1, f"--strict with failures must exit 1, got {strict.returncode}")
