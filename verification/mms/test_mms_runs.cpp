@@ -323,7 +323,8 @@ TEST_P(NightlyMmsSpace3D, EveryFieldAndNormAtSecondOrder) {
   // step and the error accumulates the same way over a quarter of the time: ~15 min.
   // Measured on 16..128 (2026-11-29): u_x, u_y, u_z, T finest pairs 1.85-1.99, each above
   // the pair before it (approaching 2 from below); n 2.11-2.39 (from above in L1, L2).
-  // Still outside the band in 13 of 15 series per variant; a 256 level would cost ~16x.
+  // Fitted over the 3 finest, 10 of 15 series per variant are outside the band; a 256
+  // level would cost ~16x.
   c.t_end = 0.0625;
   c.source_at_centre = true;  // 27 Gauss points per cell and stage would cost an hour
   conv::ErrorTable table;
