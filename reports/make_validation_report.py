@@ -24,6 +24,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from make_convergence_report import GCI_HEADER, read_csv  # noqa: E402  (one reader of the tables)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 STYLE = {"md": dict(marker="o", ms=3, ls="none"), "continuum": dict(ls="-", lw=1.2)}
 FIG1_PHASES = (0.0, 0.15, 0.22, 0.40)
@@ -42,8 +44,7 @@ class Results:
         self.gci_path = gci_path
         self.gci_rows = []
         if gci_path and os.path.exists(gci_path):
-            with open(gci_path) as f:
-                self.gci_rows = [dict(r) for r in csv.DictReader(f)]
+            self.gci_rows = read_csv(gci_path, GCI_HEADER)
 
     def gci(self, quantity, cell_size):
         """The GCI row of the real-problem study whose finest grid is the validation run's
@@ -51,8 +52,7 @@ class Results:
         if cell_size is None:
             return None
         for r in self.gci_rows:
-            if r["quantity"] == quantity and math.isclose(float(r["h1"]), cell_size,
-                                                          rel_tol=1e-9):
+            if r["quantity"] == quantity and math.isclose(r["h1"], cell_size, rel_tol=1e-9):
                 return r
         return None
 
@@ -423,11 +423,11 @@ def gci_text(results, claim, value):
     row = results.gci(quantity, cell)
     if row is None:
         return f" (GCI: no {quantity} row at cell {cell} in the convergence tables)"
-    cells = ", ".join(f"{float(row[h]):g}" for h in ("h1", "h2", "h3"))
-    gci = float(row["gci21"])
+    cells = ", ".join(f"{row[h]:g}" for h in ("h1", "h2", "h3"))
+    gci = row["gci21"]
     if math.isnan(gci):
         return f" (GCI n/a: {row['convergence']} on cells {cells})"
-    asymptotic = "asymptotic" if row["pass"].strip() == "1" \
+    asymptotic = "asymptotic" if row["pass"] == 1 \
         else f"not asymptotic, {row['convergence']}"
     return f" ± {fmt(abs(value) * gci, 2)} (GCI {fmt(100 * gci, 2)} %, cells {cells}; {asymptotic})"
 
