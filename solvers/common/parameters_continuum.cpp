@@ -17,7 +17,7 @@ std::vector<ParameterSpec> continuum_parameters() {
       text("continuum.limiter", "mc", {"minmod", "mc", "van_leer", "none"},
            "slope limiter; none = unlimited central slopes (smooth-solution verification only)"),
       text("continuum.riemann", "hllc", {"hllc", "hll"}, "approximate Riemann solver"),
-      real("continuum.cfl", 0.4, positive(1.0), "Courant number of the adaptive step"),
+      real("continuum.cfl", 0.4, positive(1.0), "Courant number of each forward-Euler stage of the adaptive step"),
       real("continuum.perturbation", 1e-3, closed(0.0, 0.5),
            "3D: relative amplitude of the seeded random perturbation of the initial layer"),
       real("continuum.initial_temperature", 1e-2, positive(1e6),
@@ -25,6 +25,9 @@ std::vector<ParameterSpec> continuum_parameters() {
       real("continuum.background_volume_fraction", 1e-5, Range{0.0, 0.1, true, false},
            "volume fraction of the dilute gas above the initial layer"),
       integer("continuum.integrator_order", 2, closed(2, 3), "SSP Runge-Kutta order (2 or 3)"),
+      integer("continuum.integrator_stages", 2, closed(2, 10),
+              "order 2: stages s of SSP-RK(s,2) (2 = Heun); each stage is a forward-Euler step "
+              "at continuum.cfl, so the step grows as s - 1. Order 3 (Shu-Osher) takes only 2"),
       real("continuum.diffusion_number", 0.8, positive(1.0),
            "time step as a fraction of the forward-Euler diffusive limit h^2 / (2 dim D)"),
       text("continuum.diffusion_integrator", "auto", {"auto", "explicit", "rkl2", "implicit"},

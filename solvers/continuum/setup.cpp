@@ -24,6 +24,11 @@ ContinuumCase continuum_case(const config::Config& config) {
                                        config.real("continuum.artificial_volume_fraction")};
   IntegratorSettings& i = c.integration;
   i.order = static_cast<int>(config.integer("continuum.integrator_order"));
+  i.stages = static_cast<int>(config.integer("continuum.integrator_stages"));
+  if (i.order == 3 && i.stages != 2)
+    throw InputError(fmt::format("continuum.integrator_stages = {} needs continuum.integrator_order = 2 "
+                                 "(SSP-RK3 is the three-stage Shu-Osher scheme); allowed with order 3: 2, "
+                                 "the default", i.stages));
   i.cfl = config.real("continuum.cfl");
   i.diffusion_number = config.real("continuum.diffusion_number");
   i.temperature_floor = config.real("continuum.temperature_floor");

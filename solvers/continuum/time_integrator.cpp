@@ -112,46 +112,71 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
 double TimeIntegrator::choose_step(double t_limit) {
   double dt = settings_.fixed_dt;
   if (dt <= 0.0) {
-    dt = op_.advective_step(settings_.cfl);
+    dt = op_.advective_step(settings_.cfl * ssp_coefficient());
     if (settings_.diffusion == DiffusionIntegrator::explicit_rk)
-      dt = std::min(dt, settings_.diffusion_number * op_.diffusive_step());
+      dt = std::min(dt, settings_.diffusion_number * ssp_coefficient() * op_.diffusive_step());
   }
   if (!(dt > 0.0) || !std::isfinite(dt)) dt = t_limit - t_;
   return std::min(dt, t_limit - t_);
 }
 
 bool TimeIntegrator::ssp_runge_kutta(double dt, Part part, std::string& failure) {
+  if (settings_.order == 2) return ssp_rk_second_order(dt, part, failure);
   // U0_ holds the state at t_, K0_ its right-hand side (already evaluated, sources in power0_).
   // The budget weights are those of the stages in the final combination:
-  // RK2 U = U0 + dt (K0 + K1) / 2; RK3 U = U0 + dt (K0 / 6 + K1 / 6 + 2 K2 / 3).
+  // U = U0 + dt (K0 / 6 + K1 / 6 + 2 K2 / 3).
   double floor1 = 0, floor2 = 0, floor3 = 0;
-  const auto book = [&](double weight, const Operator::SourcePower& p) {
-    pending_.body_work += weight * dt * p.body;
-    pending_.collisional_loss += weight * dt * p.loss;
-  };
   axpy(U1_, 1.0, U0_, 0.0, U0_, dt, K0_);
   if (!admissible(U1_, t_ + dt, failure, &floor1)) return false;
   op_.rhs(t_ + dt, U1_, K_, part);
   const Operator::SourcePower power1 = op_.source_power();
-  if (settings_.order == 2) {
-    axpy(U_, 0.5, U0_, 0.5, U1_, 0.5 * dt, K_);
-    if (!admissible(U_, t_ + dt, failure, &floor3)) return false;
-    book(0.5, power0_);
-    book(0.5, power1);
-    pending_.floor_energy += 0.5 * floor1 + floor3;
-    return true;
-  }
   axpy(U2_, 0.75, U0_, 0.25, U1_, 0.25 * dt, K_);
   if (!admissible(U2_, t_ + 0.5 * dt, failure, &floor2)) return false;
   op_.rhs(t_ + 0.5 * dt, U2_, K_, part);
   const Operator::SourcePower power2 = op_.source_power();
   axpy(U_, 1.0 / 3.0, U0_, 2.0 / 3.0, U2_, 2.0 / 3.0 * dt, K_);
   if (!admissible(U_, t_ + dt, failure, &floor3)) return false;
-  book(1.0 / 6.0, power0_);
-  book(1.0 / 6.0, power1);
-  book(2.0 / 3.0, power2);
+  book(dt, 1.0 / 6.0, power0_);
+  book(dt, 1.0 / 6.0, power1);
+  book(dt, 2.0 / 3.0, power2);
   pending_.floor_energy += floor1 / 6.0 + 2.0 / 3.0 * floor2 + floor3;
   return true;
+}
+
+// SSP-RK(s,2) (Ketcheson, SIAM J. Sci. Comput. 30, 2113 (2008)): s - 1 forward-Euler stages of
+// dt / (s - 1), then U = U0 / s + (s - 1) / s (Y_{s-1} + dt / (s - 1) L(Y_{s-1})). It is SSP with
+// coefficient s - 1, so with s stages the step may be s - 1 Euler steps; s = 2 is Heun's method.
+// Each stage's right-hand side enters U with weight 1 / s (the budget weights); the floor
+// energy added to an intermediate stage reaches U with weight (s - 1) / s.
+bool TimeIntegrator::ssp_rk_second_order(double dt, Part part, std::string& failure) {
+  const int s = settings_.stages;
+  const double h = dt / (s - 1);
+  const double carried = (s - 1.0) / s;
+  State* previous = &U0_;
+  const State* slope = &K0_;
+  double floors = 0.0;
+  book(dt, 1.0 / s, power0_);  // pending_ is discarded if the step fails
+  for (int stage = 1; stage < s; ++stage) {
+    State& Y = stage % 2 == 1 ? U1_ : U2_;
+    double floor = 0.0;
+    axpy(Y, 1.0, *previous, 0.0, *previous, h, *slope);
+    if (!admissible(Y, t_ + stage * h, failure, &floor)) return false;
+    floors += carried * floor;
+    op_.rhs(t_ + stage * h, Y, K_, part);
+    book(dt, 1.0 / s, op_.source_power());
+    previous = &Y;
+    slope = &K_;
+  }
+  double floor_end = 0.0;
+  axpy(U_, 1.0 / s, U0_, carried, *previous, carried * h, K_);
+  if (!admissible(U_, t_ + dt, failure, &floor_end)) return false;
+  pending_.floor_energy += floors + floor_end;
+  return true;
+}
+
+void TimeIntegrator::book(double dt, double weight, const Operator::SourcePower& p) {
+  pending_.body_work += weight * dt * p.body;
+  pending_.collisional_loss += weight * dt * p.loss;
 }
 
 // RKL2 over dt for the diffusive part, from U_ into U_ (U0_ keeps the step's start state).

@@ -1,5 +1,5 @@
 #pragma once
-// Time integration: explicit strong-stability-preserving Runge–Kutta (SSP-RK2 or SSP-RK3)
+// Time integration: explicit strong-stability-preserving Runge–Kutta (SSP-RK(s,2) or SSP-RK3)
 // with adaptive steps from the advective (CFL) and diffusive limits; or, for the stiff
 // `full` transport, a Strang split in which the diffusive terms advance by the second-order
 // Runge–Kutta–Legendre super-time-stepping scheme RKL2 (Meyer, Balsara & Aslam 2014) and the
@@ -24,8 +24,9 @@ namespace shaker::continuum {
 enum class DiffusionIntegrator { explicit_rk, rkl2, implicit };
 
 struct IntegratorSettings {
-  int order = 2;                  ///< 2: SSP-RK2 (Heun), 3: SSP-RK3 (Shu–Osher)
-  double cfl = 0.4;               ///< Courant number of the advective step
+  int order = 2;                  ///< 2: SSP-RK(stages, 2), 3: SSP-RK3 (Shu–Osher)
+  int stages = 2;                 ///< order 2 only: 2 is Heun; s stages allow s - 1 times the step
+  double cfl = 0.4;               ///< Courant number of each forward-Euler stage
   double diffusion_number = 0.8;  ///< fraction of the forward-Euler diffusive limit
   double fixed_dt = 0.0;          ///< > 0: constant step (convergence tests), else adaptive
   double temperature_floor = 1e-12;
@@ -79,7 +80,12 @@ class TimeIntegrator {
   double choose_step(double t_limit);
   bool try_step(double dt, std::string& failure);
   bool ssp_runge_kutta(double dt, Part part, std::string& failure);
+  bool ssp_rk_second_order(double dt, Part part, std::string& failure);
+  /// Step of the scheme over that of one forward-Euler stage at the same Courant number.
+  double ssp_coefficient() const { return settings_.order == 2 ? settings_.stages - 1.0 : 1.0; }
   bool rkl2(double dt, std::string& failure);
+  /// Adds weight * dt times the source power of one stage to the pending budget.
+  void book(double dt, double weight, const Operator::SourcePower& p);
   /// `added` (if given) receives the energy per unit plate area the temperature floor added.
   bool admissible(State& s, double t, std::string& failure, double* added = nullptr);
   void axpy(State& out, double a, const State& x, double b, const State& y, double c,

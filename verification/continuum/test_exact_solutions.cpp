@@ -8,12 +8,17 @@
 namespace shaker::continuum::testing {
 namespace {
 
-double haff_error(int order, double dt, double t_end, double& T_end) {
+struct Scheme {
+  int order, stages;
+};
+
+double haff_error(const Scheme& scheme, double dt, double t_end, double& T_end) {
   PhysicsSettings physics;
   physics.e = 0.9;
   physics.terms.gravity = physics.terms.frame_force = false;
   IntegratorSettings integration;
-  integration.order = order;
+  integration.order = scheme.order;
+  integration.stages = scheme.stages;
   integration.fixed_dt = dt;
   const Grid g = column(8, 8.0);
   TimeIntegrator solver(g, physics, integration);
@@ -30,10 +35,11 @@ double haff_error(int order, double dt, double t_end, double& T_end) {
   return worst;
 }
 
-class Haff : public ::testing::TestWithParam<int> {};
+class Haff : public ::testing::TestWithParam<Scheme> {};
 
 TEST_P(Haff, MatchesTheExactCoolingAtTheIntegratorsOrder) {
-  const int order = GetParam();
+  const Scheme scheme = GetParam();
+  const int order = scheme.order;
   const double nu = 0.3, e = 0.9;
   const double t0 = 1.0 / (4.0 / std::sqrt(pi) * (1 - e * e) * model::G(nu));
   const double t_end = 3.0 * t0;  // T falls to T0 / 16
@@ -41,9 +47,10 @@ TEST_P(Haff, MatchesTheExactCoolingAtTheIntegratorsOrder) {
   for (int steps : {25, 50, 100, 200}) {
     double T_end = 0;
     dts.push_back(t_end / steps);
-    errors.push_back(haff_error(order, t_end / steps, t_end, T_end));
+    errors.push_back(haff_error(scheme, t_end / steps, t_end, T_end));
     temperatures.push_back(T_end);
-    std::printf("SSP-RK%d dt = %.4g: relative error of T %.3e\n", order, dts.back(), errors.back());
+    std::printf("SSP-RK(%d,%d) dt = %.4g: relative error of T %.3e\n", order == 3 ? 3 : scheme.stages,
+                order, dts.back(), errors.back());
   }
   const double observed = fitted_order(dts, errors);
   std::printf("observed temporal order %.3f (design %d)\n", observed, order);
@@ -57,7 +64,13 @@ TEST_P(Haff, MatchesTheExactCoolingAtTheIntegratorsOrder) {
   std::printf("Richardson-extrapolated relative error %.3e (finest %.3e)\n", residual, errors.back());
   EXPECT_LT(residual, 0.05 * errors.back());
 }
-INSTANTIATE_TEST_SUITE_P(Integrators, Haff, ::testing::Values(2, 3));
+// SSP-RK(s,2) for s = 2 (Heun), 4 and 10, and SSP-RK3.
+INSTANTIATE_TEST_SUITE_P(Integrators, Haff,
+                         ::testing::Values(Scheme{2, 2}, Scheme{3, 2}, Scheme{2, 4}, Scheme{2, 10}),
+                         [](const ::testing::TestParamInfo<Scheme>& p) {
+                           return p.param.order == 3 ? std::string("SspRk3")
+                                                     : "SspRk" + std::to_string(p.param.stages) + "2";
+                         });
 
 // Isothermal hydrostatic profile of the model's equation of state: d p / dz = -n g with
 // p = n T chi(nu), i.e. dn/dz = -n g / (T (chi + nu dchi/dnu)); integrated with RK4.
