@@ -30,9 +30,11 @@ std::vector<ParameterSpec> continuum_parameters() {
               "at continuum.cfl, so the step grows as s - 1. Order 3 (Shu-Osher) takes only 2"),
       real("continuum.diffusion_number", 0.8, positive(1.0),
            "time step as a fraction of the forward-Euler diffusive limit h^2 / (2 dim D)"),
-      text("continuum.diffusion_integrator", "auto", {"auto", "explicit", "rkl2", "implicit"},
+      text("continuum.diffusion_integrator", "auto", {"auto", "explicit", "rkl2", "implicit", "implicit_extrapolated"},
            "diffusive terms: explicit in the SSP-RK step, or Strang-split RKL2 super time "
-           "stepping, or Strang-split backward Euler (Eigen sparse); auto = implicit for full "
+           "stepping, or Strang-split backward Euler (Eigen sparse; first order in time), or that "
+           "Richardson-extrapolated to second order (two half steps against one whole, 3 solves); "
+           "auto = implicit for full "
            "transport, explicit for paper"),
       real("continuum.temperature_floor", 1e-12, positive(1.0),
            "lowest temperature; every raise to it is counted and reported"),

@@ -35,6 +35,8 @@ ContinuumCase continuum_case(const config::Config& config) {
   const std::string diffusion = config.text("continuum.diffusion_integrator");
   if (diffusion == "rkl2")
     i.diffusion = DiffusionIntegrator::rkl2;
+  else if (diffusion == "implicit_extrapolated")
+    i.diffusion = DiffusionIntegrator::implicit_extrapolated;
   else if (diffusion == "implicit" || (diffusion == "auto" && p.transport == model::Transport::full))
     i.diffusion = DiffusionIntegrator::implicit;
   else

@@ -179,6 +179,21 @@ void TimeIntegrator::book(double dt, double weight, const Operator::SourcePower&
   pending_.collisional_loss += weight * dt * p.loss;
 }
 
+// Backward Euler over dt, Richardson-extrapolated, from U_ into U_ (the SSP stage U1_ is free
+// during the split diffusion step). The whole step and the first half step both start from
+// U_; advance() only reads the operator's closure, so both reuse it when it is U_'s.
+bool TimeIntegrator::implicit_extrapolated(double dt, std::string& failure) {
+  State& whole = U1_;
+  whole.q = U_.q;
+  if (!closure_at_start_) op_.prepare(U_, true);
+  implicit_.advance(op_, whole, dt, true);
+  implicit_.advance(op_, U_, 0.5 * dt, true);
+  if (!admissible(U_, t_, failure)) return false;
+  implicit_.advance(op_, U_, 0.5 * dt);
+  axpy(U_, 2.0, U_, -1.0, whole, 0.0, whole);
+  return admissible(U_, t_, failure);
+}
+
 // RKL2 over dt for the diffusive part, from U_ into U_ (U0_ keeps the step's start state).
 bool TimeIntegrator::rkl2(double dt, std::string& failure) {
   // The stage recursion needs Y0, Y_{j-1}, Y_{j-2}, Y_j, M0 = L(Y0) and L(Y_{j-1}). The
@@ -236,6 +251,8 @@ bool TimeIntegrator::try_step(double dt, std::string& failure) {
       bool ok = true;
       if (settings_.diffusion == DiffusionIntegrator::rkl2) {
         ok = rkl2(tau, failure);
+      } else if (settings_.diffusion == DiffusionIntegrator::implicit_extrapolated) {
+        ok = implicit_extrapolated(tau, failure);
       } else {
         implicit_.advance(op_, U_, tau, closure_at_start_);
         ok = admissible(U_, t_, failure);
@@ -266,8 +283,10 @@ double TimeIntegrator::step(double t_limit) {
       // The step needs only the closure here (the hyperbolic right-hand side is evaluated
       // after the first diffusive half step); with the transport coefficients, the implicit
       // half step reuses it.
-      op_.prepare(U0_, settings_.diffusion == DiffusionIntegrator::implicit);
-      closure_at_start_ = settings_.diffusion == DiffusionIntegrator::implicit;
+      const bool implicit = settings_.diffusion == DiffusionIntegrator::implicit ||
+                            settings_.diffusion == DiffusionIntegrator::implicit_extrapolated;
+      op_.prepare(U0_, implicit);
+      closure_at_start_ = implicit;
     } else {
       op_.rhs(t_, U0_, K0_, Part::all);
       power0_ = op_.source_power();

@@ -6,7 +6,11 @@
 // rest by SSP-RK with the advective step only.
 //
 // A third choice, `implicit`, replaces RKL2 by a backward-Euler step of the diffusive terms
-// (implicit_diffusion.hpp): unconditionally stable, first order in time.
+// (implicit_diffusion.hpp): unconditionally stable, first order in time. `implicit_extrapolated`
+// takes that step twice with half the step and once whole and keeps 2 x (two halves) - (whole):
+// Richardson extrapolation, second order, still L-stable (its factor tends to 0 for stiff modes,
+// though it is slightly negative there, so the floor may act) and conservative (a combination
+// of conservative steps with weights summing to 1).
 //
 // Positivity: after every stage n must be positive and finite (otherwise the step is
 // rejected and retried with half the step); T below temperature_floor is raised to the floor,
@@ -21,7 +25,7 @@
 
 namespace shaker::continuum {
 
-enum class DiffusionIntegrator { explicit_rk, rkl2, implicit };
+enum class DiffusionIntegrator { explicit_rk, rkl2, implicit, implicit_extrapolated };
 
 struct IntegratorSettings {
   int order = 2;                  ///< 2: SSP-RK(stages, 2), 3: SSP-RK3 (Shu–Osher)
@@ -84,6 +88,7 @@ class TimeIntegrator {
   /// Step of the scheme over that of one forward-Euler stage at the same Courant number.
   double ssp_coefficient() const { return settings_.order == 2 ? settings_.stages - 1.0 : 1.0; }
   bool rkl2(double dt, std::string& failure);
+  bool implicit_extrapolated(double dt, std::string& failure);
   /// Adds weight * dt times the source power of one stage to the pending budget.
   void book(double dt, double weight, const Operator::SourcePower& p);
   /// `added` (if given) receives the energy per unit plate area the temperature floor added.
