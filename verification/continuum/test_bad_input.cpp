@@ -43,7 +43,12 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"ceiling", "continuum.ceiling=8", "continuum.ceiling"},
                       BadCase{"nu_max", "continuum.initial_volume_fraction=0.65", "continuum.initial_volume_fraction"},
                       BadCase{"transport", "continuum.transport=partial", "continuum.transport"},
-                      BadCase{"limiter", "continuum.limiter=superbee", "continuum.limiter"}),
+                      BadCase{"limiter", "continuum.limiter=superbee", "continuum.limiter"},
+                      BadCase{"stages", "continuum.integrator_stages=11", "continuum.integrator_stages"},
+                      BadCase{"stages_order3", "continuum.integrator_order=3 --set continuum.integrator_stages=4",
+                              "continuum.integrator_stages"},
+                      BadCase{"diffusion", "continuum.diffusion_integrator=crank_nicolson",
+                              "continuum.diffusion_integrator"}),
     [](const auto& param_info) { return std::string(param_info.param.name); });
 
 }  // namespace
