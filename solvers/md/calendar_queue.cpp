@@ -18,6 +18,8 @@ void CalendarQueue::reset(std::size_t n) {
   current_ = static_cast<std::int32_t>(buckets);  // no window yet: the first pop builds one
   base_ = 0.0;
   size_ = 0;
+  walk_bucket_ = 0;
+  walk_id_ = -1;
   cached_valid_ = false;
 }
 
@@ -79,6 +81,8 @@ void CalendarQueue::restart_window() {
     ++finite;
   }
   current_ = 0;
+  walk_bucket_ = 0;
+  walk_id_ = -1;
   if (finite == 0) {
     current_ = static_cast<std::int32_t>(head_.size());
     return;
@@ -110,6 +114,50 @@ void CalendarQueue::find_minimum() {
     }
     ++current_;
   }
+}
+
+void CalendarQueue::peek_after_top(std::int32_t& first, std::int32_t& second) const {
+  first = second = -1;
+  const auto buckets = static_cast<std::int32_t>(head_.size());
+  if (!cached_valid_ || cached_ < 0 || current_ >= buckets) return;
+  for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = next_[id]) {
+    if (id == cached_) continue;
+    if (first < 0 || less(id, first)) {
+      second = first;
+      first = id;
+    } else if (second < 0 || less(id, second)) {
+      second = id;
+    }
+  }
+  const std::int32_t end = std::min(buckets, current_ + 8);
+  for (std::int32_t b = current_ + 1; second < 0 && b < end; ++b) {
+    const std::int32_t id = head_[static_cast<std::size_t>(b)];
+    if (id < 0) continue;
+    if (first < 0) first = id;
+    else second = id;
+  }
+}
+
+std::int32_t CalendarQueue::walk_ahead() {
+  const auto buckets = static_cast<std::int32_t>(head_.size());
+  if (walk_bucket_ <= current_) {
+    walk_bucket_ = current_ + 1;
+    walk_id_ = -1;
+  }
+  const std::int32_t end = std::min(buckets, current_ + 5);
+  while (walk_bucket_ < end) {
+    // (If walk_id_ moved since, its link leads elsewhere: harmless for a hint.)
+    const std::int32_t id = walk_id_ < 0 ? head_[static_cast<std::size_t>(walk_bucket_)] : next_[walk_id_];
+    if (id < 0) {
+      ++walk_bucket_;
+      walk_id_ = -1;
+      continue;
+    }
+    walk_id_ = id;
+    prefetch(id);
+    return id;
+  }
+  return -1;
 }
 
 bool CalendarQueue::consistent() const {

@@ -24,6 +24,21 @@ class CalendarQueue {
     if (!cached_valid_) find_minimum();
     return cached_ < 0 ? std::numeric_limits<double>::infinity() : time_[cached_];
   }
+  /// Guesses of the two pops after top() (-1 where none), for prefetching only: the two
+  /// earliest other entries of the current bucket, else the first entries of the next buckets.
+  /// Call after top(); reads only what the last scan brought into the cache.
+  void peek_after_top(std::int32_t& first, std::int32_t& second) const;
+  /// One step of a cursor that walks the lists of the next buckets ahead of the scan (one link
+  /// per call, so that each link read was prefetched a call earlier): returns the entry reached
+  /// (its queue entry now being prefetched), or -1. A hint: the cursor never changes the order.
+  std::int32_t walk_ahead();
+  /// Prefetches the queue's entry of id (a hint: nothing is read).
+  void prefetch(std::int32_t id) const {
+    __builtin_prefetch(&time_[static_cast<std::size_t>(id)]);
+    __builtin_prefetch(&where_[static_cast<std::size_t>(id)]);
+    __builtin_prefetch(&next_[static_cast<std::size_t>(id)]);
+    __builtin_prefetch(&prev_[static_cast<std::size_t>(id)]);
+  }
   bool empty() const { return size_ == 0; }
   std::size_t size() const { return size_; }
   bool consistent() const;
@@ -49,6 +64,7 @@ class CalendarQueue {
   double base_ = 0.0, width_ = 1.0;
   std::size_t size_ = 0;
   std::int32_t cached_ = -1;
+  std::int32_t walk_bucket_ = 0, walk_id_ = -1;  // walk_ahead's cursor
   bool cached_valid_ = false;
 };
 

@@ -57,6 +57,36 @@ class CellList {
     }
     for_each_cell_in_block(c, -1, 1, -1, 1, -1, 1, f);
   }
+  /// Prefetches the heads of the 27 cells around cell c (nine rows of three, far apart in
+  /// memory): a hint only, nothing is read.
+  void prefetch_block(int c) const {
+    const int cx = ix(c), cy = iy(c), cz = iz(c);
+    if (cx > 0 && cx < nx_ - 1 && cy > 0 && cy < ny_ - 1 && cz > 0 && cz < nz_ - 1) {
+      const int plane = nx_ * ny_;
+      for (int dz = -plane; dz <= plane; dz += plane)
+        for (int dy = -nx_; dy <= nx_; dy += nx_) {
+          __builtin_prefetch(&head_[static_cast<std::size_t>(c + dz + dy - 1)]);
+          __builtin_prefetch(&head_[static_cast<std::size_t>(c + dz + dy + 1)]);
+        }
+      return;
+    }
+    for_each_cell_in_block(c, -1, 1, -1, 1, -1, 1, [&](int cell, const Vec3&) {
+      __builtin_prefetch(&head_[static_cast<std::size_t>(cell)]);
+    });
+  }
+  /// The cell next to c across its face `direction` (2 axis + 1 if upwards), wrapping
+  /// periodically (or c itself beyond a wall: a hint for prefetching only).
+  int neighbor_cell(int c, int direction) const {
+    int x = ix(c), y = iy(c), z = iz(c);
+    const int step = (direction & 1) ? 1 : -1;
+    auto move = [step](int& u, int count) { u += step; u = u < 0 ? u + count : (u >= count ? u - count : u); };
+    switch (direction / 2) {
+      case 0: move(x, nx_); break;
+      case 1: move(y, ny_); break;
+      default: move(z, nz_); break;
+    }
+    return index(x, y, z);
+  }
   /// Calls f(cell, shift) for the 9 cells that became neighbours when a particle entered cell c
   /// by a crossing along `axis` (0, 1, 2) in direction `step` (+1 or -1).
   template <class F> void for_each_cell_in_new_face(int c, int axis, int step, F&& f) const {

@@ -4,6 +4,7 @@
 // IndexedHeap is an indexed binary heap, O(log N) per update.
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace shaker::md {
@@ -19,6 +20,18 @@ class IndexedHeap {
   double top_time() const {
     return heap_.empty() ? std::numeric_limits<double>::infinity() : heap_.front().time;
   }
+  /// Guesses of the two pops after top() (-1 where none), for prefetching only: the root's
+  /// children, the earlier first.
+  void peek_after_top(std::int32_t& first, std::int32_t& second) const {
+    first = second = -1;
+    if (heap_.size() > 1) first = heap_[1].id;
+    if (heap_.size() > 2) {
+      second = heap_[2].id;
+      if (less(heap_[2], heap_[1])) std::swap(first, second);
+    }
+  }
+  /// Prefetches the heap position of id (a hint: nothing is read).
+  void prefetch(std::int32_t id) const { __builtin_prefetch(&position_[static_cast<std::size_t>(id)]); }
   /// Inserts the particle or changes its key.
   void update(std::int32_t id, double time) {
     std::int32_t at = position_[id];

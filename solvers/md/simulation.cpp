@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "common/errors.hpp"
 
@@ -25,6 +26,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
   }
   heap_.reset(use_calendar_ ? 0 : n);
   calendar_.reset(use_calendar_ ? n : 0);
+  lookahead_ = n >= lookahead_min_particles;
   for (std::size_t i = 0; i < n; ++i) predict(static_cast<std::int32_t>(i));
 }
 
@@ -47,6 +49,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
   data_.cell_of.clear();
   heap_.reset(use_calendar_ ? 0 : n);
   calendar_.reset(use_calendar_ ? n : 0);
+  lookahead_ = n >= lookahead_min_particles;
   for (std::size_t i = 0; i < n; ++i)
     schedule(static_cast<std::int32_t>(i), data_.events[i].next());
 }
@@ -69,8 +72,79 @@ void Simulation::advance_to(double t) {
   data_.time = t;
 }
 
+void Simulation::prefetch_stage1(std::int32_t a) const {
+  const auto k = static_cast<std::size_t>(a);
+  __builtin_prefetch(&data_.events[k]);
+  __builtin_prefetch(&data_.particles[k]);
+  __builtin_prefetch(&cells_.cell_[k]);
+}
+
+void Simulation::prefetch_stage2(std::int32_t a) const {
+  const Event& e = data_.events[static_cast<std::size_t>(a)];
+  const int c = cells_.cell(a);
+  if (e.cell_time < e.time) {
+    cells_.prefetch_block(cells_.neighbor_cell(c, e.cell_direction));
+    return;
+  }
+  cells_.prefetch_block(c);
+  if (e.kind == EventKind::pair && e.partner >= 0) {
+    const auto b = static_cast<std::size_t>(e.partner);
+    __builtin_prefetch(&data_.counters[b]);
+    __builtin_prefetch(&data_.particles[b]);
+    __builtin_prefetch(&data_.events[b]);
+    __builtin_prefetch(&cells_.cell_[b]);
+    if (use_calendar_) calendar_.prefetch(e.partner);
+    else heap_.prefetch(e.partner);
+  }
+}
+
+void Simulation::prefetch_stage3(std::int32_t a) const {
+  const Event& e = data_.events[static_cast<std::size_t>(a)];
+  const int c = cells_.cell(a);
+  if (e.cell_time < e.time) {
+    prefetch_members(cells_.neighbor_cell(c, e.cell_direction), e.cell_direction / 2,
+                     (e.cell_direction & 1) ? 1 : -1);
+    return;
+  }
+  prefetch_members(c);
+  if (e.kind == EventKind::pair && e.partner >= 0) cells_.prefetch_block(cells_.cell(e.partner));
+}
+
+void Simulation::prefetch_members(int c, int axis, int step) const {
+  const Particle* particles = data_.particles.data();
+  auto touch = [&](int cell, const Vec3&) {
+    const std::int32_t h = cells_.head_[static_cast<std::size_t>(cell)];
+    if (h < 0) return;
+    __builtin_prefetch(&cells_.next_[static_cast<std::size_t>(h)]);
+    __builtin_prefetch(particles + h);
+    __builtin_prefetch(&data_.counters[static_cast<std::size_t>(h)]);
+  };
+  if (axis < 0) cells_.for_each_neighbor_cell(c, touch);
+  else cells_.for_each_cell_in_new_face(c, axis, step, touch);
+}
+
 void Simulation::step() {
   const std::int32_t i = use_calendar_ ? calendar_.top() : heap_.top();
+  if (lookahead_) {
+    // Events k + 1 and k + 2 are (most likely) the next two in the queue; the calendar's
+    // cursor meets later ones a few events ahead.
+    std::int32_t ahead1 = -1, ahead2 = -1;
+    if (use_calendar_) {
+      for (int link = 0; link < 2; ++link) {
+        const std::int32_t later = calendar_.walk_ahead();
+        if (later >= 0) prefetch_stage1(later);
+      }
+      calendar_.peek_after_top(ahead1, ahead2);
+    } else {
+      heap_.peek_after_top(ahead1, ahead2);
+      if (ahead2 >= 0) prefetch_stage1(ahead2);
+    }
+    if (ahead2 >= 0 && use_calendar_) prefetch_stage2(ahead2);
+    if (ahead1 >= 0) {
+      prefetch_stage2(ahead1);
+      if (use_calendar_) prefetch_stage3(ahead1);
+    }
+  }
   const Event event = data_.events[i];
   const bool crossing = event.cell_time < event.time;
   data_.time = crossing ? event.cell_time : event.time;
@@ -91,6 +165,7 @@ void Simulation::step() {
         ++tally.stale;
         break;
       }
+      if (lookahead_) prefetch_members(cells_.cell(j));
       Particle& q = data_.particles[j];
       update(j, now);
       Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
@@ -106,8 +181,10 @@ void Simulation::step() {
         note_collision(i, j);
         note_collision(j, i);
       }
-      predict(j);
+      // i first: its cells were prefetched longer ago (the order does not change the result:
+      // each prediction writes only its own event, and the queue's order is total).
       predict(i);
+      predict(j);
       // Deterministic in the run's own history (a restart sorts at the same collisions).
       if (data_.tally.pair % (sort_interval * data_.particles.size()) == 0) sort_by_cell();
       return;

@@ -110,6 +110,11 @@ class Simulation {
   /// Heap property, index, and every pending event in the future of time().
   bool queue_consistent() const;
   std::size_t bytes_per_particle() const;
+  /// Software pipelining across events (see prefetch_stage1): on by default from
+  /// lookahead_min_particles particles, where memory latency dominates. It only prefetches, so
+  /// a run is the same with or without (tested); benchmarks switch it to compare.
+  void set_lookahead(bool on) { lookahead_ = on; }
+  bool lookahead() const { return lookahead_; }
 
  private:
   void initialise_queue();
@@ -130,6 +135,23 @@ class Simulation {
   static constexpr std::uint64_t sort_interval = 2;
   /// Brings particle i to now, counting the crossings of its free flight on the way.
   void update(std::int32_t i, double now);
+
+  /// Software pipelining across events (large N, where every event waits for memory): while
+  /// event k is processed, what the next events will read is prefetched in stages, each stage
+  /// reading only what an earlier one brought in. Stage 1, for entries the calendar queue's
+  /// cursor meets a few buckets ahead: their event, state and cell. Stage 2, for the next two
+  /// entries of the current bucket (events k + 1 and k + 2, most likely): the heads of their 27
+  /// cells, and the partner's state, counter, event and cell. Stage 3, for event k + 1: the
+  /// first member of each of its cells, and the partner's cell heads; event k itself prefetches
+  /// its partner's first members before the collision. Hints only: the same results either way.
+  void prefetch_stage1(std::int32_t a) const;
+  void prefetch_stage2(std::int32_t a) const;
+  void prefetch_stage3(std::int32_t a) const;
+  /// Prefetches the state and next link of the first particle of each cell around c (their
+  /// heads are read), or of the 9 cells of a new face if axis >= 0.
+  void prefetch_members(int c, int axis = -1, int step = 0) const;
+  static constexpr std::size_t lookahead_min_particles = 20000;
+  bool lookahead_ = false;
 
   Geometry geometry_;
   CollisionRules rules_;

@@ -92,5 +92,37 @@ TEST(MdEventQueue, CalendarQueueGivesTheHeapsTrajectoryInTheVibratedLayer) {
   EXPECT_TRUE(identical(fast.save(), reference.save()));
 }
 
+// The software pipelining of large runs only prefetches: forced on at small N (with both
+// queues, in the gas and in the vibrated layer with its walls and open top row), every state,
+// event and count is the same as without it.
+TEST(MdEventQueue, LookaheadPrefetchingLeavesTheTrajectoryUnchanged) {
+  const std::size_t n = 2000;
+  const Geometry g = testing::periodic_box(n, 0.3);
+  CollisionRules rules;
+  rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
+  const State start = homogeneous_gas(g, n, 0.3, 1.0, 5);
+  for (const QueueKind queue : {QueueKind::calendar, QueueKind::heap}) {
+    Simulation with(g, rules, start, queue), without(g, rules, start, queue);
+    EXPECT_FALSE(without.lookahead());  // off by default at this size
+    with.set_lookahead(true);
+    with.advance_to(20.0);
+    without.advance_to(20.0);
+    EXPECT_GT(with.tally().pair, 100000u);
+    EXPECT_TRUE(with.queue_consistent());
+    EXPECT_TRUE(identical(with.save(), without.save()));
+  }
+  const ShakerKinematics shaker{3.0, 0.095};
+  Geometry box;
+  box.plate = PlateMotion::from(shaker);
+  rules.restitution = Restitution{Restitution::Kind::constant, 0.9};
+  const State layer = flat_layer(box, 3937, 9);
+  Simulation with(box, rules, layer), without(box, rules, layer);
+  with.set_lookahead(true);
+  with.advance_to(1.0 / shaker.f);
+  without.advance_to(1.0 / shaker.f);
+  EXPECT_GT(with.tally().pair, 100000u);
+  EXPECT_TRUE(identical(with.save(), without.save()));
+}
+
 }  // namespace
 }  // namespace shaker::md
