@@ -138,49 +138,65 @@ TEST(NightlyRealProblem, BaseCase1DGridConvergence) {
   EXPECT_FALSE(conv::write_study(dir, "real-1d-base", table, {}, rows).empty());
 }
 
-// The time integrators that meet the speed target of issue 4: the diffusive terms implicit
-// (Strang split; backward Euler, first order in time, or its Richardson extrapolation, second
-// order) and SSP-RK(s,2) with s = 2, 4 or 10, whose steps are 1, 3 and 9 times Heun's at the
-// same Courant number per stage. Each is compared at cell 0.1 with the
-// case's own configuration (base.toml with the given transport: `full` is implicit + Heun,
-// `paper` explicit + Heun): every quantity must differ from it by less than the grid
-// uncertainty there (GCI21 of the triple 0.1, 0.2, 0.4). A larger difference makes the fast
-// setting a different answer, not a faster one.
-class FastIntegrators : public ::testing::TestWithParam<std::string> {};
+// The faster time integrators of issue 4 against the most accurate one available for the
+// transport, at cell 0.1. The fast ones: the diffusive terms implicit (Strang split; backward
+// Euler, first order in time, or its Richardson extrapolation, second order) with SSP-RK(s,2),
+// s = 2, 4 or 10, whose steps are 1, 3 and 9 times Heun's at the same Courant number per
+// stage. The reference: Heun with explicit diffusion for `paper`; Heun with the extrapolated
+// implicit diffusion for `full` (explicit diffusion is too stiff there). Every quantity must
+// differ from the reference by less than the reference's grid uncertainty at cell 0.1: GCI21
+// of the triple 0.1, 0.2, 0.4 where that triple is in the asymptotic range; elsewhere the GCI
+// is no error estimate, and the two-grid estimate of the finest pair (design order 2, Fs = 3,
+// i.e. |phi(0.1) - phi(0.2)|) is used. A larger difference makes the fast setting a different
+// answer, not a faster one.
+struct FastIntegrator {
+  std::string transport, diffusion;
+  int stages;
+};
 
-TEST_P(FastIntegrators, AgreeWithinTheGridUncertainty) {
-  const std::string transport = GetParam();
-  const auto dir = study_directory("real-problem-integrators-" + transport);
+class FastIntegrators : public ::testing::TestWithParam<FastIntegrator> {};
+
+TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
+  const FastIntegrator fast = GetParam();
+  const std::string label = fast.transport + "-" + fast.diffusion + "-s" + std::to_string(fast.stages);
+  const auto dir = study_directory("real-problem-integrators-" + label);
+  const std::vector<std::string> model{"continuum.transport=" + fast.transport};
+  std::vector<std::string> reference_settings = model;
+  reference_settings.push_back(fast.transport == "paper" ? "continuum.diffusion_integrator=explicit"
+                                                         : "continuum.diffusion_integrator=implicit_extrapolated");
   const std::vector<double> cells{0.4, 0.2, 0.1};
-  const std::vector<std::string> model{"continuum.transport=" + transport};
   std::vector<Quantities> reference;
-  for (double h : cells) reference.push_back(run_base_case(dir, transport + "-default", h, model));
-  const auto rows = three_grid_rows("real-1d-integrators-" + transport, cells, reference, 2, false);
-  const std::vector<std::pair<std::string, int>> fast_settings{
-      {"implicit", 2}, {"implicit", 4}, {"implicit_extrapolated", 4}, {"implicit_extrapolated", 10}};
-  for (const auto& [diffusion, stages] : fast_settings) {
-    if (transport == "full" && diffusion == "implicit" && stages == 2) continue;  // the reference
-    const std::string label = transport + "-" + diffusion + "-s" + std::to_string(stages);
-    std::vector<std::string> settings = model;
-    settings.push_back("continuum.diffusion_integrator=" + diffusion);
-    settings.push_back("continuum.integrator_stages=" + std::to_string(stages));
-    const Quantities fast = run_base_case(dir, label, 0.1, settings);
-    for (const conv::GciRow& row : rows) {
-      const double value = fast.at(row.quantity);
-      if (std::isnan(row.result.gci21)) {
-        std::printf("%-20s %-26s %.6g vs %.6g: no grid uncertainty (%s), not compared\n", label.c_str(),
-                    row.quantity.c_str(), value, row.phi1, conv::to_string(row.result.kind).c_str());
-        continue;
-      }
-      const double allowed = std::abs(row.phi1) * row.result.gci21;
-      std::printf("%-20s %-26s %.6g vs %.6g  |diff| %.3e  allowed (GCI21) %.3e\n", label.c_str(),
-                  row.quantity.c_str(), value, row.phi1, std::abs(value - row.phi1), allowed);
-      EXPECT_LE(std::abs(value - row.phi1), allowed) << label << " " << row.quantity;
-    }
+  for (double h : cells) reference.push_back(run_base_case(dir, fast.transport + "-reference", h, reference_settings));
+  const auto rows = three_grid_rows("real-1d-integrators-" + fast.transport, cells, reference, 2, false);
+  std::vector<std::string> settings = model;
+  settings.push_back("continuum.diffusion_integrator=" + fast.diffusion);
+  settings.push_back("continuum.integrator_stages=" + std::to_string(fast.stages));
+  const Quantities values = run_base_case(dir, label, 0.1, settings);
+  for (const conv::GciRow& row : rows) {
+    const double value = values.at(row.quantity);
+    const double difference = std::abs(value - row.phi1);
+    const bool asymptotic = row.pass();
+    const double allowed = asymptotic ? std::abs(row.phi1) * row.result.gci21 : std::abs(row.phi1 - row.phi2);
+    std::printf("%-32s %-26s %.6g vs %.6g  |diff| %.3e  allowed %.3e (%s)\n", label.c_str(),
+                row.quantity.c_str(), value, row.phi1, difference, allowed,
+                asymptotic ? "GCI21" : "finest pair, not asymptotic");
+    EXPECT_LE(difference, allowed) << label << " " << row.quantity;
   }
 }
-INSTANTIATE_TEST_SUITE_P(NightlyRealProblem, FastIntegrators, ::testing::Values("paper", "full"),
-                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+// Measured (see the report): only paper + extrapolated + SSP-RK(4,2) agrees in every quantity.
+// The others are known-failure: backward Euler's first-order time error exceeds the grid
+// uncertainty even at Heun's step for `full` (6 of 9 quantities) and in d/xi for `paper`; the
+// extrapolated step with `full` at SSP-RK(4,2) in 3 (centre of mass at f t = 0 and 0.25, shock
+// speed); SSP-RK(10,2) in 2 (paper) and 7 (full).
+INSTANTIATE_TEST_SUITE_P(
+    NightlyRealProblem, FastIntegrators,
+    ::testing::Values(FastIntegrator{"paper", "implicit", 2}, FastIntegrator{"paper", "implicit_extrapolated", 4},
+                      FastIntegrator{"full", "implicit", 2}, FastIntegrator{"full", "implicit_extrapolated", 4},
+                      FastIntegrator{"paper", "implicit", 4}, FastIntegrator{"paper", "implicit_extrapolated", 10},
+                      FastIntegrator{"full", "implicit", 4}, FastIntegrator{"full", "implicit_extrapolated", 10}),
+    [](const ::testing::TestParamInfo<FastIntegrator>& p) {
+      return p.param.transport + "_" + p.param.diffusion + "_s" + std::to_string(p.param.stages);
+    });
 
 // The 3D base case on two grids (cells 1.0 and 0.5; a third, 0.25, would cost ~16x the
 // 0.5 run, hours on this machine). The box is 4 wide, the narrowest that holds 4 cells of
