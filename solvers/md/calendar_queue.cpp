@@ -6,11 +6,7 @@
 namespace shaker::md {
 
 void CalendarQueue::reset(std::size_t n) {
-  time_.assign(n, std::numeric_limits<double>::infinity());
-  where_.assign(n, absent);
-  next_.assign(n, -1);
-  prev_.assign(n, -1);
-  overflow_slot_.assign(n, -1);
+  node_.assign(n, Node{std::numeric_limits<double>::infinity(), absent, -1, -1, -1});
   std::size_t buckets = 16;
   while (buckets < n) buckets *= 2;
   head_.assign(buckets, -1);
@@ -24,44 +20,44 @@ void CalendarQueue::reset(std::size_t n) {
 }
 
 void CalendarQueue::unlink(std::int32_t id) {
-  const std::int32_t w = where_[id];
+  const std::int32_t w = node_[id].where;
   if (w == absent) return;
   if (w == in_overflow) {
-    const std::int32_t slot = overflow_slot_[id];
+    const std::int32_t slot = node_[id].overflow_slot;
     const std::int32_t last = overflow_.back();
     overflow_[static_cast<std::size_t>(slot)] = last;
-    overflow_slot_[last] = slot;
+    node_[last].overflow_slot = slot;
     overflow_.pop_back();
   } else {
-    if (prev_[id] >= 0) next_[prev_[id]] = next_[id];
-    else head_[static_cast<std::size_t>(w)] = next_[id];
-    if (next_[id] >= 0) prev_[next_[id]] = prev_[id];
+    if (node_[id].prev >= 0) node_[node_[id].prev].next = node_[id].next;
+    else head_[static_cast<std::size_t>(w)] = node_[id].next;
+    if (node_[id].next >= 0) node_[node_[id].next].prev = node_[id].prev;
   }
-  where_[id] = absent;
+  node_[id].where = absent;
 }
 
 void CalendarQueue::place(std::int32_t id) {
   const double nb = static_cast<double>(head_.size());
-  const double k = std::floor((time_[id] - base_) / width_);
+  const double k = std::floor((node_[id].time - base_) / width_);
   if (!(k < nb) || current_ >= static_cast<std::int32_t>(head_.size())) {
-    where_[id] = in_overflow;
-    overflow_slot_[id] = static_cast<std::int32_t>(overflow_.size());
+    node_[id].where = in_overflow;
+    node_[id].overflow_slot = static_cast<std::int32_t>(overflow_.size());
     overflow_.push_back(id);
     return;
   }
   // Times before the current bucket (only by rounding) go into it: buckets are scanned in full.
   const auto bucket = std::max(current_, static_cast<std::int32_t>(std::max(k, 0.0)));
-  where_[id] = bucket;
-  prev_[id] = -1;
-  next_[id] = head_[static_cast<std::size_t>(bucket)];
-  if (next_[id] >= 0) prev_[next_[id]] = id;
+  node_[id].where = bucket;
+  node_[id].prev = -1;
+  node_[id].next = head_[static_cast<std::size_t>(bucket)];
+  if (node_[id].next >= 0) node_[node_[id].next].prev = id;
   head_[static_cast<std::size_t>(bucket)] = id;
 }
 
 void CalendarQueue::update(std::int32_t id, double time) {
-  if (where_[id] == absent) ++size_;
+  if (node_[id].where == absent) ++size_;
   unlink(id);
-  time_[id] = time;
+  node_[id].time = time;
   place(id);
   if (cached_valid_) {
     if (id == cached_) cached_valid_ = false;
@@ -75,9 +71,9 @@ void CalendarQueue::restart_window() {
   double earliest = std::numeric_limits<double>::infinity(), sum = 0.0;
   std::size_t finite = 0;
   for (std::int32_t id : overflow_) {
-    if (!std::isfinite(time_[id])) continue;
-    earliest = std::min(earliest, time_[id]);
-    sum += time_[id];
+    if (!std::isfinite(node_[id].time)) continue;
+    earliest = std::min(earliest, node_[id].time);
+    sum += node_[id].time;
     ++finite;
   }
   current_ = 0;
@@ -106,7 +102,7 @@ void CalendarQueue::find_minimum() {
       if (current_ >= static_cast<std::int32_t>(head_.size())) return;  // only `never` left
     }
     std::int32_t best = -1;
-    for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = next_[id])
+    for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = node_[id].next)
       if (best < 0 || less(id, best)) best = id;
     if (best >= 0) {
       cached_ = best;
@@ -116,25 +112,23 @@ void CalendarQueue::find_minimum() {
   }
 }
 
-void CalendarQueue::peek_after_top(std::int32_t& first, std::int32_t& second) const {
-  first = second = -1;
+void CalendarQueue::peek_after_top(std::int32_t also, std::int32_t next[3]) const {
+  next[0] = next[1] = next[2] = -1;
   const auto buckets = static_cast<std::int32_t>(head_.size());
   if (!cached_valid_ || cached_ < 0 || current_ >= buckets) return;
-  for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = next_[id]) {
-    if (id == cached_) continue;
-    if (first < 0 || less(id, first)) {
-      second = first;
-      first = id;
-    } else if (second < 0 || less(id, second)) {
-      second = id;
-    }
+  for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = node_[id].next) {
+    if (id == cached_ || id == also) continue;
+    int k = 3;  // insertion into the sorted three
+    while (k > 0 && (next[k - 1] < 0 || less(id, next[k - 1]))) --k;
+    if (k == 3) continue;
+    for (int m = 2; m > k; --m) next[m] = next[m - 1];
+    next[k] = id;
   }
+  int found = next[2] >= 0 ? 3 : next[1] >= 0 ? 2 : next[0] >= 0 ? 1 : 0;
   const std::int32_t end = std::min(buckets, current_ + 8);
-  for (std::int32_t b = current_ + 1; second < 0 && b < end; ++b) {
+  for (std::int32_t b = current_ + 1; found < 3 && b < end; ++b) {
     const std::int32_t id = head_[static_cast<std::size_t>(b)];
-    if (id < 0) continue;
-    if (first < 0) first = id;
-    else second = id;
+    if (id >= 0 && id != also) next[found++] = id;
   }
 }
 
@@ -147,7 +141,7 @@ std::int32_t CalendarQueue::walk_ahead() {
   const std::int32_t end = std::min(buckets, current_ + 5);
   while (walk_bucket_ < end) {
     // (If walk_id_ moved since, its link leads elsewhere: harmless for a hint.)
-    const std::int32_t id = walk_id_ < 0 ? head_[static_cast<std::size_t>(walk_bucket_)] : next_[walk_id_];
+    const std::int32_t id = walk_id_ < 0 ? head_[static_cast<std::size_t>(walk_bucket_)] : node_[walk_id_].next;
     if (id < 0) {
       ++walk_bucket_;
       walk_id_ = -1;
@@ -163,13 +157,13 @@ std::int32_t CalendarQueue::walk_ahead() {
 bool CalendarQueue::consistent() const {
   std::size_t counted = overflow_.size();
   for (std::size_t b = 0; b < head_.size(); ++b)
-    for (std::int32_t id = head_[b]; id >= 0; id = next_[id]) {
-      if (where_[id] != static_cast<std::int32_t>(b)) return false;
+    for (std::int32_t id = head_[b]; id >= 0; id = node_[id].next) {
+      if (node_[id].where != static_cast<std::int32_t>(b)) return false;
       if (static_cast<std::int32_t>(b) < current_) return false;  // behind the scan
       ++counted;
     }
   for (std::size_t s = 0; s < overflow_.size(); ++s)
-    if (where_[overflow_[s]] != in_overflow || overflow_slot_[overflow_[s]] != static_cast<std::int32_t>(s))
+    if (node_[overflow_[s]].where != in_overflow || node_[overflow_[s]].overflow_slot != static_cast<std::int32_t>(s))
       return false;
   return counted == size_;
 }

@@ -22,42 +22,49 @@ class CalendarQueue {
   }
   double top_time() {
     if (!cached_valid_) find_minimum();
-    return cached_ < 0 ? std::numeric_limits<double>::infinity() : time_[cached_];
+    return cached_ < 0 ? std::numeric_limits<double>::infinity() : node_[cached_].time;
   }
-  /// Guesses of the two pops after top() (-1 where none), for prefetching only: the two
-  /// earliest other entries of the current bucket, else the first entries of the next buckets.
+  /// Guesses of the next pops after top(): fills next[0..2] (-1 where none), for prefetching
+  /// only: the three earliest entries of the current bucket other than the top and `also` (the
+  /// top's partner, whose entry is about to move), else the first entries of the next buckets.
   /// Call after top(); reads only what the last scan brought into the cache.
-  void peek_after_top(std::int32_t& first, std::int32_t& second) const;
+  void peek_after_top(std::int32_t also, std::int32_t next[3]) const;
   /// One step of a cursor that walks the lists of the next buckets ahead of the scan (one link
   /// per call, so that each link read was prefetched a call earlier): returns the entry reached
   /// (its queue entry now being prefetched), or -1. A hint: the cursor never changes the order.
   std::int32_t walk_ahead();
   /// Prefetches the queue's entry of id (a hint: nothing is read).
   void prefetch(std::int32_t id) const {
-    __builtin_prefetch(&time_[static_cast<std::size_t>(id)]);
-    __builtin_prefetch(&where_[static_cast<std::size_t>(id)]);
-    __builtin_prefetch(&next_[static_cast<std::size_t>(id)]);
-    __builtin_prefetch(&prev_[static_cast<std::size_t>(id)]);
+    const Node& node = node_[static_cast<std::size_t>(id)];
+    __builtin_prefetch(&node.time);
+    __builtin_prefetch(&node.overflow_slot);  // the other line, if the node straddles two
   }
   bool empty() const { return size_ == 0; }
   std::size_t size() const { return size_; }
   bool consistent() const;
   std::size_t bytes_per_entry() const {
-    return sizeof(double) + 4 * sizeof(std::int32_t) + 2 * sizeof(std::int32_t);  // + buckets
+    return sizeof(Node) + 2 * sizeof(std::int32_t);  // + buckets
   }
 
  private:
   static constexpr std::int32_t in_overflow = -2, absent = -1;
   bool less(std::int32_t a, std::int32_t b) const {
-    return time_[a] < time_[b] || (time_[a] == time_[b] && a < b);
+    return node_[a].time < node_[b].time || (node_[a].time == node_[b].time && a < b);
   }
   void unlink(std::int32_t id);
   void place(std::int32_t id);
   void find_minimum();
   void restart_window();
 
-  std::vector<double> time_;
-  std::vector<std::int32_t> where_, next_, prev_, overflow_slot_;
+  /// Everything the queue keeps of one entry in one place (24 bytes: a scan or an update
+  /// touches one line per entry, not five).
+  struct Node {
+    double time;
+    std::int32_t where;          ///< bucket, in_overflow or absent
+    std::int32_t next, prev;     ///< links in the bucket's list
+    std::int32_t overflow_slot;  ///< position in overflow_ when there
+  };
+  std::vector<Node> node_;
   std::vector<std::int32_t> head_;      // per bucket
   std::vector<std::int32_t> overflow_;  // ids
   std::int32_t current_ = 0;            // bucket holding the earliest times

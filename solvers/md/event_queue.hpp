@@ -20,14 +20,14 @@ class IndexedHeap {
   double top_time() const {
     return heap_.empty() ? std::numeric_limits<double>::infinity() : heap_.front().time;
   }
-  /// Guesses of the two pops after top() (-1 where none), for prefetching only: the root's
-  /// children, the earlier first.
-  void peek_after_top(std::int32_t& first, std::int32_t& second) const {
-    first = second = -1;
-    if (heap_.size() > 1) first = heap_[1].id;
+  /// Guesses of the next pops after top(): next[0..2] (-1 where none), for prefetching only:
+  /// the root's children, the earlier first (the heap keeps no cheap third; `also` unused).
+  void peek_after_top(std::int32_t /*also*/, std::int32_t next[3]) const {
+    next[0] = next[1] = next[2] = -1;
+    if (heap_.size() > 1) next[0] = heap_[1].id;
     if (heap_.size() > 2) {
-      second = heap_[2].id;
-      if (less(heap_[2], heap_[1])) std::swap(first, second);
+      next[1] = heap_[2].id;
+      if (less(heap_[2], heap_[1])) std::swap(next[0], next[1]);
     }
   }
   /// Prefetches the heap position of id (a hint: nothing is read).

@@ -117,7 +117,6 @@ void Simulation::prefetch_members(int c, int axis, int step) const {
     if (h < 0) return;
     __builtin_prefetch(&cells_.next_[static_cast<std::size_t>(h)]);
     __builtin_prefetch(particles + h);
-    __builtin_prefetch(&data_.counters[static_cast<std::size_t>(h)]);
   };
   if (axis < 0) cells_.for_each_neighbor_cell(c, touch);
   else cells_.for_each_cell_in_new_face(c, axis, step, touch);
@@ -125,27 +124,29 @@ void Simulation::prefetch_members(int c, int axis, int step) const {
 
 void Simulation::step() {
   const std::int32_t i = use_calendar_ ? calendar_.top() : heap_.top();
+  const Event event = data_.events[i];
   if (lookahead_) {
-    // Events k + 1 and k + 2 are (most likely) the next two in the queue; the calendar's
-    // cursor meets later ones a few events ahead.
-    std::int32_t ahead1 = -1, ahead2 = -1;
+    // Events k + 1 and k + 2 are (most likely) the next two in the queue, the partner's entry
+    // aside (it usually holds this same collision and is about to move); the calendar's cursor
+    // meets later ones a few events ahead.
+    const std::int32_t partner = event.cell_time < event.time || event.kind != EventKind::pair ? -1 : event.partner;
+    std::int32_t ahead[3];
     if (use_calendar_) {
       for (int link = 0; link < 2; ++link) {
         const std::int32_t later = calendar_.walk_ahead();
         if (later >= 0) prefetch_stage1(later);
       }
-      calendar_.peek_after_top(ahead1, ahead2);
+      calendar_.peek_after_top(partner, ahead);
+      // Each stage reads only what an earlier step prefetched (if the guesses hold).
+      if (ahead[2] >= 0) prefetch_stage2(ahead[2]);
+      if (ahead[1] >= 0) prefetch_stage2(ahead[1]);
+      if (ahead[0] >= 0) prefetch_stage3(ahead[0]);
     } else {
-      heap_.peek_after_top(ahead1, ahead2);
-      if (ahead2 >= 0) prefetch_stage1(ahead2);
-    }
-    if (ahead2 >= 0 && use_calendar_) prefetch_stage2(ahead2);
-    if (ahead1 >= 0) {
-      prefetch_stage2(ahead1);
-      if (use_calendar_) prefetch_stage3(ahead1);
+      heap_.peek_after_top(partner, ahead);
+      if (ahead[1] >= 0) prefetch_stage1(ahead[1]);
+      if (ahead[0] >= 0) prefetch_stage2(ahead[0]);
     }
   }
-  const Event event = data_.events[i];
   const bool crossing = event.cell_time < event.time;
   data_.time = crossing ? event.cell_time : event.time;
   const double now = data_.time;
