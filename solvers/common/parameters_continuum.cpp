@@ -34,8 +34,8 @@ std::vector<ParameterSpec> continuum_parameters() {
            "diffusive terms: explicit in the SSP-RK step, or Strang-split RKL2 super time "
            "stepping, or Strang-split backward Euler (Eigen sparse; first order in time), or that "
            "Richardson-extrapolated to second order (two half steps against one whole, 3 solves); "
-           "auto = implicit_extrapolated for full transport (plain backward Euler's time error "
-           "exceeds the grid uncertainty of the base case at cell 0.1), explicit for paper"),
+           "auto = implicit for full "
+           "transport, explicit for paper"),
       real("continuum.temperature_floor", 1e-12, positive(1.0),
            "lowest temperature; every raise to it is counted and reported"),
       real("continuum.artificial_viscosity", 0.5, at_least(0.0, 100.0),
