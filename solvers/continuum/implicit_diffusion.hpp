@@ -9,7 +9,8 @@
 // solver's tolerance). Each system is symmetric positive definite and diagonally dominant.
 // A 1D column between walls gives a tridiagonal system, solved directly by two-sided
 // (twisted) Gaussian elimination (O(n), no pivoting needed, nothing allocated per step); other grids use Eigen
-// (LDLT for a periodic column, preconditioned conjugate gradients in 3D). Mass is untouched.
+// (LDLT for a periodic column; in 3D conjugate gradients preconditioned by Jacobi plus an exact
+// solve of the horizontally uniform part). Mass is untouched.
 // The mixed-derivative viscous terms of 3D (d_i (mu d_j u_i), i != j) are not part of this
 // operator; in 3D the full variant keeps only the terms above (stated in the report).
 #include <Eigen/Sparse>
