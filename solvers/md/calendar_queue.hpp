@@ -10,6 +10,8 @@
 #include <limits>
 #include <vector>
 
+#include "md/prefetch.hpp"
+
 namespace shaker::md {
 
 class CalendarQueue {
@@ -36,8 +38,8 @@ class CalendarQueue {
   /// Prefetches the queue's entry of id (a hint: nothing is read).
   void prefetch(std::int32_t id) const {
     const Node& node = node_[static_cast<std::size_t>(id)];
-    __builtin_prefetch(&node.time);
-    __builtin_prefetch(&node.overflow_slot);  // the other line, if the node straddles two
+    md::prefetch(&node.time);
+    md::prefetch(&node.overflow_slot);  // the other line, if the node straddles two
   }
   bool empty() const { return size_ == 0; }
   std::size_t size() const { return size_; }

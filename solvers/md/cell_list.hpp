@@ -7,6 +7,7 @@
 
 #include "md/geometry.hpp"
 #include "md/particles.hpp"
+#include "md/prefetch.hpp"
 
 namespace shaker::md {
 
@@ -49,7 +50,7 @@ class CellList {
       const Vec3 none{};
       const int plane = nx_ * ny_;
       for (int dz = -plane; dz <= plane; dz += plane)  // the nine rows are far apart in memory
-        for (int dy = -nx_; dy <= nx_; dy += nx_) __builtin_prefetch(&head_[c + dz + dy - 1]);
+        for (int dy = -nx_; dy <= nx_; dy += nx_) prefetch(&head_[c + dz + dy - 1]);
       for (int dz = -plane; dz <= plane; dz += plane)
         for (int dy = -nx_; dy <= nx_; dy += nx_)
           for (int dx = -1; dx <= 1; ++dx) f(c + dz + dy + dx, none);
@@ -65,13 +66,13 @@ class CellList {
       const int plane = nx_ * ny_;
       for (int dz = -plane; dz <= plane; dz += plane)
         for (int dy = -nx_; dy <= nx_; dy += nx_) {
-          __builtin_prefetch(&head_[static_cast<std::size_t>(c + dz + dy - 1)]);
-          __builtin_prefetch(&head_[static_cast<std::size_t>(c + dz + dy + 1)]);
+          prefetch(&head_[static_cast<std::size_t>(c + dz + dy - 1)]);
+          prefetch(&head_[static_cast<std::size_t>(c + dz + dy + 1)]);
         }
       return;
     }
     for_each_cell_in_block(c, -1, 1, -1, 1, -1, 1, [&](int cell, const Vec3&) {
-      __builtin_prefetch(&head_[static_cast<std::size_t>(cell)]);
+      prefetch(&head_[static_cast<std::size_t>(cell)]);
     });
   }
   /// The cell next to c across its face `direction` (2 axis + 1 if upwards), wrapping

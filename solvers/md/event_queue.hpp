@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "md/prefetch.hpp"
+
 namespace shaker::md {
 
 class IndexedHeap {
@@ -31,7 +33,7 @@ class IndexedHeap {
     }
   }
   /// Prefetches the heap position of id (a hint: nothing is read).
-  void prefetch(std::int32_t id) const { __builtin_prefetch(&position_[static_cast<std::size_t>(id)]); }
+  void prefetch(std::int32_t id) const { md::prefetch(&position_[static_cast<std::size_t>(id)]); }
   /// Inserts the particle or changes its key.
   void update(std::int32_t id, double time) {
     std::int32_t at = position_[id];

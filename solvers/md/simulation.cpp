@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "common/errors.hpp"
+#include "md/prefetch.hpp"
 
 namespace shaker::md {
 
@@ -74,9 +75,9 @@ void Simulation::advance_to(double t) {
 
 void Simulation::prefetch_stage1(std::int32_t a) const {
   const auto k = static_cast<std::size_t>(a);
-  __builtin_prefetch(&data_.events[k]);
-  __builtin_prefetch(&data_.particles[k]);
-  __builtin_prefetch(&cells_.cell_[k]);
+  prefetch(&data_.events[k]);
+  prefetch(&data_.particles[k]);
+  prefetch(&cells_.cell_[k]);
 }
 
 void Simulation::prefetch_stage2(std::int32_t a) const {
@@ -89,10 +90,10 @@ void Simulation::prefetch_stage2(std::int32_t a) const {
   cells_.prefetch_block(c);
   if (e.kind == EventKind::pair && e.partner >= 0) {
     const auto b = static_cast<std::size_t>(e.partner);
-    __builtin_prefetch(&data_.counters[b]);
-    __builtin_prefetch(&data_.particles[b]);
-    __builtin_prefetch(&data_.events[b]);
-    __builtin_prefetch(&cells_.cell_[b]);
+    prefetch(&data_.counters[b]);
+    prefetch(&data_.particles[b]);
+    prefetch(&data_.events[b]);
+    prefetch(&cells_.cell_[b]);
     if (use_calendar_) calendar_.prefetch(e.partner);
     else heap_.prefetch(e.partner);
   }
@@ -113,10 +114,12 @@ void Simulation::prefetch_stage3(std::int32_t a) const {
 void Simulation::prefetch_members(int c, int axis, int step) const {
   const Particle* particles = data_.particles.data();
   auto touch = [&](int cell, const Vec3&) {
+    // Without a branch (whether a cell is empty is a coin toss): an empty cell prefetches
+    // particle 0's lines instead, which costs nothing.
     const std::int32_t h = cells_.head_[static_cast<std::size_t>(cell)];
-    if (h < 0) return;
-    __builtin_prefetch(&cells_.next_[static_cast<std::size_t>(h)]);
-    __builtin_prefetch(particles + h);
+    const auto k = static_cast<std::size_t>(h < 0 ? 0 : h);
+    prefetch(&cells_.next_[k]);
+    prefetch(particles + k);
   };
   if (axis < 0) cells_.for_each_neighbor_cell(c, touch);
   else cells_.for_each_cell_in_new_face(c, axis, step, touch);

@@ -150,7 +150,7 @@ class Simulation {
   /// Prefetches the state and next link of the first particle of each cell around c (their
   /// heads are read), or of the 9 cells of a new face if axis >= 0.
   void prefetch_members(int c, int axis = -1, int step = 0) const;
-  static constexpr std::size_t lookahead_min_particles = 20000;
+  static constexpr std::size_t lookahead_min_particles = 30000;
   bool lookahead_ = false;
 
   Geometry geometry_;
