@@ -34,9 +34,9 @@ std::vector<ParameterSpec> continuum_parameters() {
            "diffusive terms: explicit in the SSP-RK step, or Strang-split RKL2 super time "
            "stepping, or Strang-split backward Euler (Eigen sparse; first order in time), or that "
            "Richardson-extrapolated to second order (two half steps against one whole, 3 solves); "
-           "auto = implicit for full transport (its first-order time error exceeds the base "
-           "case's grid uncertainty at cell 0.1 in 6 of 9 quantities; implicit_extrapolated "
-           "removes that at ~1.3x the 1D and ~2.3x the 3D cost), explicit for paper"),
+           "auto = implicit_extrapolated for full transport (plain backward Euler's time error "
+           "exceeds the base case's grid uncertainty at cell 0.1 in 6 of 9 quantities), "
+           "explicit for paper"),
       real("continuum.temperature_floor", 1e-12, positive(1.0),
            "lowest temperature; every raise to it is counted and reported"),
       real("continuum.artificial_viscosity", 0.5, at_least(0.0, 100.0),

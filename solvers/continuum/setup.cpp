@@ -35,9 +35,9 @@ ContinuumCase continuum_case(const config::Config& config) {
   const std::string diffusion = config.text("continuum.diffusion_integrator");
   if (diffusion == "rkl2")
     i.diffusion = DiffusionIntegrator::rkl2;
-  else if (diffusion == "implicit_extrapolated")
+  else if (diffusion == "implicit_extrapolated" || (diffusion == "auto" && p.transport == model::Transport::full))
     i.diffusion = DiffusionIntegrator::implicit_extrapolated;
-  else if (diffusion == "implicit" || (diffusion == "auto" && p.transport == model::Transport::full))
+  else if (diffusion == "implicit")
     i.diffusion = DiffusionIntegrator::implicit;
   else
     i.diffusion = DiffusionIntegrator::explicit_rk;

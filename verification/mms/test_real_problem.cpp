@@ -185,7 +185,8 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
 }
 // Measured (see the report): only paper + extrapolated + SSP-RK(4,2) agrees in every quantity.
 // The others are known-failure: backward Euler's first-order time error exceeds the grid
-// uncertainty even at Heun's step for `full` (6 of 9 quantities) and in d/xi for `paper`; the
+// uncertainty even at Heun's step for `full` (6 of 9 quantities; it was the full default until
+// this measurement made implicit_extrapolated the default) and in d/xi for `paper`; the
 // extrapolated step with `full` at SSP-RK(4,2) in 3 (centre of mass at f t = 0 and 0.25, shock
 // speed); SSP-RK(10,2) in 2 (paper) and 7 (full).
 INSTANTIATE_TEST_SUITE_P(
