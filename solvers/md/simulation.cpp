@@ -28,6 +28,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
   heap_.reset(use_calendar_ ? 0 : n);
   calendar_.reset(use_calendar_ ? n : 0);
   lookahead_ = n >= lookahead_min_particles;
+  lookahead_members_ = n >= lookahead_members_min_particles;
   for (std::size_t i = 0; i < n; ++i) predict(static_cast<std::int32_t>(i));
 }
 
@@ -51,6 +52,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
   heap_.reset(use_calendar_ ? 0 : n);
   calendar_.reset(use_calendar_ ? n : 0);
   lookahead_ = n >= lookahead_min_particles;
+  lookahead_members_ = n >= lookahead_members_min_particles;
   for (std::size_t i = 0; i < n; ++i)
     schedule(static_cast<std::int32_t>(i), data_.events[i].next());
 }
@@ -143,7 +145,7 @@ void Simulation::step() {
       // Each stage reads only what an earlier step prefetched (if the guesses hold).
       if (ahead[2] >= 0) prefetch_stage2(ahead[2]);
       if (ahead[1] >= 0) prefetch_stage2(ahead[1]);
-      if (ahead[0] >= 0) prefetch_stage3(ahead[0]);
+      if (ahead[0] >= 0 && lookahead_members_) prefetch_stage3(ahead[0]);
     } else {
       heap_.peek_after_top(partner, ahead);
       if (ahead[1] >= 0) prefetch_stage1(ahead[1]);
@@ -169,7 +171,7 @@ void Simulation::step() {
         ++tally.stale;
         break;
       }
-      if (lookahead_) prefetch_members(cells_.cell(j));
+      if (lookahead_members_) prefetch_members(cells_.cell(j));
       Particle& q = data_.particles[j];
       update(j, now);
       Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
