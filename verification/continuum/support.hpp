@@ -1,6 +1,7 @@
 #pragma once
 // Shared helpers of the continuum tests: building solvers, norms, least-squares orders.
 #include <gtest/gtest.h>
+#include <unistd.h>  // getpid
 
 #include <cmath>
 #include <filesystem>
@@ -39,11 +40,13 @@ inline double fitted_order(const std::vector<double>& h, const std::vector<doubl
   return (m * sxy - sx * sy) / (m * sxx - sx * sx);
 }
 
-/// A fresh directory for one test, removed first so reruns start clean.
+/// A fresh directory for one test and process (two ctest runs at once do not share it),
+/// removed first so reruns start clean.
 inline std::filesystem::path test_directory() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const auto dir = std::filesystem::temp_directory_path() /
-                   ("shaker-continuum-" + std::string(info->test_suite_name()) + "-" + info->name());
+                   ("shaker-continuum-" + std::string(info->test_suite_name()) + "-" + info->name() + "-" +
+                    std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

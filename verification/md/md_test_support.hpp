@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers shared by the MD tests.
 #include <gtest/gtest.h>
+#include <unistd.h>  // getpid
 
 #include <cmath>
 #include <filesystem>
@@ -11,11 +12,12 @@
 
 namespace shaker::md::testing {
 
-/// A fresh directory for one test (ctest -j safe).
+/// A fresh directory for one test and process (ctest -j safe, also with two ctest runs at once).
 inline std::filesystem::path test_directory() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const auto dir = std::filesystem::temp_directory_path() /
-                   (std::string("shaker-md-") + info->test_suite_name() + "-" + info->name());
+                   (std::string("shaker-md-") + info->test_suite_name() + "-" + info->name() + "-" +
+                    std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
