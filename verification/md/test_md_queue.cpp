@@ -62,13 +62,37 @@ bool identical(const SimulationData& a, const SimulationData& b) {
   return a.tally.pair == b.tally.pair && a.tally.cell == b.tally.cell && a.tally.plate == b.tally.plate;
 }
 
-TEST(MdEventQueue, CalendarQueueGivesTheHeapsTrajectoryInTheGas) {
-  const std::size_t n = 2000;
-  const Geometry g = testing::periodic_box(n, 0.3);
+/// A run's starting point: the two the trajectory-equality tests below use.
+struct Start {
+  Geometry geometry;
   CollisionRules rules;
-  rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
-  const State start = homogeneous_gas(g, n, 0.3, 1.0, 4);
-  Simulation fast(g, rules, start, QueueKind::calendar), reference(g, rules, start, QueueKind::heap);
+  State state;
+};
+
+/// Elastic gas of n particles at nu = 0.3 in a periodic box without gravity.
+Start elastic_gas(std::size_t n, std::uint64_t seed) {
+  Start s;
+  s.geometry = testing::periodic_box(n, 0.3);
+  s.rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
+  s.state = homogeneous_gas(s.geometry, n, 0.3, 1.0, seed);
+  return s;
+}
+
+const ShakerKinematics base_shaker{3.0, 0.095};
+
+/// The base case's layer (Gamma = 3, f = 0.095, 3937 particles, e = 0.9) at rest on the plate.
+Start vibrated_layer(std::uint64_t seed) {
+  Start s;
+  s.geometry.plate = PlateMotion::from(base_shaker);
+  s.rules.restitution = Restitution{Restitution::Kind::constant, 0.9};
+  s.state = flat_layer(s.geometry, 3937, seed);
+  return s;
+}
+
+TEST(MdEventQueue, CalendarQueueGivesTheHeapsTrajectoryInTheGas) {
+  const Start s = elastic_gas(2000, 4);
+  Simulation fast(s.geometry, s.rules, s.state, QueueKind::calendar),
+      reference(s.geometry, s.rules, s.state, QueueKind::heap);
   fast.advance_to(50.0);
   reference.advance_to(50.0);
   std::printf("measured: %llu collisions each\n", static_cast<unsigned long long>(fast.tally().pair));
@@ -78,15 +102,11 @@ TEST(MdEventQueue, CalendarQueueGivesTheHeapsTrajectoryInTheGas) {
 }
 
 TEST(MdEventQueue, CalendarQueueGivesTheHeapsTrajectoryInTheVibratedLayer) {
-  const ShakerKinematics shaker{3.0, 0.095};
-  Geometry g;
-  g.plate = PlateMotion::from(shaker);
-  CollisionRules rules;
-  rules.restitution = Restitution{Restitution::Kind::constant, 0.9};
-  const State start = flat_layer(g, 3937, 8);
-  Simulation fast(g, rules, start, QueueKind::calendar), reference(g, rules, start, QueueKind::heap);
-  fast.advance_to(1.5 / shaker.f);
-  reference.advance_to(1.5 / shaker.f);
+  const Start s = vibrated_layer(8);
+  Simulation fast(s.geometry, s.rules, s.state, QueueKind::calendar),
+      reference(s.geometry, s.rules, s.state, QueueKind::heap);
+  fast.advance_to(1.5 / base_shaker.f);
+  reference.advance_to(1.5 / base_shaker.f);
   EXPECT_GT(fast.tally().pair, 300000u);
   EXPECT_TRUE(fast.queue_consistent());
   EXPECT_TRUE(identical(fast.save(), reference.save()));
@@ -96,13 +116,10 @@ TEST(MdEventQueue, CalendarQueueGivesTheHeapsTrajectoryInTheVibratedLayer) {
 // queues, in the gas and in the vibrated layer with its walls and open top row), every state,
 // event and count is the same as without it.
 TEST(MdEventQueue, LookaheadPrefetchingLeavesTheTrajectoryUnchanged) {
-  const std::size_t n = 2000;
-  const Geometry g = testing::periodic_box(n, 0.3);
-  CollisionRules rules;
-  rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
-  const State start = homogeneous_gas(g, n, 0.3, 1.0, 5);
+  const Start gas = elastic_gas(2000, 5);
   for (const QueueKind queue : {QueueKind::calendar, QueueKind::heap}) {
-    Simulation with(g, rules, start, queue), without(g, rules, start, queue);
+    Simulation with(gas.geometry, gas.rules, gas.state, queue),
+        without(gas.geometry, gas.rules, gas.state, queue);
     EXPECT_FALSE(without.lookahead());  // off by default at this size
     with.set_lookahead(true);
     with.advance_to(20.0);
@@ -111,15 +128,12 @@ TEST(MdEventQueue, LookaheadPrefetchingLeavesTheTrajectoryUnchanged) {
     EXPECT_TRUE(with.queue_consistent());
     EXPECT_TRUE(identical(with.save(), without.save()));
   }
-  const ShakerKinematics shaker{3.0, 0.095};
-  Geometry box;
-  box.plate = PlateMotion::from(shaker);
-  rules.restitution = Restitution{Restitution::Kind::constant, 0.9};
-  const State layer = flat_layer(box, 3937, 9);
-  Simulation with(box, rules, layer), without(box, rules, layer);
+  const Start layer = vibrated_layer(9);
+  Simulation with(layer.geometry, layer.rules, layer.state),
+      without(layer.geometry, layer.rules, layer.state);
   with.set_lookahead(true);
-  with.advance_to(1.0 / shaker.f);
-  without.advance_to(1.0 / shaker.f);
+  with.advance_to(1.0 / base_shaker.f);
+  without.advance_to(1.0 / base_shaker.f);
   EXPECT_GT(with.tally().pair, 100000u);
   EXPECT_TRUE(identical(with.save(), without.save()));
 }
