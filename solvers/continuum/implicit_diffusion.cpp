@@ -41,20 +41,20 @@ class PlaneAveragedColumn {
     const auto n = static_cast<std::size_t>(a.cols());
     const auto planes = static_cast<std::size_t>(planes_);
     inverse_diagonal_.assign(n, 1.0);
-    std::vector<double> diagonal(planes, 0.0), lower(planes, 0.0);  // Ac(k, k), Ac(k, k - 1)
+    std::vector<double> diagonal(planes, 0.0);  // Ac(k, k); lower_ holds Ac(k, k - 1)
+    lower_.assign(planes, 0.0);
     for (Eigen::Index col = 0; col < a.outerSize(); ++col) {
       const auto k = static_cast<std::size_t>(col / plane_);
       for (typename M::InnerIterator it(a, col); it; ++it) {
         if (it.index() == col && it.value() != 0.0) inverse_diagonal_[static_cast<std::size_t>(col)] = 1.0 / it.value();
         const auto row_plane = static_cast<std::size_t>(it.index() / plane_);
         if (row_plane == k) diagonal[k] += it.value();
-        else if (row_plane + 1 == k) lower[k] += it.value();
+        else if (row_plane + 1 == k) lower_[k] += it.value();
       }
     }
     // Thomas elimination of Ac once per matrix.
     inverse_pivot_.assign(planes, 1.0);
     upper_.assign(planes, 0.0);
-    lower_ = lower;
     for (std::size_t k = 0; k < planes; ++k) {
       const double pivot = diagonal[k] - (k > 0 ? lower_[k] * upper_[k - 1] : 0.0);
       inverse_pivot_[k] = 1.0 / pivot;
@@ -64,7 +64,8 @@ class PlaneAveragedColumn {
   }
   template <class Rhs> Eigen::VectorXd solve(const Rhs& r) const {
     const auto planes = static_cast<std::size_t>(planes_);
-    std::vector<double> coarse(planes, 0.0);
+    std::vector<double>& coarse = coarse_;  // applied every CG iteration: no allocation
+    coarse.resize(planes);
     for (std::size_t k = 0; k < planes; ++k) {
       double sum = 0.0;
       for (Eigen::Index m = static_cast<Eigen::Index>(k) * plane_; m < static_cast<Eigen::Index>(k + 1) * plane_; ++m)
@@ -82,6 +83,7 @@ class PlaneAveragedColumn {
  private:
   Eigen::Index plane_ = 1, planes_ = 1;
   std::vector<double> inverse_diagonal_, lower_, upper_, inverse_pivot_;
+  mutable std::vector<double> coarse_;  ///< solve's work vector, one value per plane
 };
 }  // namespace
 
