@@ -40,7 +40,7 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
     std::vector<std::int64_t> partner, partner_counter, kind;
     for (std::size_t i = 0; i < n; ++i) {
       const Particle& p = d.particles[i];
-      for (double x : {p.r.x, p.r.y, p.r.z, p.v.x, p.v.y, p.v.z, p.t, p.last_collision})
+      for (double x : {p.r.x, p.r.y, p.r.z, p.v.x, p.v.y, p.v.z, p.t, d.last_collision[i]})
         table.push_back(x);
       event_time.push_back(d.events[i].time);
       cell_time.push_back(d.events[i].cell_time);
@@ -54,8 +54,13 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
     h5::write(f, "event_partner", partner);
     h5::write(f, "event_partner_counter", partner_counter);
     h5::write(f, "event_kind", kind);
-    h5::write(f, "counters", widen(d.counters));
-    h5::write(f, "streaks", widen(d.streaks));
+    std::vector<std::uint32_t> counters, streaks;
+    for (const Particle& p : d.particles) {
+      counters.push_back(p.counter);
+      streaks.push_back(p.streak);
+    }
+    h5::write(f, "counters", widen(counters));
+    h5::write(f, "streaks", widen(streaks));
     h5::write(f, "cell_head", widen(d.cell_head));
     h5::write(f, "cell_next", widen(d.cell_next));
     h5::write(f, "cell_prev", widen(d.cell_prev));
@@ -84,13 +89,14 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     const std::vector<double> table = h5::read_doubles(f, "particles");
     const std::size_t n = table.size() / particle_columns;
     d.particles.resize(n);
+    d.last_collision.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       const double* x = &table[i * particle_columns];
       Particle& p = d.particles[i];
       p.r = {x[0], x[1], x[2]};
       p.v = {x[3], x[4], x[5]};
       p.t = x[6];
-      p.last_collision = x[7];
+      d.last_collision[i] = x[7];
     }
     const auto event_time = h5::read_doubles(f, "event_time");
     const auto cell_time = h5::read_doubles(f, "event_cell_time");
@@ -106,8 +112,13 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
       d.events[i].kind = static_cast<EventKind>(kind.at(i) % 256);
       d.events[i].cell_direction = static_cast<std::int8_t>(kind.at(i) / 256);
     }
-    d.counters = narrow<std::uint32_t>(h5::read_integers(f, "counters"));
-    d.streaks = narrow<std::uint32_t>(h5::read_integers(f, "streaks"));
+    const auto counters = narrow<std::uint32_t>(h5::read_integers(f, "counters"));
+    const auto streaks = narrow<std::uint32_t>(h5::read_integers(f, "streaks"));
+    if (counters.size() != n || streaks.size() != n) throw InputError("inconsistent array lengths");
+    for (std::size_t i = 0; i < n; ++i) {
+      d.particles[i].counter = counters[i];
+      d.particles[i].streak = streaks[i];
+    }
     d.cell_head = narrow<std::int32_t>(h5::read_integers(f, "cell_head"));
     d.cell_next = narrow<std::int32_t>(h5::read_integers(f, "cell_next"));
     d.cell_prev = narrow<std::int32_t>(h5::read_integers(f, "cell_prev"));
@@ -122,7 +133,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     t.pair_loss = energy.at(1);
     t.wall_loss = energy.at(2);
     t.virial = energy.at(3);
-    if (d.counters.size() != n || d.streaks.size() != n || d.cell_next.size() != n ||
+    if (d.cell_next.size() != n ||
         d.cell_prev.size() != n || d.cell_of.size() != n)
       throw InputError("inconsistent array lengths");
   } catch (const std::exception& error) {

@@ -35,8 +35,9 @@ struct PairCollision {
 };
 
 /// Collides a and b (both at the same time) whose centres differ by r_ab = r_a - r_b.
-inline PairCollision collide_pair(Particle& a, Particle& b, const Vec3& r_ab, double now,
-                                  const CollisionRules& rules) {
+/// last_a and last_b: the times of their previous collisions (TC guard).
+inline PairCollision collide_pair(Particle& a, Particle& b, const Vec3& r_ab, double now, double last_a,
+                                  double last_b, const CollisionRules& rules) {
   PairCollision out;
   const double distance = std::sqrt(dot(r_ab, r_ab));
   const Vec3 k = (1.0 / distance) * r_ab;
@@ -45,7 +46,7 @@ inline PairCollision collide_pair(Particle& a, Particle& b, const Vec3& r_ab, do
   out.happened = true;
   out.normal_speed = -vn;
   double e = rules.restitution(-vn);
-  if (rules.tc_guard && (now - a.last_collision < rules.tc || now - b.last_collision < rules.tc)) {
+  if (rules.tc_guard && (now - last_a < rules.tc || now - last_b < rules.tc)) {
     e = 1.0;
     out.elastic_by_guard = true;
   }
@@ -66,13 +67,14 @@ struct WallCollision {
 
 /// Collides p with a wall moving at wall_velocity along z; normal = +1 for the plate (the
 /// particle is above), -1 for the ceiling.
-inline WallCollision collide_wall(Particle& p, double wall_velocity, double normal, double now,
+/// last: the time of p's previous collision (TC guard).
+inline WallCollision collide_wall(Particle& p, double wall_velocity, double normal, double now, double last,
                                   const CollisionRules& rules) {
   WallCollision out;
   const double w = (p.v.z - wall_velocity) * normal;  // < 0: approaching
   if (w >= CollisionRules::wall_floor_speed) return out;
   double e = rules.restitution(std::fabs(w));
-  if (rules.tc_guard && now - p.last_collision < rules.tc) {
+  if (rules.tc_guard && now - last < rules.tc) {
     e = 1.0;
     out.elastic_by_guard = true;
   }

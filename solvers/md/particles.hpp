@@ -16,12 +16,20 @@ inline Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
 inline Vec3 operator*(double s, const Vec3& a) { return {s * a.x, s * a.y, s * a.z}; }
 inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
-/// One cache line per particle: what every prediction reads.
+/// One cache line per particle: what every prediction reads. The collision counter is here
+/// (not in an array of its own) because a prediction reads the counter of the partner it finds,
+/// whose state it has just read: one cache line instead of two, and at large N the second was
+/// a DRAM miss in every prediction.
 struct alignas(64) Particle {
   Vec3 r, v;
-  double t = 0.0;               ///< local time at which r and v are valid
-  double last_collision = -1e300;  ///< time of the last pair or wall collision (TC guard)
+  double t = 0.0;              ///< local time at which r and v are valid
+  std::uint32_t counter = 0;   ///< collisions so far (a pair event remembers its partner's)
+  std::uint32_t streak = 0;    ///< consecutive very short collision intervals (collapse detector)
 };
+static_assert(sizeof(Particle) == 64);
+
+/// Time of a particle's last collision before any (the TC guard never applies).
+inline constexpr double no_collision_yet = -1e300;
 
 /// Position and velocity at time t >= p.t, without modifying p (gravity g along -z).
 inline void state_at(const Particle& p, double t, double g, Vec3& r, Vec3& v) {
@@ -52,6 +60,9 @@ inline bool rises_through(const Particle& p, double t, double g, double h) {
 struct State {
   double time = 0.0;
   std::vector<Particle> particles;
+  /// Time of each particle's last pair or wall collision (TC guard and collapse detector);
+  /// empty: none yet.
+  std::vector<double> last_collision;
 };
 
 }  // namespace shaker::md

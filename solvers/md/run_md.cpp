@@ -57,7 +57,7 @@ Simulation make_simulation(const CaseParameters& c, const MdSettings& s, const G
   validate_state(g, saved.data);
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
-  State state{saved.data.time, std::move(saved.data.particles)};
+  State state{saved.data.time, std::move(saved.data.particles), std::move(saved.data.last_collision)};
   return Simulation(g, rules, state, s.queue);
 }
 

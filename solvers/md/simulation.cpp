@@ -17,8 +17,9 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
   data_.time = initial.time;
   data_.particles = initial.particles;
   data_.events.assign(n, Event{});
-  data_.counters.assign(n, 0);
-  data_.streaks.assign(n, 0);
+  for (Particle& p : data_.particles) p.counter = p.streak = 0;
+  data_.last_collision = initial.last_collision;
+  data_.last_collision.resize(n, no_collision_yet);
   cells_.build(geometry_, n);
   for (std::size_t i = 0; i < n; ++i) {
     Particle& p = data_.particles[i];
@@ -37,6 +38,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
     : geometry_(geometry), rules_(rules), data_(std::move(saved)),
       use_calendar_(queue == QueueKind::calendar) {
   const std::size_t n = data_.particles.size();
+  data_.last_collision.resize(n, no_collision_yet);
   cells_.build(geometry_, n);
   if (data_.cell_head.size() != cells_.head_.size())
     throw InputError(fmt::format("checkpoint cell grid has {} cells, this geometry needs {} (written "
@@ -92,7 +94,6 @@ void Simulation::prefetch_stage2(std::int32_t a) const {
   cells_.prefetch_block(c);
   if (e.kind == EventKind::pair && e.partner >= 0) {
     const auto b = static_cast<std::size_t>(e.partner);
-    prefetch(&data_.counters[b]);
     prefetch(&data_.particles[b]);
     prefetch(&data_.events[b]);
     prefetch(&cells_.cell_[b]);
@@ -167,18 +168,18 @@ void Simulation::step() {
   switch (event.kind) {
     case EventKind::pair: {
       const std::int32_t j = event.partner;
-      if (data_.counters[j] != event.partner_counter) {
+      Particle& q = data_.particles[j];
+      if (q.counter != event.partner_counter) {
         ++tally.stale;
         break;
       }
       if (lookahead_members_) prefetch_members(cells_.cell(j));
-      Particle& q = data_.particles[j];
       update(j, now);
       Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
       r.x -= geometry_.width * std::round(r.x / geometry_.width);
       r.y -= geometry_.width * std::round(r.y / geometry_.width);
       if (geometry_.periodic_z) r.z -= geometry_.height * std::round(r.z / geometry_.height);
-      const PairCollision c = collide_pair(p, q, r, now, rules_);
+      const PairCollision c = collide_pair(p, q, r, now, data_.last_collision[i], data_.last_collision[j], rules_);
       ++tally.pair;
       if (c.happened) {
         tally.pair_loss += c.loss;
@@ -198,8 +199,9 @@ void Simulation::step() {
     case EventKind::plate:
     case EventKind::ceiling: {
       const bool plate = event.kind == EventKind::plate;
-      const WallCollision c = plate ? collide_wall(p, geometry_.plate.velocity(now), 1.0, now, rules_)
-                                    : collide_wall(p, 0.0, -1.0, now, rules_);
+      const double last = data_.last_collision[i];
+      const WallCollision c = plate ? collide_wall(p, geometry_.plate.velocity(now), 1.0, now, last, rules_)
+                                    : collide_wall(p, 0.0, -1.0, now, last, rules_);
       ++(plate ? tally.plate : tally.ceiling);
       if (c.changed) {
         tally.plate_work += c.work;
@@ -234,8 +236,7 @@ void Simulation::sort_by_cell() {
   };
   permute(data_.particles);
   permute(data_.events);
-  permute(data_.counters);
-  permute(data_.streaks);
+  permute(data_.last_collision);
   for (Event& e : data_.events)
     if (e.partner >= 0) e.partner = new_of_old[static_cast<std::size_t>(e.partner)];
   std::vector<std::int32_t> cell_of(n);
@@ -275,23 +276,24 @@ std::vector<std::uint64_t> Simulation::crossings_at(double t) const {
 
 void Simulation::note_collision(std::int32_t i, std::int32_t partner) {
   Particle& p = data_.particles[i];
-  ++data_.counters[i];
+  ++p.counter;
   const double now = data_.time;
+  double& last = data_.last_collision[static_cast<std::size_t>(i)];
   if (!rules_.tc_guard) {
-    if (now - p.last_collision < collapse_interval) {
-      if (++data_.streaks[i] >= collapse_streak) {
+    if (now - last < collapse_interval) {
+      if (++p.streak >= collapse_streak) {
         const std::string with = partner >= 0 ? fmt::format("particle {}", partner) : "a wall";
         throw CollapseError(fmt::format(
             "inelastic collapse at t = {:.9g}: particle {} (with {}) has had {} collisions in a "
             "row less than {:g} apart (collision rate above {:.3g} per unit time); set "
             "md.collapse_guard = \"tc\" or use a larger e",
-            now, i, with, data_.streaks[i], collapse_interval, 1.0 / collapse_interval));
+            now, i, with, p.streak, collapse_interval, 1.0 / collapse_interval));
       }
     } else {
-      data_.streaks[i] = 0;
+      p.streak = 0;
     }
   }
-  p.last_collision = now;
+  last = now;
 }
 
 double Simulation::cell_crossing_delay(const Particle& p, int c, std::int32_t& direction) const {
@@ -427,7 +429,7 @@ void Simulation::predict(std::int32_t i) {
     collect_cell(batch, cells_, data_.particles.data(), cell, shift, i, flush);
   });
   flush();
-  if (best < never) event.partner_counter = data_.counters[event.partner];
+  if (best < never) event.partner_counter = data_.particles[static_cast<std::size_t>(event.partner)].counter;
   predict_walls(i, event, best, cell_delay);
   event.time = now + best;
   event.cell_time = now + cell_delay;
@@ -471,7 +473,7 @@ void Simulation::predict_after_crossing(std::int32_t i, int direction) {
     if (found >= 0) {
       event.kind = EventKind::pair;
       event.partner = found;
-      event.partner_counter = data_.counters[found];
+      event.partner_counter = data_.particles[static_cast<std::size_t>(found)].counter;
     }
   };
   // (i itself is in none of the new cells: the box is at least three cells across.)
@@ -553,7 +555,7 @@ bool Simulation::queue_consistent() const {
 
 std::size_t Simulation::bytes_per_particle() const {
   const std::size_t n = std::max<std::size_t>(1, data_.particles.size());
-  const std::size_t per_particle = sizeof(Particle) + sizeof(Event) + 2 * sizeof(std::uint32_t) +
+  const std::size_t per_particle = sizeof(Particle) + sizeof(Event) + sizeof(double) +
                                    3 * sizeof(std::int32_t) +
                                    (use_calendar_ ? calendar_.bytes_per_entry() : heap_.bytes_per_entry());
   // Grids: cell heads, and the calendar's buckets (at most two per particle).

@@ -46,8 +46,9 @@ struct SimulationData {
   double time = 0.0;
   std::vector<Particle> particles;
   std::vector<Event> events;
-  std::vector<std::uint32_t> counters;  ///< collisions of each particle (invalidates events)
-  std::vector<std::uint32_t> streaks;   ///< consecutive very short collision intervals
+  /// Time of each particle's last pair or wall collision (TC guard); only collisions touch it,
+  /// so it is kept out of the particles' cache lines.
+  std::vector<double> last_collision;
   std::vector<std::int32_t> cell_head, cell_next, cell_prev, cell_of;
   Tally tally;
 };

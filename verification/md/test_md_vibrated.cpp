@@ -113,10 +113,10 @@ bool same_bits(const SimulationData& a, const SimulationData& b) {
   if (a.particles.size() != b.particles.size() || a.time != b.time) return false;
   for (std::size_t i = 0; i < a.particles.size(); ++i) {
     const Particle &p = a.particles[i], &q = b.particles[i];
-    const double x[] = {p.r.x, p.r.y, p.r.z, p.v.x, p.v.y, p.v.z, p.t, p.last_collision};
-    const double y[] = {q.r.x, q.r.y, q.r.z, q.v.x, q.v.y, q.v.z, q.t, q.last_collision};
+    const double x[] = {p.r.x, p.r.y, p.r.z, p.v.x, p.v.y, p.v.z, p.t, a.last_collision[i]};
+    const double y[] = {q.r.x, q.r.y, q.r.z, q.v.x, q.v.y, q.v.z, q.t, b.last_collision[i]};
     if (std::memcmp(x, y, sizeof x) != 0) return false;
-    if (a.events[i].time != b.events[i].time || a.counters[i] != b.counters[i]) return false;
+    if (a.events[i].time != b.events[i].time || p.counter != q.counter || p.streak != q.streak) return false;
   }
   return a.cell_of == b.cell_of && a.tally.pair == b.tally.pair &&
          a.tally.plate_work == b.tally.plate_work;
