@@ -11,6 +11,8 @@ void CalendarQueue::reset(std::size_t n) {
   while (buckets < n) buckets *= 2;
   head_.assign(buckets, -1);
   overflow_.clear();
+  heap_.clear();
+  sorted_ = false;
   current_ = static_cast<std::int32_t>(buckets);  // no window yet: the first pop builds one
   base_ = 0.0;
   size_ = 0;
@@ -22,7 +24,9 @@ void CalendarQueue::reset(std::size_t n) {
 void CalendarQueue::unlink(std::int32_t id) {
   const std::int32_t w = node_[id].where;
   if (w == absent) return;
-  if (w == in_overflow) {
+  if (w == in_heap) {
+    heap_remove(id);
+  } else if (w == in_overflow) {
     const std::int32_t slot = node_[id].overflow_slot;
     const std::int32_t last = overflow_.back();
     overflow_[static_cast<std::size_t>(slot)] = last;
@@ -47,6 +51,10 @@ void CalendarQueue::place(std::int32_t id) {
   }
   // Times before the current bucket (only by rounding) go into it: buckets are scanned in full.
   const auto bucket = std::max(current_, static_cast<std::int32_t>(std::max(k, 0.0)));
+  if (sorted_ && bucket == current_) {
+    heap_push(id);
+    return;
+  }
   node_[id].where = bucket;
   node_[id].prev = -1;
   node_[id].next = head_[static_cast<std::size_t>(bucket)];
@@ -101,9 +109,23 @@ void CalendarQueue::find_minimum() {
       restart_window();
       if (current_ >= static_cast<std::int32_t>(head_.size())) return;  // only `never` left
     }
+    if (sorted_) {
+      if (!heap_.empty()) {
+        cached_ = heap_.front();
+        return;
+      }
+      sorted_ = false;  // the crowded bucket is used up
+      ++current_;
+      continue;
+    }
     std::int32_t best = -1;
-    for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = node_[id].next)
+    int count = 0;
+    for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = node_[id].next, ++count)
       if (best < 0 || less(id, best)) best = id;
+    if (count > crowded_bucket) {
+      sort_current_bucket();
+      continue;
+    }
     if (best >= 0) {
       cached_ = best;
       return;
@@ -112,10 +134,62 @@ void CalendarQueue::find_minimum() {
   }
 }
 
+void CalendarQueue::sort_current_bucket() {
+  sorted_ = true;
+  heap_.clear();
+  std::int32_t id = head_[static_cast<std::size_t>(current_)];
+  head_[static_cast<std::size_t>(current_)] = -1;
+  while (id >= 0) {
+    const std::int32_t next = node_[id].next;
+    heap_push(id);
+    id = next;
+  }
+}
+
+void CalendarQueue::heap_push(std::int32_t id) {
+  node_[id].where = in_heap;
+  heap_.push_back(id);
+  heap_set(heap_.size() - 1, id);
+  heap_sift(heap_.size() - 1);
+}
+
+void CalendarQueue::heap_remove(std::int32_t id) {
+  const auto at = static_cast<std::size_t>(node_[id].next);
+  const std::int32_t last = heap_.back();
+  heap_.pop_back();
+  if (at == heap_.size()) return;
+  heap_set(at, last);
+  heap_sift(at);
+}
+
+// Moves the entry at `at` up or down to its place.
+void CalendarQueue::heap_sift(std::size_t at) {
+  const std::int32_t id = heap_[at];
+  while (at > 0 && less(id, heap_[(at - 1) / 2])) {
+    heap_set(at, heap_[(at - 1) / 2]);
+    at = (at - 1) / 2;
+  }
+  for (;;) {
+    std::size_t child = 2 * at + 1;
+    if (child >= heap_.size()) break;
+    if (child + 1 < heap_.size() && less(heap_[child + 1], heap_[child])) ++child;
+    if (!less(heap_[child], id)) break;
+    heap_set(at, heap_[child]);
+    at = child;
+  }
+  heap_set(at, id);
+}
+
 void CalendarQueue::peek_after_top(std::int32_t also, std::int32_t next[3]) const {
   next[0] = next[1] = next[2] = -1;
   const auto buckets = static_cast<std::int32_t>(head_.size());
   if (!cached_valid_ || cached_ < 0 || current_ >= buckets) return;
+  if (sorted_) {  // the root's children (a hint: not necessarily the next two)
+    int found = 0;
+    for (std::size_t k = 1; k < 3 && k < heap_.size(); ++k)
+      if (heap_[k] != also) next[found++] = heap_[k];
+    return;
+  }
   for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = node_[id].next) {
     if (id == cached_ || id == also) continue;
     int k = 3;  // insertion into the sorted three
@@ -155,7 +229,14 @@ std::int32_t CalendarQueue::walk_ahead() {
 }
 
 bool CalendarQueue::consistent() const {
-  std::size_t counted = overflow_.size();
+  std::size_t counted = overflow_.size() + heap_.size();
+  if (!sorted_ && !heap_.empty()) return false;
+  for (std::size_t k = 0; k < heap_.size(); ++k) {
+    if (node_[heap_[k]].where != in_heap || node_[heap_[k]].next != static_cast<std::int32_t>(k)) return false;
+    if (k > 0 && less(heap_[k], heap_[(k - 1) / 2])) return false;
+  }
+  if (sorted_ && current_ < static_cast<std::int32_t>(head_.size()) && head_[static_cast<std::size_t>(current_)] >= 0)
+    return false;  // a sorted bucket keeps no list
   for (std::size_t b = 0; b < head_.size(); ++b)
     for (std::int32_t id = head_[b]; id >= 0; id = node_[id].next) {
       if (node_[id].where != static_cast<std::int32_t>(b)) return false;

@@ -5,7 +5,10 @@
 // (ties by particle index), so the pop order is the same total order as IndexedHeap's and a
 // run gives the same trajectory with either queue. When the window is used up, every entry is
 // in the overflow list; the width is then re-estimated from the pending times and the window
-// restarts at the earliest one (O(N) once per window, about N events).
+// restarts at the earliest one (O(N) once per window, about N events). A crowded current
+// bucket (more than crowded_bucket entries, e.g. the lattice start's thousands of contacts at
+// t ~ 1e-14 in one bucket) is not rescanned at every pop: its entries move into a binary heap
+// (same order) that serves the pops, and the inserts into that bucket, until it is empty.
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -49,7 +52,8 @@ class CalendarQueue {
   }
 
  private:
-  static constexpr std::int32_t in_overflow = -2, absent = -1;
+  static constexpr std::int32_t in_overflow = -2, absent = -1, in_heap = -3;
+  static constexpr int crowded_bucket = 32;
   bool less(std::int32_t a, std::int32_t b) const {
     return node_[a].time < node_[b].time || (node_[a].time == node_[b].time && a < b);
   }
@@ -57,18 +61,31 @@ class CalendarQueue {
   void place(std::int32_t id);
   void find_minimum();
   void restart_window();
+  /// The heap of a crowded current bucket: ids ordered by less(), each node's `next` holding
+  /// its position.
+  void heap_push(std::int32_t id);
+  void heap_remove(std::int32_t id);
+  void heap_sift(std::size_t at);
+  void heap_set(std::size_t at, std::int32_t id) {
+    heap_[at] = id;
+    node_[id].next = static_cast<std::int32_t>(at);
+  }
+  /// Moves the entries of the current bucket's list into the heap.
+  void sort_current_bucket();
 
   /// Everything the queue keeps of one entry in one place (24 bytes: a scan or an update
   /// touches one line per entry, not five).
   struct Node {
     double time;
-    std::int32_t where;          ///< bucket, in_overflow or absent
-    std::int32_t next, prev;     ///< links in the bucket's list
+    std::int32_t where;          ///< bucket, in_overflow, in_heap or absent
+    std::int32_t next, prev;     ///< links in the bucket's list (next: position in heap_)
     std::int32_t overflow_slot;  ///< position in overflow_ when there
   };
   std::vector<Node> node_;
   std::vector<std::int32_t> head_;      // per bucket
   std::vector<std::int32_t> overflow_;  // ids
+  std::vector<std::int32_t> heap_;      // ids of the crowded current bucket (if sorted)
+  bool sorted_ = false;                 // the current bucket lives in heap_
   std::int32_t current_ = 0;            // bucket holding the earliest times
   double base_ = 0.0, width_ = 1.0;
   std::size_t size_ = 0;
