@@ -13,6 +13,7 @@ void CalendarQueue::reset(std::size_t n) {
   overflow_.clear();
   heap_.clear();
   sorted_ = false;
+  pending_count_ = 0;
   current_ = static_cast<std::int32_t>(buckets);  // no window yet: the first pop builds one
   base_ = 0.0;
   size_ = 0;
@@ -24,7 +25,12 @@ void CalendarQueue::reset(std::size_t n) {
 void CalendarQueue::unlink(std::int32_t id) {
   const std::int32_t w = node_[id].where;
   if (w == absent) return;
-  if (w == in_heap) {
+  if (w == pending) {
+    int k = 0;
+    while (pending_[k] != id) ++k;
+    for (; k + 1 < pending_count_; ++k) pending_[k] = pending_[k + 1];
+    --pending_count_;
+  } else if (w == in_heap) {
     heap_remove(id);
   } else if (w == in_overflow) {
     const std::int32_t slot = node_[id].overflow_slot;
@@ -66,12 +72,31 @@ void CalendarQueue::update(std::int32_t id, double time) {
   if (node_[id].where == absent) ++size_;
   unlink(id);
   node_[id].time = time;
-  place(id);
+  if (deferred_) {
+    // Prefetch what linking will touch: the bucket's head now, the old head's node when the
+    // entry is linked (by then the head has arrived).
+    const double k = std::floor((time - base_) / width_);
+    if (k >= 0.0 && k < static_cast<double>(head_.size()))
+      md::prefetch(&head_[static_cast<std::size_t>(k)]);
+    node_[id].where = pending;
+    pending_[pending_count_++] = id;
+    flush_pending(pending_capacity);
+  } else {
+    place(id);
+  }
   if (cached_valid_) {
     if (id == cached_) cached_valid_ = false;
     else if (cached_ >= 0 && less(id, cached_)) cached_ = id;
     else if (cached_ < 0) cached_valid_ = false;
   }
+}
+
+void CalendarQueue::flush_pending(int keep) {
+  if (pending_count_ <= keep) return;
+  const int linked = pending_count_ - keep;
+  for (int k = 0; k < linked; ++k) place(pending_[k]);
+  for (int k = 0; k < keep; ++k) pending_[k] = pending_[k + linked];
+  pending_count_ = keep;
 }
 
 void CalendarQueue::restart_window() {
@@ -106,30 +131,29 @@ void CalendarQueue::find_minimum() {
   if (size_ == 0) return;
   for (;;) {
     if (current_ >= static_cast<std::int32_t>(head_.size())) {
+      flush_pending(0);  // into the overflow list, which the new window distributes
       restart_window();
       if (current_ >= static_cast<std::int32_t>(head_.size())) return;  // only `never` left
     }
-    if (sorted_) {
-      if (!heap_.empty()) {
-        cached_ = heap_.front();
-        return;
-      }
-      sorted_ = false;  // the crowded bucket is used up
-      ++current_;
-      continue;
-    }
     std::int32_t best = -1;
-    int count = 0;
-    for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = node_[id].next, ++count)
-      if (best < 0 || less(id, best)) best = id;
-    if (count > crowded_bucket) {
-      sort_current_bucket();
-      continue;
+    if (sorted_) {
+      if (!heap_.empty()) best = heap_.front();
+    } else {
+      int count = 0;
+      for (std::int32_t id = head_[static_cast<std::size_t>(current_)]; id >= 0; id = node_[id].next, ++count)
+        if (best < 0 || less(id, best)) best = id;
+      if (count > crowded_bucket) {
+        sort_current_bucket();
+        continue;
+      }
     }
+    for (int k = 0; k < pending_count_; ++k)  // members of this bucket not linked yet
+      if (in_current_bucket(pending_[k]) && (best < 0 || less(pending_[k], best))) best = pending_[k];
     if (best >= 0) {
       cached_ = best;
       return;
     }
+    sorted_ = false;  // (a sorted bucket is used up)
     ++current_;
   }
 }
@@ -229,7 +253,9 @@ std::int32_t CalendarQueue::walk_ahead() {
 }
 
 bool CalendarQueue::consistent() const {
-  std::size_t counted = overflow_.size() + heap_.size();
+  std::size_t counted = overflow_.size() + heap_.size() + static_cast<std::size_t>(pending_count_);
+  for (int k = 0; k < pending_count_; ++k)
+    if (node_[pending_[k]].where != pending) return false;
   if (!sorted_ && !heap_.empty()) return false;
   for (std::size_t k = 0; k < heap_.size(); ++k) {
     if (node_[heap_[k]].where != in_heap || node_[heap_[k]].next != static_cast<std::int32_t>(k)) return false;

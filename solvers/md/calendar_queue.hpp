@@ -9,6 +9,14 @@
 // bucket (more than crowded_bucket entries, e.g. the lattice start's thousands of contacts at
 // t ~ 1e-14 in one bucket) is not rescanned at every pop: its entries move into a binary heap
 // (same order) that serves the pops, and the inserts into that bucket, until it is empty.
+//
+// Deferred insertion (set_deferred, for large N): linking an entry into its bucket reads the
+// bucket's head and writes the old head's node, two cache misses at large N that nothing can
+// prefetch before the time is known. With deferral an update only prefetches them and leaves
+// the entry pending; it is linked when `pending_capacity` later updates have come (about one
+// event later, the lines have arrived). The minimum search counts pending entries as members
+// of the bucket their time belongs to, so the pop order is exactly the same.
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -44,6 +52,11 @@ class CalendarQueue {
     md::prefetch(&node.time);
     md::prefetch(&node.overflow_slot);  // the other line, if the node straddles two
   }
+  /// Deferred insertion on or off (the order of pops is the same either way).
+  void set_deferred(bool on) {
+    if (!on) flush_pending(0);
+    deferred_ = on;
+  }
   bool empty() const { return size_ == 0; }
   std::size_t size() const { return size_; }
   bool consistent() const;
@@ -52,7 +65,7 @@ class CalendarQueue {
   }
 
  private:
-  static constexpr std::int32_t in_overflow = -2, absent = -1, in_heap = -3;
+  static constexpr std::int32_t in_overflow = -2, absent = -1, in_heap = -3, pending = -4;
   static constexpr int crowded_bucket = 32;
   bool less(std::int32_t a, std::int32_t b) const {
     return node_[a].time < node_[b].time || (node_[a].time == node_[b].time && a < b);
@@ -61,6 +74,12 @@ class CalendarQueue {
   void place(std::int32_t id);
   void find_minimum();
   void restart_window();
+  /// Links pending entries, the oldest first, until at most `keep` are left.
+  void flush_pending(int keep);
+  /// Whether a pending entry's time belongs to the current bucket (or before it).
+  bool in_current_bucket(std::int32_t id) const {
+    return std::floor((node_[id].time - base_) / width_) < static_cast<double>(current_) + 1.0;
+  }
   /// The heap of a crowded current bucket: ids ordered by less(), each node's `next` holding
   /// its position.
   void heap_push(std::int32_t id);
@@ -77,7 +96,7 @@ class CalendarQueue {
   /// touches one line per entry, not five).
   struct Node {
     double time;
-    std::int32_t where;          ///< bucket, in_overflow, in_heap or absent
+    std::int32_t where;          ///< bucket, in_overflow, in_heap, pending or absent
     std::int32_t next, prev;     ///< links in the bucket's list (next: position in heap_)
     std::int32_t overflow_slot;  ///< position in overflow_ when there
   };
@@ -86,6 +105,10 @@ class CalendarQueue {
   std::vector<std::int32_t> overflow_;  // ids
   std::vector<std::int32_t> heap_;      // ids of the crowded current bucket (if sorted)
   bool sorted_ = false;                 // the current bucket lives in heap_
+  static constexpr int pending_capacity = 2;
+  std::int32_t pending_[pending_capacity + 1] = {};  // ids of pending entries, oldest first
+  int pending_count_ = 0;
+  bool deferred_ = false;
   std::int32_t current_ = 0;            // bucket holding the earliest times
   double base_ = 0.0, width_ = 1.0;
   std::size_t size_ = 0;

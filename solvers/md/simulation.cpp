@@ -30,6 +30,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
   calendar_.reset(use_calendar_ ? n : 0);
   lookahead_ = n >= lookahead_min_particles;
   lookahead_members_ = n >= lookahead_members_min_particles;
+  calendar_.set_deferred(lookahead_);
   for (std::size_t i = 0; i < n; ++i) predict(static_cast<std::int32_t>(i));
 }
 
@@ -55,6 +56,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
   calendar_.reset(use_calendar_ ? n : 0);
   lookahead_ = n >= lookahead_min_particles;
   lookahead_members_ = n >= lookahead_members_min_particles;
+  calendar_.set_deferred(lookahead_);
   for (std::size_t i = 0; i < n; ++i)
     schedule(static_cast<std::int32_t>(i), data_.events[i].next());
 }
@@ -157,6 +159,7 @@ void Simulation::step() {
   data_.time = crossing ? event.cell_time : event.time;
   const double now = data_.time;
   Particle& p = data_.particles[i];
+  const double before_i = p.t;
   update(i, now);
   Tally& tally = data_.tally;
   if (crossing) {
@@ -174,19 +177,22 @@ void Simulation::step() {
         break;
       }
       if (lookahead_members_) prefetch_members(cells_.cell(j));
+      const double before_j = q.t;
       update(j, now);
       Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
       r.x -= geometry_.width * std::round(r.x / geometry_.width);
       r.y -= geometry_.width * std::round(r.y / geometry_.width);
       if (geometry_.periodic_z) r.z -= geometry_.height * std::round(r.z / geometry_.height);
-      const PairCollision c = collide_pair(p, q, r, now, data_.last_collision[i], data_.last_collision[j], rules_);
+      const bool tc = rules_.tc_guard;
+      const PairCollision c = collide_pair(p, q, r, now, tc ? last_collision(i, before_i, rules_.tc) : no_collision_yet,
+                                           tc ? last_collision(j, before_j, rules_.tc) : no_collision_yet, rules_);
       ++tally.pair;
       if (c.happened) {
         tally.pair_loss += c.loss;
         tally.virial += c.virial;
         tally.guard_activations += c.elastic_by_guard ? 1 : 0;
-        note_collision(i, j);
-        note_collision(j, i);
+        note_collision(i, j, before_i);
+        note_collision(j, i, before_j);
       }
       // i first: its cells were prefetched longer ago (the order does not change the result:
       // each prediction writes only its own event, and the queue's order is total).
@@ -199,7 +205,7 @@ void Simulation::step() {
     case EventKind::plate:
     case EventKind::ceiling: {
       const bool plate = event.kind == EventKind::plate;
-      const double last = data_.last_collision[i];
+      const double last = rules_.tc_guard ? last_collision(i, before_i, rules_.tc) : no_collision_yet;
       const WallCollision c = plate ? collide_wall(p, geometry_.plate.velocity(now), 1.0, now, last, rules_)
                                     : collide_wall(p, 0.0, -1.0, now, last, rules_);
       ++(plate ? tally.plate : tally.ceiling);
@@ -207,7 +213,7 @@ void Simulation::step() {
         tally.plate_work += c.work;
         tally.wall_loss += c.loss;
         tally.guard_activations += c.elastic_by_guard ? 1 : 0;
-        note_collision(i, -1);
+        note_collision(i, -1, before_i);
       } else {
         ++tally.grazes;
       }
@@ -274,13 +280,12 @@ std::vector<std::uint64_t> Simulation::crossings_at(double t) const {
   return std::vector<std::uint64_t>(counts.begin(), counts.end());
 }
 
-void Simulation::note_collision(std::int32_t i, std::int32_t partner) {
+void Simulation::note_collision(std::int32_t i, std::int32_t partner, double before) {
   Particle& p = data_.particles[i];
   ++p.counter;
   const double now = data_.time;
-  double& last = data_.last_collision[static_cast<std::size_t>(i)];
   if (!rules_.tc_guard) {
-    if (now - last < collapse_interval) {
+    if (now - last_collision(i, before, collapse_interval) < collapse_interval) {
       if (++p.streak >= collapse_streak) {
         const std::string with = partner >= 0 ? fmt::format("particle {}", partner) : "a wall";
         throw CollapseError(fmt::format(
@@ -293,7 +298,7 @@ void Simulation::note_collision(std::int32_t i, std::int32_t partner) {
       p.streak = 0;
     }
   }
-  last = now;
+  data_.last_collision[static_cast<std::size_t>(i)] = now;
 }
 
 double Simulation::cell_crossing_delay(const Particle& p, int c, std::int32_t& direction) const {

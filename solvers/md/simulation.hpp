@@ -111,10 +111,14 @@ class Simulation {
   /// Heap property, index, and every pending event in the future of time().
   bool queue_consistent() const;
   std::size_t bytes_per_particle() const;
-  /// Software pipelining across events (see prefetch_stage1): on by default from
+  /// Software pipelining across events (see prefetch_stage1, and the calendar queue's deferred
+  /// insertion): on by default from
   /// lookahead_min_particles particles, where memory latency dominates. It only prefetches, so
   /// a run is the same with or without (tested); benchmarks switch it to compare.
-  void set_lookahead(bool on) { lookahead_ = lookahead_members_ = on; }
+  void set_lookahead(bool on) {
+    lookahead_ = lookahead_members_ = on;
+    calendar_.set_deferred(on);
+  }
   bool lookahead() const { return lookahead_; }
 
  private:
@@ -129,7 +133,15 @@ class Simulation {
   void predict_walls(std::int32_t i, Event& event, double& best, double cell_delay);
   double cell_crossing_delay(const Particle& p, int cell, std::int32_t& direction) const;
   void cross_cell(std::int32_t i, std::int32_t direction);
-  void note_collision(std::int32_t i, std::int32_t partner);
+  /// Counts a collision of i (at now; `before`: i's local time before this event).
+  void note_collision(std::int32_t i, std::int32_t partner, double before);
+  /// The time of i's last collision where it matters, for a test now - last < window; `before`
+  /// is i's local time before this event. The last collision is never later than any local
+  /// time since (a collision happens at the particle's local time), so if now - before >= window
+  /// the test fails either way and the array (a cache miss at large N) is not read.
+  double last_collision(std::int32_t i, double before, double window) const {
+    return data_.time - before < window ? data_.last_collision[static_cast<std::size_t>(i)] : no_collision_yet;
+  }
   /// Renumbers the particles in cell order (memory locality); called every
   /// sort_interval * N pair collisions.
   void sort_by_cell();

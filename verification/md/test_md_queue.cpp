@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <type_traits>
 #include <utility>
 
 #include "md/calendar_queue.hpp"
@@ -14,11 +15,13 @@ namespace {
 
 /// Random key changes like the event loop's; returns the number of wrong pops. With `crowd`,
 /// a quarter of the starting keys lie within 1e-12 of zero (like the lattice start's contacts),
-/// so that one calendar bucket holds hundreds of entries.
-template <class Queue> int wrong_pops_against_sorted_reference(bool crowd = false) {
+/// so that one calendar bucket holds hundreds of entries. `deferred`: the calendar queue's
+/// deferred insertion.
+template <class Queue> int wrong_pops_against_sorted_reference(bool crowd = false, bool deferred = false) {
   const std::int32_t n = 2000;
   Queue heap;
   heap.reset(static_cast<std::size_t>(n));
+  if constexpr (std::is_same_v<Queue, CalendarQueue>) heap.set_deferred(deferred);
   std::map<std::int32_t, double> keys;  // the reference: all current keys
   Random random(99);
   for (std::int32_t id = 0; id < n; ++id) {
@@ -55,6 +58,9 @@ TEST(MdEventQueue, PopOrderMatchesSortedReferenceUnderRandomUpdates) {
   EXPECT_EQ(wrong_pops_against_sorted_reference<CalendarQueue>(), 0);
   // A crowded bucket is sorted into a heap when the scan reaches it: the same order.
   EXPECT_EQ(wrong_pops_against_sorted_reference<CalendarQueue>(true), 0);
+  // Deferred insertion (large runs): pending entries count in the minimum search.
+  EXPECT_EQ(wrong_pops_against_sorted_reference<CalendarQueue>(false, true), 0);
+  EXPECT_EQ(wrong_pops_against_sorted_reference<CalendarQueue>(true, true), 0);
 }
 
 bool identical(const SimulationData& a, const SimulationData& b) {
