@@ -7,6 +7,7 @@
 // (the wall pressure) survives; mass, energy and tangential momentum fluxes are exactly zero,
 // so mass is conserved to round-off.
 #include <algorithm>
+#include <type_traits>
 #include <utility>
 
 #include "continuum/reconstruct.hpp"
@@ -56,9 +57,12 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
   const double* fn = w[0].data();
   const double* fp = closure.p.data();
   const double* fc = closure.c.data();
-  // minus[v][q], plus[v][q]: face states of the block's cell q at its low and high face.
-  using FaceStates = double[7][face_block + 1];
-  // S = double: cell c; S = Pair: cells c and c + 1 of a contiguous pencil (s = 1), every
+  // minus[v][slot], plus[v][slot]: face states at the low and high face of the block's cell q
+  // of pencil `lane`, slot = q W + lane, for W pencils at once (W = 2: two pencils side by side
+  // in x, whose cells are adjacent in storage).
+  using FaceStates = double[7][(face_block + 1) * 2];
+  // S = double: cell c; S = Pair: cells c and c + 1, either of a contiguous pencil (s = 1,
+  // slots q and q + 1) or of two pencils side by side (W = 2, the two lanes of cell q), every
   // lane doing the scalar arithmetic, the early returns of the scalar code as a mask.
   const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, int q,
                                   FaceStates& minus, FaceStates& plus, auto lanes) {
@@ -93,47 +97,52 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     const int normal = momentum_x + d;
     const int tangential1 = momentum_x + (d + 1) % 3, tangential2 = momentum_x + (d + 2) % 3;
     const int total = P.count_a * P.count_b;
-    // Dynamic scheduling: on a shared machine a thread that is held up does not hold up the
-    // other (pencils touch disjoint cells, so the result does not depend on the order). A
-    // chunk is a whole row or plane of pencils, so that two threads never write into the
-    // same cache line.
-#pragma omp parallel for schedule(dynamic, P.count_a) if (total > 1 && g.interior_cells() > 4096)
-    for (int pencil = 0; pencil < total; ++pencil) {
-      const std::ptrdiff_t base = P.base(g, d, pencil % P.count_a, pencil / P.count_a);
-      // Face f lies between cells f - 1 and f. A block of faces f0 .. f1 - 1 first
-      // reconstructs both face states of its cells f0 - 1 .. f1 - 1 (each cell's slopes
-      // once, field by field: simple loops without a dependence from one cell to the next),
-      // then solves the faces' Riemann problems.
-      for (int f0 = 0; f0 <= P.length; f0 += face_block) {
-        const int f1 = std::min(f0 + face_block, P.length + 1);
-        const int cells = f1 - f0 + 1;
-        const std::ptrdiff_t c0 = base + (f0 - 1) * s;  // the block's cell q is c0 + q s
-        FaceStates minus, plus;
-        for (int v = 0; v < 7; ++v) {
-          const double* x = fields[v];
-          if (s == 1) {  // a contiguous pencil: two cells per instruction
-            reconstruct_run<L>(x + c0, cells, minus[v], plus[v]);
-            continue;
+    // Block of faces f0 .. f1 - 1 of W pencils whose first cells are base, base + 1, ...
+    const auto block = [&](auto pencils, std::ptrdiff_t base, int f0, int f1) {
+      constexpr int W = decltype(pencils)::value;
+      // Face f lies between cells f - 1 and f. The block first reconstructs both face states
+      // of its cells f0 - 1 .. f1 - 1 (each cell's slopes once, field by field: simple loops
+      // without a dependence from one cell to the next), then solves the faces' Riemann
+      // problems.
+      const int cells = f1 - f0 + 1;
+      const std::ptrdiff_t c0 = base + (f0 - 1) * s;  // the block's cell q is c0 + q s
+      FaceStates minus, plus;
+      for (int v = 0; v < 7; ++v) {
+        const double* x = fields[v];
+        if (W == 2) {  // two pencils side by side: their cells are one Pair
+          for (int q = 0; q < cells; ++q) {
+            const std::ptrdiff_t c = c0 + q * s;
+            const Pair left = load_lanes<Pair>(x + c - s), middle = load_lanes<Pair>(x + c);
+            const Pair half_slope = 0.5 * limited_slope<L>(middle - left, load_lanes<Pair>(x + c + s) - middle);
+            store_lanes(minus[v] + 2 * q, middle - half_slope);
+            store_lanes(plus[v] + 2 * q, middle + half_slope);
           }
+        } else if (s == 1) {  // a contiguous pencil: two cells per instruction
+          reconstruct_run<L>(x + c0, cells, minus[v], plus[v]);
+        } else {
           for (int q = 0; q < cells; ++q) {
             const std::ptrdiff_t c = c0 + q * s;
             reconstruct<L>(x[c - s], x[c], x[c + s], minus[v][q], plus[v][q]);
           }
         }
-        double change[variable_count][face_block];  // flux / h of face f0 + b
-        if (pressure) {
-          int q = 0;
-          if (s == 1)
-            for (; q + 2 <= cells; q += 2) characteristic(c0 + q, s, un_index, q, minus, plus, Pair{});
-          for (; q < cells; ++q) characteristic(c0 + q * s, s, un_index, q, minus, plus, 0.0);
-        }
-        for (int f = f0; f < f1; ++f) {
+      }
+      double change[variable_count][face_block * 2];  // flux / h of face f0 + b, pencil l: b W + l
+      if (pressure) {
+        int q = 0;
+        if (W == 2)
+          for (; q < cells; ++q) characteristic(c0 + q * s, s, un_index, 2 * q, minus, plus, Pair{});
+        if (s == 1)
+          for (; q + 2 <= cells; q += 2) characteristic(c0 + q, s, un_index, q, minus, plus, Pair{});
+        for (; q < cells; ++q) characteristic(c0 + q * s, s, un_index, q, minus, plus, 0.0);
+      }
+      for (int f = f0; f < f1; ++f) {
+        for (int lane = 0; lane < W; ++lane) {
           const int q = f - f0 + 1;  // the block index of cell f
-          const std::ptrdiff_t cR = base + f * s, cL = cR - s;
+          const std::ptrdiff_t cR = base + lane + f * s, cL = cR - s;
           double left[7], right[7];
           for (int v = 0; v < 7; ++v) {
-            left[v] = plus[v][q - 1];
-            right[v] = minus[v][q];
+            left[v] = plus[v][(q - 1) * W + lane];
+            right[v] = minus[v][q * W + lane];
           }
           if (walls) {
             // Beside a wall the mirror ghost makes every even field a local extremum, and the
@@ -204,23 +213,45 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
           double F[5];
           riemann_flux<R>(SL, SR, F);
           if (walls && (f == 0 || f == P.length)) F[0] = F[2] = F[3] = F[4] = 0.0;
-          const int b = f - f0;
+          const int b = (f - f0) * W + lane;
           change[density][b] = F[0] * inv_h;
           change[energy][b] = F[4] * inv_h;
           change[normal][b] = F[1] * inv_h;
           change[tangential1][b] = F[2] * inv_h;
           change[tangential2][b] = F[3] * inv_h;
         }
-        // Face f adds to cell f (its high side) and subtracts from cell f - 1. Each cell
-        // receives its low face first, then its high face (in this block or the next), as in
-        // a face-by-face loop; the two loops have no dependence from one face to the next.
-        const int add_end = std::min(f1, P.length), subtract_begin = std::max(f0, 1);
-        for (int v = 0; v < variable_count; ++v) {
-          double* dU = dUdt.q[v].data() + base;
-          const double* ch = change[v];  // ch[f - f0]: face f
-          for (int f = f0; f < add_end; ++f) dU[f * s] += ch[f - f0];
-          for (int f = subtract_begin; f < f1; ++f) dU[(f - 1) * s] -= ch[f - f0];
+      }
+      // Face f adds to cell f (its high side) and subtracts from cell f - 1. Each cell
+      // receives its low face first, then its high face (in this block or the next), as in
+      // a face-by-face loop; the two loops have no dependence from one face to the next.
+      const int add_end = std::min(f1, P.length), subtract_begin = std::max(f0, 1);
+      for (int v = 0; v < variable_count; ++v) {
+        for (int lane = 0; lane < W; ++lane) {
+          double* dU = dUdt.q[v].data() + base + lane;
+          const double* ch = change[v] + lane;  // ch[(f - f0) W]: face f
+          for (int f = f0; f < add_end; ++f) dU[f * s] += ch[(f - f0) * W];
+          for (int f = subtract_begin; f < f1; ++f) dU[(f - 1) * s] -= ch[(f - f0) * W];
         }
+      }
+    };
+    // Pencils across x (y and z faces) go two at a time when nx is even: side by side in
+    // storage, one Pair holds both (bit for bit the scalar arithmetic of each).
+    // Dynamic scheduling: on a shared machine a thread that is held up does not hold up the
+    // other (pencils touch disjoint cells, so the result does not depend on the order). A
+    // chunk is a whole row or plane of pencils, so that two threads never write into the
+    // same cache line.
+    const bool paired = s != 1 && P.count_a % 2 == 0;
+    const int groups = paired ? total / 2 : total;
+#pragma omp parallel for schedule(dynamic, paired ? P.count_a / 2 : P.count_a) if (total > 1 && g.interior_cells() > 4096)
+    for (int group = 0; group < groups; ++group) {
+      const int pencil = paired ? 2 * group : group;
+      const std::ptrdiff_t base = P.base(g, d, pencil % P.count_a, pencil / P.count_a);
+      for (int f0 = 0; f0 <= P.length; f0 += face_block) {
+        const int f1 = std::min(f0 + face_block, P.length + 1);
+        if (paired)
+          block(std::integral_constant<int, 2>{}, base, f0, f1);
+        else
+          block(std::integral_constant<int, 1>{}, base, f0, f1);
       }
     }
   }

@@ -112,50 +112,72 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
   const int n_a = d == 0 ? g.ny : g.nx, n_b = d == 2 ? g.ny : g.nz;
   const int length = d == 0 ? g.nx : d == 1 ? g.ny : g.nz;
   const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
-  const int total = n_a * n_b;
-#pragma omp parallel for schedule(dynamic, n_a) if (total > 1 && g.interior_cells() > 4096)
-  for (int pencil = 0; pencil < total; ++pencil) {
-    const int a = pencil % n_a, b = pencil / n_a;
-    const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
-    for (int f = 0; f <= length; ++f) {
-      const std::ptrdiff_t cR = base + f * s, cL = cR - s;
-      // grad[i][j] = d u_i / d x_j at the face
-      double grad[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-      // Tangential derivatives enter only through d u_d / d x_t and the divergence
-      // (d u_t / d x_t); the other two are not needed.
-      for (int i = 0; i < 3; ++i) {
-        grad[i][d] = (u[i][cR] - u[i][cL]) * inv_h;
-        if (!three_d) continue;
-        for (int t = 0; t < 3; ++t) {
-          if (t == d || (i != d && i != t)) continue;
-          const std::ptrdiff_t st = strides[t];
-          grad[i][t] = 0.25 * inv_h * (u[i][cL + st] - u[i][cL - st] + u[i][cR + st] - u[i][cR - st]);
-        }
-      }
-      const double mu_f = harmonic_mean(mu[cL], mu[cR]);
-      const double lambda_f = harmonic_mean(lambda[cL], lambda[cR]);
-      const double kappa_f = harmonic_mean(kappa[cL], kappa[cR]);
-      const double divergence = grad[0][0] + grad[1][1] + grad[2][2];
-      double flux[variable_count] = {0, 0, 0, 0, 0};
-      double work = 0.0;
-      for (int i = 0; i < 3; ++i) {
-        double tau = mu_f * (grad[i][d] + grad[d][i]);
-        if (i == d) tau += (lambda_f - 2.0 / 3.0 * mu_f) * divergence;
-        flux[momentum_x + i] = -tau;
-        work += tau * 0.5 * (u[i][cL] + u[i][cR]);
-      }
-      flux[energy] = -work - kappa_f * (T[cR] - T[cL]) * inv_h;
-      if (walls && (f == 0 || f == length)) {
-        flux[energy] = 0.0;
-        for (int i = 0; i < 3; ++i)
-          if (i != d) flux[momentum_x + i] = 0.0;
-      }
-      for (int v = momentum_x; v < variable_count; ++v) {
-        const double change = flux[v] * inv_h;
-        if (f < length) dUdt.q[v][cR] += change;
-        if (f > 0) dUdt.q[v][cL] -= change;
+  // The face whose high-side cell is cR (S = double), or the faces of cells cR and cR + 1
+  // (S = Pair: x-neighbours, either two pencils side by side or two faces of an x pencil),
+  // every lane doing the scalar arithmetic. `add` / `subtract`: the face adds to its high
+  // cell / subtracts from its low cell (not both at the ends of a pencil).
+  const auto face = [&](std::ptrdiff_t cR, bool add, bool subtract, bool wall, auto lanes) {
+    using S = decltype(lanes);
+    const auto at = [](const double* x) { return load_lanes<S>(x); };
+    const std::ptrdiff_t cL = cR - s;
+    S grad[3][3] = {};  // grad[i][j] = d u_i / d x_j at the face
+    // Tangential derivatives enter only through d u_d / d x_t and the divergence
+    // (d u_t / d x_t); the other two are not needed.
+    for (int i = 0; i < 3; ++i) {
+      grad[i][d] = (at(u[i] + cR) - at(u[i] + cL)) * inv_h;
+      if (!three_d) continue;
+      for (int t = 0; t < 3; ++t) {
+        if (t == d || (i != d && i != t)) continue;
+        const std::ptrdiff_t st = strides[t];
+        grad[i][t] = 0.25 * inv_h * (at(u[i] + cL + st) - at(u[i] + cL - st) + at(u[i] + cR + st) - at(u[i] + cR - st));
       }
     }
+    const S mu_f = harmonic_mean(at(mu + cL), at(mu + cR));
+    const S lambda_f = harmonic_mean(at(lambda + cL), at(lambda + cR));
+    const S kappa_f = harmonic_mean(at(kappa + cL), at(kappa + cR));
+    const S divergence = grad[0][0] + grad[1][1] + grad[2][2];
+    S flux[variable_count] = {};
+    S work = S{};
+    for (int i = 0; i < 3; ++i) {
+      S tau = mu_f * (grad[i][d] + grad[d][i]);
+      if (i == d) tau += (lambda_f - 2.0 / 3.0 * mu_f) * divergence;
+      flux[momentum_x + i] = -tau;
+      work += tau * 0.5 * (at(u[i] + cL) + at(u[i] + cR));
+    }
+    flux[energy] = -work - kappa_f * (at(T + cR) - at(T + cL)) * inv_h;
+    if (wall) {
+      flux[energy] = S{};
+      for (int i = 0; i < 3; ++i)
+        if (i != d) flux[momentum_x + i] = S{};
+    }
+    for (int v = momentum_x; v < variable_count; ++v) {
+      const S change = flux[v] * inv_h;
+      double* dU = dUdt.q[v].data();
+      if (add) store_lanes(dU + cR, at(dU + cR) + change);
+      if (subtract) store_lanes(dU + cL, at(dU + cL) - change);
+    }
+  };
+  // y and z faces: two pencils side by side when nx is even; x faces: two faces at a time
+  // between the pencil's end faces. Either way each cell receives its low face before its
+  // high face, as in the face-by-face loop, so the sums are the same bit for bit.
+  const bool paired = d != 0 && n_a % 2 == 0;
+  const int total = paired ? n_a * n_b / 2 : n_a * n_b;
+#pragma omp parallel for schedule(dynamic, paired ? n_a / 2 : n_a) if (total > 1 && g.interior_cells() > 4096)
+  for (int group = 0; group < total; ++group) {
+    const int pencil = paired ? 2 * group : group;
+    const int a = pencil % n_a, b = pencil / n_a;
+    const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
+    const auto wall_face = [&](int f) { return walls && (f == 0 || f == length); };
+    if (paired) {
+      for (int f = 0; f <= length; ++f) face(base + f * s, f < length, f > 0, wall_face(f), Pair{});
+      continue;
+    }
+    int f = 0;
+    if (d == 0) {
+      face(base, true, false, false, 0.0);
+      for (f = 1; f + 1 < length; f += 2) face(base + f, true, true, false, Pair{});
+    }
+    for (; f <= length; ++f) face(base + f * s, f < length, f > 0, wall_face(f), 0.0);
   }
 }
 }  // namespace
