@@ -18,7 +18,7 @@ void CalendarQueue::reset(std::size_t n) {
   base_ = 0.0;
   size_ = 0;
   walk_bucket_ = 0;
-  walk_id_ = -1;
+  walk_link_count_ = 0;
   cached_valid_ = false;
 }
 
@@ -111,7 +111,7 @@ void CalendarQueue::restart_window() {
   }
   current_ = 0;
   walk_bucket_ = 0;
-  walk_id_ = -1;
+  walk_link_count_ = 0;
   if (finite == 0) {
     current_ = static_cast<std::int32_t>(head_.size());
     return;
@@ -230,26 +230,34 @@ void CalendarQueue::peek_after_top(std::int32_t also, std::int32_t next[3]) cons
   }
 }
 
-std::int32_t CalendarQueue::walk_ahead() {
+int CalendarQueue::walk_ahead(std::int32_t reached[2]) {
   const auto buckets = static_cast<std::int32_t>(head_.size());
   if (walk_bucket_ <= current_) {
     walk_bucket_ = current_ + 1;
-    walk_id_ = -1;
+    walk_link_count_ = 0;
+  }
+  int count = 0;
+  auto reach = [&](std::int32_t id) {
+    prefetch(id);
+    reached[count++] = id;
+    if (walk_link_count_ < 4) walk_links_[walk_link_count_++] = id;
+  };
+  if (walk_link_count_ > 0) {
+    // (If that entry moved since, its link leads elsewhere: harmless for a hint.)
+    const std::int32_t id = node_[walk_links_[0]].next;
+    --walk_link_count_;
+    for (int k = 0; k < walk_link_count_; ++k) walk_links_[k] = walk_links_[k + 1];
+    if (id >= 0) reach(id);
   }
   const std::int32_t end = std::min(buckets, current_ + 5);
-  while (walk_bucket_ < end) {
-    // (If walk_id_ moved since, its link leads elsewhere: harmless for a hint.)
-    const std::int32_t id = walk_id_ < 0 ? head_[static_cast<std::size_t>(walk_bucket_)] : node_[walk_id_].next;
-    if (id < 0) {
-      ++walk_bucket_;
-      walk_id_ = -1;
-      continue;
-    }
-    walk_id_ = id;
-    prefetch(id);
-    return id;
+  for (; walk_bucket_ < end; ++walk_bucket_) {
+    const std::int32_t id = head_[static_cast<std::size_t>(walk_bucket_)];
+    if (id < 0) continue;
+    reach(id);
+    ++walk_bucket_;
+    break;
   }
-  return -1;
+  return count;
 }
 
 bool CalendarQueue::consistent() const {

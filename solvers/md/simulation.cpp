@@ -140,10 +140,9 @@ void Simulation::step() {
     const std::int32_t partner = event.cell_time < event.time || event.kind != EventKind::pair ? -1 : event.partner;
     std::int32_t ahead[3];
     if (use_calendar_) {
-      for (int link = 0; link < 2; ++link) {
-        const std::int32_t later = calendar_.walk_ahead();
-        if (later >= 0) prefetch_stage1(later);
-      }
+      std::int32_t later[2];
+      const int reached = calendar_.walk_ahead(later);
+      for (int k = 0; k < reached; ++k) prefetch_stage1(later[k]);
       calendar_.peek_after_top(partner, ahead);
       // Each stage reads only what an earlier step prefetched (if the guesses hold).
       if (ahead[2] >= 0) prefetch_stage2(ahead[2]);
