@@ -30,7 +30,6 @@ import hashlib
 import json
 import math
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -518,18 +517,32 @@ def run_program(record):
     return commit.decode() if isinstance(commit, bytes) else commit
 
 
+COLLISION_COUNTS = ("pair_collisions", "plate_collisions", "ceiling_collisions")
+
+
+def run_collisions(path):
+    """Collisions an MD run file records for its own run: its running totals (continued across
+    checkpoints) at the last series row minus those at the first, the run's start."""
+    with h5py.File(path, "r") as f:
+        series = f["timeseries"]
+        if any(name not in series for name in COLLISION_COUNTS):
+            return None
+        return int(sum(series[name][-1] - series[name][0] for name in COLLISION_COUNTS))
+
+
 def collisions_per_second(view):
-    """Collisions per second of wall time of an MD case: the collisions its runs report on
-    stdout ("collisions: N (...)"), summed over a pool's runs, over their summed wall time
-    (kept in each run's record, so a reused run reports the rate it was run at)."""
+    """Collisions per second of wall time of an MD case: the collisions its run files record,
+    summed over a pool's runs, over their summed wall time (kept in each run's record, so a
+    reused run reports the rate it was run at)."""
     if view.solver != "md" or view.status != "ok" or not view.runs:
         return None
     runs = [r for r in view.runs if r["status"] == "ok"]
-    counts = [re.search(r"collisions: (\d+) \(", r.get("stdout") or "") for r in runs]
+    counts = [run_collisions(r["path"]) if r.get("path") and os.path.exists(r["path"]) else None
+              for r in runs]
     seconds = sum(r["seconds"] for r in runs)
     if not runs or None in counts or seconds <= 0:
         return None
-    return sum(int(m.group(1)) for m in counts) / seconds
+    return sum(counts) / seconds
 
 
 def main(argv=None):
@@ -542,9 +555,8 @@ def main(argv=None):
                         help="where runs, analyses and derived files go (reused across calls)")
     parser.add_argument("--report", default=os.path.join(ROOT, "reports", "validation.md"))
     parser.add_argument("--claims", default=os.path.join(ROOT, "reference-data", "claims.toml"))
-    parser.add_argument("--gci", default=os.path.join(ROOT, "reports", "convergence-tables",
-                                                      "real-1d-base.gci.csv"),
-                        help="GCI table of the base-case grid study (continuum uncertainty)")
+    parser.add_argument("--gci", help="GCI table of the base-case grid study (continuum "
+                                      "uncertainty; default: the report generator's)")
     parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
     parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
     parser.add_argument("--bootstrap", type=int, help="bootstrap replicates of MD profiles")
@@ -633,8 +645,8 @@ def main(argv=None):
 
     report = subprocess.run([sys.executable, os.path.join(ROOT, "reports",
                                                           "make_validation_report.py"),
-                             "--results", results_path, "--output", args.report,
-                             "--gci", args.gci])
+                             "--results", results_path, "--output", args.report]
+                            + (["--gci", args.gci] if args.gci else []))
     if report.returncode != 0:
         log("the report generator failed")
         return 1

@@ -26,6 +26,9 @@ sys.path.insert(0, os.path.dirname(HERE))
 import run_validation  # noqa: E402
 
 
+# Collisions each synthetic MD run records in its running totals (see write_run).
+SYNTHETIC_COLLISIONS = 200000.0
+
 def plate(config, t):
     gamma, f = config["shaker"]["gamma"], config["shaker"]["frequency"]
     omega = 2 * math.pi * f
@@ -124,7 +127,13 @@ def write_run(path, config_text, solver, seed):
             per_cycle = 0.3 if config["layer"]["particles"] > 3000 else 5.0
             data["crossings_z80"] = per_cycle * (times - times[0]) * f
             data["collisions"] = 240000.0 * (times - times[0]) * f
-            columns += ["crossings_z80", "collisions"]
+            # Running totals as a continued run has them (not starting at 0): SYNTHETIC_COLLISIONS
+            # collisions in the run, pair + plate.
+            data["pair_collisions"] = np.linspace(5000.0, 5000.0 + SYNTHETIC_COLLISIONS - 20000.0, len(times))
+            data["plate_collisions"] = np.linspace(700.0, 700.0 + 20000.0, len(times))
+            data["ceiling_collisions"] = np.full(len(times), 3.0)
+            columns += ["crossings_z80", "collisions", "pair_collisions", "plate_collisions",
+                        "ceiling_collisions"]
         s.attrs["columns"] = ",".join(columns)
         for name in columns:
             s.create_dataset(name, data=np.asarray(data[name], dtype=float))

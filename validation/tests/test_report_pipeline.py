@@ -25,6 +25,8 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 VALIDATION = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import synthetic_runs  # noqa: E402  (the cartoon's collision count)
 CASES = ("base,single_shock_e0p99,single_shock_e0p90,single_shock_e0p85,velocity_dependent,"
          "depth_h4p5,depth_h13p5,collapse_e0p70")
 FIGURES = ("fig1-profiles.png", "fig2-single-shock.png", "fig3-mach.png", "fig4-mach-width.png",
@@ -114,6 +116,19 @@ def main():
     expect(md_c13 == "not measured", f"C13 without the e = 0.80 runs: {md_c13}")
     expect(claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None,
            "C14 has a jackknife error from the pooled runs")
+
+    md_views = [v for v in results["views"].values() if v["solver"] == "md" and v["status"] == "ok"]
+    for view in md_views:
+        seconds = sum(r["seconds"] for r in results["runs"] if r["case"] == view["case"]
+                      and r["solver"] == "md" and r["status"] == "ok")
+        runs = sum(1 for r in results["runs"] if r["case"] == view["case"] and r["solver"] == "md"
+                   and r["status"] == "ok")
+        expected = runs * synthetic_runs.SYNTHETIC_COLLISIONS / seconds
+        rate = view["collisions_per_second"]
+        expect(rate is not None and abs(rate - expected) <= 1e-9 * expected,
+               f"{view['case']}: MD collisions per second from the run files' running totals "
+               f"{rate} (cartoon: {expected})")
+    expect(len(md_views) > 0, f"MD views with a collision rate: {len(md_views)}")
 
     c6, c5 = rows.get("C6", "").split(" | "), rows.get("C5", "").split(" | ")
     c6_continuum = c6[4] if len(c6) > 4 else ""
