@@ -249,7 +249,8 @@ int CalendarQueue::walk_ahead(std::int32_t reached[2]) {
     for (int k = 0; k < walk_link_count_; ++k) walk_links_[k] = walk_links_[k + 1];
     if (id >= 0) reach(id);
   }
-  const std::int32_t end = std::min(buckets, current_ + 5);
+  // Eight buckets ahead (four was 2 % slower at N = 400000 and 40000).
+  const std::int32_t end = std::min(buckets, current_ + 9);
   for (; walk_bucket_ < end; ++walk_bucket_) {
     const std::int32_t id = head_[static_cast<std::size_t>(walk_bucket_)];
     if (id < 0) continue;

@@ -145,7 +145,7 @@ void Simulation::step() {
       for (int k = 0; k < reached; ++k) prefetch_stage1(later[k]);
       calendar_.peek_after_top(partner, ahead);
       // Each stage reads only what an earlier step prefetched (if the guesses hold).
-      if (ahead[2] >= 0) prefetch_stage2(ahead[2]);
+      if (ahead[2] >= 0) prefetch_stage1(ahead[2]);
       if (ahead[1] >= 0) prefetch_stage2(ahead[1]);
       if (ahead[0] >= 0 && lookahead_members_) prefetch_stage3(ahead[0]);
     } else {

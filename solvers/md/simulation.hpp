@@ -152,9 +152,10 @@ class Simulation {
   /// Software pipelining across events (large N, where every event waits for memory): while
   /// event k is processed, what the next events will read is prefetched in stages, each stage
   /// reading only what an earlier one brought in. Stage 1, for entries the calendar queue's
-  /// cursor meets a few buckets ahead: their event, state and cell. Stage 2, for the next two
-  /// entries of the current bucket (events k + 1 and k + 2, most likely): the heads of their 27
-  /// cells, and the partner's state, counter, event and cell. Stage 3, for event k + 1: the
+  /// cursor meets a few buckets ahead, and for event k + 3: their event, state and cell.
+  /// Stage 2, for event k + 2 (the guesses come from the queue): the heads of its 27 cells,
+  /// and the partner's state, event and cell (stage 2 for k + 3 as well read events that had
+  /// not arrived yet: 2 % slower at N = 400000). Stage 3, for event k + 1: the
   /// first member of each of its cells, and the partner's cell heads; event k itself prefetches
   /// its partner's first members before the collision. Hints only: the same results either way.
   void prefetch_stage1(std::int32_t a) const;
