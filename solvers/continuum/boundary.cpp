@@ -10,25 +10,29 @@ namespace shaker::continuum {
 
 namespace {
 /// Calls copy(to, from, reverse_z) for every ghost cell, in an order in which every source
-/// cell is already filled (x, then y including the x ghosts, then z including both).
+/// cell is already filled (x, then y including the x ghosts, plane by plane; then z including
+/// both). Ghosts are disjoint and each is a copy, so the threads' order does not matter.
 template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
   const int G = Grid::ghosts;
+  const bool threaded = g.dimension == 3 && g.interior_cells() > 4096;
   if (g.dimension == 3) {
-    for (int k = 0; k < g.nz; ++k)
+#pragma omp parallel for schedule(static) if (threaded)
+    for (int k = 0; k < g.nz; ++k) {
       for (int j = 0; j < g.ny; ++j)
         for (int m = 1; m <= G; ++m) {
           copy(g.index(-m, j, k), g.index(g.nx - m, j, k), false);
           copy(g.index(g.nx - 1 + m, j, k), g.index(m - 1, j, k), false);
         }
-    for (int k = 0; k < g.nz; ++k)
       for (int i = -G; i < g.nx + G; ++i)
         for (int m = 1; m <= G; ++m) {
           copy(g.index(i, -m, k), g.index(i, g.ny - m, k), false);
           copy(g.index(i, g.ny - 1 + m, k), g.index(i, m - 1, k), false);
         }
+    }
   }
   const int gxy = g.ghosts_xy();
   const bool walls = g.z_boundary == ZBoundary::walls;
+#pragma omp parallel for schedule(static) if (threaded)
   for (int j = -gxy; j < g.ny + gxy; ++j)
     for (int i = -gxy; i < g.nx + gxy; ++i)
       for (int m = 1; m <= G; ++m) {

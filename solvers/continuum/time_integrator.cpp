@@ -62,6 +62,7 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
   // Almost always every cell is admissible and above the floor: one branch-free scan (which
   // vectorises) establishes that, and only otherwise the cell-by-cell pass below runs.
   bool suspect = false;
+#pragma omp parallel for schedule(static) reduction(|| : suspect) if (g.interior_rows() > 1 && g.interior_cells() > 4096)
   for (int row = 0; row < g.interior_rows(); ++row) {
     const std::ptrdiff_t first = g.row_start(row);
     for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) {
