@@ -75,6 +75,11 @@ class CellList {
       prefetch(&head_[static_cast<std::size_t>(cell)]);
     });
   }
+  /// Prefetches the list links of particle p (a hint: nothing is read).
+  void prefetch_links(std::int32_t p) const {
+    prefetch(&prev_[static_cast<std::size_t>(p)]);
+    prefetch(&next_[static_cast<std::size_t>(p)]);
+  }
   /// The cell next to c across its face `direction` (2 axis + 1 if upwards), wrapping
   /// periodically (or c itself beyond a wall: a hint for prefetching only).
   int neighbor_cell(int c, int direction) const {

@@ -91,6 +91,7 @@ void Simulation::prefetch_stage2(std::int32_t a) const {
   const int c = cells_.cell(a);
   if (e.cell_time < e.time) {
     cells_.prefetch_block(cells_.neighbor_cell(c, e.cell_direction));
+    cells_.prefetch_links(a);  // the crossing unlinks a from its cell
     return;
   }
   cells_.prefetch_block(c);
