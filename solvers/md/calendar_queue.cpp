@@ -22,7 +22,8 @@ void CalendarQueue::reset(std::size_t n) {
   cached_valid_ = false;
 }
 
-void CalendarQueue::unlink(std::int32_t id) {
+// (Inlined into update, the hot path: out of line it cost ~2 % at N = 4000.)
+[[gnu::always_inline]] inline void CalendarQueue::unlink(std::int32_t id) {
   const std::int32_t w = node_[id].where;
   if (w == absent) return;
   if (w == pending) {
@@ -46,7 +47,7 @@ void CalendarQueue::unlink(std::int32_t id) {
   node_[id].where = absent;
 }
 
-void CalendarQueue::place(std::int32_t id) {
+[[gnu::always_inline]] inline void CalendarQueue::place(std::int32_t id) {
   const double nb = static_cast<double>(head_.size());
   const double k = std::floor((node_[id].time - base_) / width_);
   if (!(k < nb) || current_ >= static_cast<std::int32_t>(head_.size())) {
