@@ -14,10 +14,18 @@ namespace {
 /// both). Ghosts are disjoint and each is a copy, so the threads' order does not matter.
 template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
   const int G = Grid::ghosts;
-  const bool threaded = g.dimension == 3 && g.interior_cells() > 4096;
+  // An OpenMP region with a false `if` still costs a runtime call: a 1D column (two ghost
+  // copies per end) takes the plain loop.
+  const auto loop = [&](int begin, int end, auto body) {
+    if (g.dimension == 3 && g.interior_cells() > 4096) {
+#pragma omp parallel for schedule(static)
+      for (int m = begin; m < end; ++m) body(m);
+    } else {
+      for (int m = begin; m < end; ++m) body(m);
+    }
+  };
   if (g.dimension == 3) {
-#pragma omp parallel for schedule(static) if (threaded)
-    for (int k = 0; k < g.nz; ++k) {
+    loop(0, g.nz, [&](int k) {
       for (int j = 0; j < g.ny; ++j)
         for (int m = 1; m <= G; ++m) {
           copy(g.index(-m, j, k), g.index(g.nx - m, j, k), false);
@@ -28,12 +36,11 @@ template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
           copy(g.index(i, -m, k), g.index(i, g.ny - m, k), false);
           copy(g.index(i, g.ny - 1 + m, k), g.index(i, m - 1, k), false);
         }
-    }
+    });
   }
   const int gxy = g.ghosts_xy();
   const bool walls = g.z_boundary == ZBoundary::walls;
-#pragma omp parallel for schedule(static) if (threaded)
-  for (int j = -gxy; j < g.ny + gxy; ++j)
+  loop(-gxy, g.ny + gxy, [&](int j) {
     for (int i = -gxy; i < g.nx + gxy; ++i)
       for (int m = 1; m <= G; ++m) {
         if (walls) {
@@ -44,6 +51,7 @@ template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
           copy(g.index(i, j, g.nz - 1 + m), g.index(i, j, m - 1), false);
         }
       }
+  });
 }
 }  // namespace
 

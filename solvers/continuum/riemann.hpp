@@ -23,8 +23,10 @@ inline void physical_flux(const FaceState& s, double E, double* F) {
   F[4] = (E + s.p) * s.un;
 }
 
+// Always inlined into the per-face loop of the flux kernel: GCC declined once that loop became
+// a template over the number of pencils, and the call cost ~5 % of a 1D run.
 template <RiemannSolver Solver>
-inline void riemann_flux(const FaceState& L, const FaceState& R, double* F) {
+[[gnu::always_inline]] inline void riemann_flux(const FaceState& L, const FaceState& R, double* F) {
   const double SL = std::min(L.un - L.c, R.un - R.c);
   const double SR = std::max(L.un + L.c, R.un + R.c);
   const double EL = L.total_energy(), ER = R.total_energy();

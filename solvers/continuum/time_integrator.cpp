@@ -61,10 +61,9 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
   double* E = s.q[energy].data();
   // Almost always every cell is admissible and above the floor: one branch-free scan (which
   // vectorises) establishes that, and only otherwise the cell-by-cell pass below runs.
-  bool suspect = false;
-#pragma omp parallel for schedule(static) reduction(|| : suspect) if (g.interior_rows() > 1 && g.interior_cells() > 4096)
-  for (int row = 0; row < g.interior_rows(); ++row) {
+  const auto row_suspect = [&](int row) {
     const std::ptrdiff_t first = g.row_start(row);
+    bool any = false;
     for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) {
       const double n = N[c];
       const double kinetic = 0.5 * (Mx[c] * Mx[c] + My[c] * My[c] + Mz[c] * Mz[c]) / n;
@@ -72,8 +71,16 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
       // suspect through n or through E - kinetic.
       const bool fine = n > 0.0 && volume_fraction(n) < nu_max && E[c] - kinetic >= 1.5 * n * floor &&
                         E[c] - kinetic < std::numeric_limits<double>::infinity();
-      suspect = suspect || !fine;
+      any = any || !fine;
     }
+    return any;
+  };
+  bool suspect = false;
+  if (g.interior_rows() > 1 && g.interior_cells() > 4096) {
+#pragma omp parallel for schedule(static) reduction(|| : suspect)
+    for (int row = 0; row < g.interior_rows(); ++row) suspect = row_suspect(row) || suspect;
+  } else {
+    for (int row = 0; row < g.interior_rows(); ++row) suspect = row_suspect(row) || suspect;
   }
   if (!suspect) {
     if (added) *added = 0.0;
