@@ -4,6 +4,7 @@
 // so positive fields (n, T, p, c) stay positive at faces.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "continuum/operator.hpp"
 #include "continuum/simd_pair.hpp"
@@ -60,21 +61,23 @@ inline void reconstruct(double left, double middle, double right, double& minus,
   plus = middle + half_slope;
 }
 
+/// reconstruct() for the adjacent cells x[0] and x[1] at once, their neighbours s away
+/// (s = 1: a contiguous run; s = a stride: two pencils side by side); the faces of x[0] go to
+/// minus[0], plus[0], those of x[1] to minus[1], plus[1].
+template <Limiter L>
+inline void reconstruct_pair(const double* x, std::ptrdiff_t s, double* minus, double* plus) {
+  const Pair left = load_lanes<Pair>(x - s), middle = load_lanes<Pair>(x);
+  const Pair half_slope = 0.5 * limited_slope<L>(middle - left, load_lanes<Pair>(x + s) - middle);
+  store_lanes(minus, middle - half_slope);
+  store_lanes(plus, middle + half_slope);
+}
+
 /// reconstruct() for cells 0 .. count - 1 of a contiguous run x (x[-1] and x[count] exist),
 /// two cells at a time.
 template <Limiter L>
 inline void reconstruct_run(const double* x, int count, double* minus, double* plus) {
   int q = 0;
-  for (; q + 2 <= count; q += 2) {
-    Pair left, middle, right;
-    __builtin_memcpy(&left, x + q - 1, sizeof(Pair));
-    __builtin_memcpy(&middle, x + q, sizeof(Pair));
-    __builtin_memcpy(&right, x + q + 1, sizeof(Pair));
-    const Pair half_slope = 0.5 * limited_slope<L>(middle - left, right - middle);
-    const Pair low = middle - half_slope, high = middle + half_slope;
-    __builtin_memcpy(minus + q, &low, sizeof(Pair));
-    __builtin_memcpy(plus + q, &high, sizeof(Pair));
-  }
+  for (; q + 2 <= count; q += 2) reconstruct_pair<L>(x + q, 1, minus + q, plus + q);
   for (; q < count; ++q) reconstruct<L>(x[q - 1], x[q], x[q + 1], minus[q], plus[q]);
 }
 

@@ -110,13 +110,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
       for (int v = 0; v < 7; ++v) {
         const double* x = fields[v];
         if (W == 2) {  // two pencils side by side: their cells are one Pair
-          for (int q = 0; q < cells; ++q) {
-            const std::ptrdiff_t c = c0 + q * s;
-            const Pair left = load_lanes<Pair>(x + c - s), middle = load_lanes<Pair>(x + c);
-            const Pair half_slope = 0.5 * limited_slope<L>(middle - left, load_lanes<Pair>(x + c + s) - middle);
-            store_lanes(minus[v] + 2 * q, middle - half_slope);
-            store_lanes(plus[v] + 2 * q, middle + half_slope);
-          }
+          for (int q = 0; q < cells; ++q) reconstruct_pair<L>(x + c0 + q * s, s, minus[v] + 2 * q, plus[v] + 2 * q);
         } else if (s == 1) {  // a contiguous pencil: two cells per instruction
           reconstruct_run<L>(x + c0, cells, minus[v], plus[v]);
         } else {
