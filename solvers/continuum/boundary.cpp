@@ -14,10 +14,8 @@ namespace {
 /// both). Ghosts are disjoint and each is a copy, so the threads' order does not matter.
 template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
   const int G = Grid::ghosts;
-  // An OpenMP region with a false `if` still costs a runtime call: a 1D column (two ghost
-  // copies per end) takes the plain loop.
   const auto loop = [&](int begin, int end, auto body) {
-    if (g.dimension == 3 && g.interior_cells() > 4096) {
+    if (g.threaded()) {
 #pragma omp parallel for schedule(static)
       for (int m = begin; m < end; ++m) body(m);
     } else {

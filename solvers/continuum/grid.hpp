@@ -43,6 +43,9 @@ struct Grid {
     return dimension == 3 ? index(0, row % ny, row / ny) : index(0, 0, 0);
   }
   int row_length() const { return dimension == 3 ? nx : nx * ny * nz; }
+  /// Worth sharing between OpenMP threads: a 3D box of more than 4096 cells. A 1D column never
+  /// is (one run of cells; even entering a region whose `if` is false costs a runtime call).
+  bool threaded() const { return dimension == 3 && interior_cells() > 4096; }
 };
 
 /// A grid of cell size h over [0, width]^2 x [0, height]; throws InputError naming the key

@@ -28,7 +28,7 @@ void Operator::rhs(double t, State& U, State& dUdt, Part part) {
   update_primitives_and_closure(U, diffusive);
   // A large grid is zeroed plane by plane on every thread (serial, the fill of the 3D box
   // would be the largest serial part of the evaluation).
-  if (grid_.dimension == 3 && grid_.interior_cells() > 4096) {
+  if (grid_.threaded()) {
     const std::ptrdiff_t plane = grid_.stride_z();
     const int planes = static_cast<int>(static_cast<std::ptrdiff_t>(grid_.size()) / plane);
 #pragma omp parallel for schedule(static)
@@ -56,7 +56,7 @@ static double interior_maximum(const Grid& g, CellValue value) {
     return m;
   };
   double largest = 0.0;
-  if (g.interior_cells() > 4096) {
+  if (g.threaded()) {
 #pragma omp parallel for schedule(static) reduction(max : largest)
     for (int row = 0; row < rows; ++row) largest = std::max(largest, run(row));
   } else {

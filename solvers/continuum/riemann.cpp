@@ -236,7 +236,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     // same cache line.
     const bool paired = s != 1 && P.count_a % 2 == 0;
     const int groups = paired ? total / 2 : total;
-#pragma omp parallel for schedule(dynamic, paired ? P.count_a / 2 : P.count_a) if (total > 1 && g.interior_cells() > 4096)
+#pragma omp parallel for schedule(dynamic, paired ? P.count_a / 2 : P.count_a) if (g.threaded())
     for (int group = 0; group < groups; ++group) {
       const int pencil = paired ? 2 * group : group;
       const std::ptrdiff_t base = P.base(g, d, pencil % P.count_a, pencil / P.count_a);

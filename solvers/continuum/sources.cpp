@@ -38,7 +38,7 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
   if (g.dimension != 3) {
     run(g.row_start(0), g.row_length(), body, lost);
   } else {
-#pragma omp parallel for schedule(static) reduction(+ : body, lost) if (g.nz > 1 && g.interior_cells() > 4096 && !external)
+#pragma omp parallel for schedule(static) reduction(+ : body, lost) if (g.nz > 1 && g.threaded() && !external)
     for (int k = 0; k < g.nz; ++k)
       for (int j = 0; j < g.ny; ++j) run(g.index(0, j, k), g.nx, body, lost);
   }

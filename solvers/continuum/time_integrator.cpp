@@ -30,7 +30,7 @@ void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const 
     }
   };
   const int rows = g.interior_rows();
-  if (g.interior_cells() > 4096) {
+  if (g.threaded()) {
 #pragma omp parallel for schedule(dynamic, 2 * g.ny)
     for (int row = 0; row < rows; ++row) run(row);
   } else {
@@ -76,7 +76,7 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
     return any;
   };
   bool suspect = false;
-  if (g.interior_rows() > 1 && g.interior_cells() > 4096) {
+  if (g.threaded()) {
 #pragma omp parallel for schedule(static) reduction(|| : suspect)
     for (int row = 0; row < g.interior_rows(); ++row) suspect = row_suspect(row) || suspect;
   } else {

@@ -250,7 +250,7 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
     }
   };
   const int rows = g.interior_rows();
-  if (g.interior_cells() > 4096) {
+  if (g.threaded()) {
     // Rows of x; dynamic scheduling: on a shared machine a thread that is held up does not
     // hold up the other. An exception must not leave an OpenMP region: the first failure is
     // kept and rethrown.

@@ -162,7 +162,7 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
   // high face, as in the face-by-face loop, so the sums are the same bit for bit.
   const bool paired = d != 0 && n_a % 2 == 0;
   const int total = paired ? n_a * n_b / 2 : n_a * n_b;
-#pragma omp parallel for schedule(dynamic, paired ? n_a / 2 : n_a) if (total > 1 && g.interior_cells() > 4096)
+#pragma omp parallel for schedule(dynamic, paired ? n_a / 2 : n_a) if (g.threaded())
   for (int group = 0; group < total; ++group) {
     const int pencil = paired ? 2 * group : group;
     const int a = pencil % n_a, b = pencil / n_a;
