@@ -26,11 +26,7 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
     advance(p, data_.time, geometry_.gravity);  // predictions assume p.t == now
     cells_.insert(static_cast<std::int32_t>(i), cells_.cell_of(p.r));
   }
-  heap_.reset(use_calendar_ ? 0 : n);
-  calendar_.reset(use_calendar_ ? n : 0);
-  lookahead_ = n >= lookahead_min_particles;
-  lookahead_members_ = n >= lookahead_members_min_particles;
-  calendar_.set_deferred(lookahead_);
+  reset_queue(n);
   for (std::size_t i = 0; i < n; ++i) predict(static_cast<std::int32_t>(i));
 }
 
@@ -52,13 +48,17 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, Si
   data_.cell_next.clear();
   data_.cell_prev.clear();
   data_.cell_of.clear();
+  reset_queue(n);
+  for (std::size_t i = 0; i < n; ++i)
+    schedule(static_cast<std::int32_t>(i), data_.events[i].next());
+}
+
+void Simulation::reset_queue(std::size_t n) {
   heap_.reset(use_calendar_ ? 0 : n);
   calendar_.reset(use_calendar_ ? n : 0);
   lookahead_ = n >= lookahead_min_particles;
   lookahead_members_ = n >= lookahead_members_min_particles;
   calendar_.set_deferred(lookahead_);
-  for (std::size_t i = 0; i < n; ++i)
-    schedule(static_cast<std::int32_t>(i), data_.events[i].next());
 }
 
 SimulationData Simulation::save() const {

@@ -174,6 +174,8 @@ class Simulation {
   CollisionRules rules_;
   SimulationData data_;
   CellList cells_;
+  /// An empty queue of the chosen kind for n particles, and the lookahead its size calls for.
+  void reset_queue(std::size_t n);
   void schedule(std::int32_t i, double time) {
     if (use_calendar_) calendar_.update(i, time);
     else heap_.update(i, time);
