@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "md/event_queue.hpp"
+
 namespace shaker::md {
 
 void CalendarQueue::reset(std::size_t n) {
@@ -189,20 +191,10 @@ void CalendarQueue::heap_remove(std::int32_t id) {
 
 // Moves the entry at `at` up or down to its place.
 void CalendarQueue::heap_sift(std::size_t at) {
-  const std::int32_t id = heap_[at];
-  while (at > 0 && less(id, heap_[(at - 1) / 2])) {
-    heap_set(at, heap_[(at - 1) / 2]);
-    at = (at - 1) / 2;
-  }
-  for (;;) {
-    std::size_t child = 2 * at + 1;
-    if (child >= heap_.size()) break;
-    if (child + 1 < heap_.size() && less(heap_[child + 1], heap_[child])) ++child;
-    if (!less(heap_[child], id)) break;
-    heap_set(at, heap_[child]);
-    at = child;
-  }
-  heap_set(at, id);
+  auto less = [this](std::int32_t a, std::int32_t b) { return this->less(a, b); };
+  auto place = [this](std::size_t k, std::int32_t id) { heap_set(k, id); };
+  at = sift_up(heap_.data(), at, less, place);
+  sift_down(heap_.data(), heap_.size(), at, less, place);
 }
 
 void CalendarQueue::peek_after_top(std::int32_t also, std::int32_t next[3]) const {

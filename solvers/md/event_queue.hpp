@@ -11,6 +11,36 @@
 
 namespace shaker::md {
 
+/// Binary-heap sifting, shared by IndexedHeap and the calendar queue's crowded bucket. `place(k,
+/// value)` stores value at position k and records the position wherever its heap keeps it.
+/// Moves heap[at] up to its place; returns where it ended.
+template <class T, class Less, class Place>
+std::size_t sift_up(const T* heap, std::size_t at, Less less, Place place) {
+  const T value = heap[at];
+  while (at > 0) {
+    const std::size_t parent = (at - 1) / 2;
+    if (!less(value, heap[parent])) break;
+    place(at, heap[parent]);
+    at = parent;
+  }
+  place(at, value);
+  return at;
+}
+/// Moves heap[at] of a heap of `size` entries down to its place.
+template <class T, class Less, class Place>
+void sift_down(const T* heap, std::size_t size, std::size_t at, Less less, Place place) {
+  const T value = heap[at];
+  for (;;) {
+    std::size_t child = 2 * at + 1;
+    if (child >= size) break;
+    if (child + 1 < size && less(heap[child + 1], heap[child])) ++child;
+    if (!less(heap[child], value)) break;
+    place(at, heap[child]);
+    at = child;
+  }
+  place(at, value);
+}
+
 class IndexedHeap {
  public:
   void reset(std::size_t n) {
@@ -68,32 +98,17 @@ class IndexedHeap {
   static bool less(const Entry& a, const Entry& b) {
     return a.time < b.time || (a.time == b.time && a.id < b.id);
   }
-  void place(std::int32_t at, const Entry& e) {
-    heap_[at] = e;
-    position_[e.id] = at;
+  auto placer() {
+    return [this](std::size_t at, const Entry& e) {
+      heap_[at] = e;
+      position_[e.id] = static_cast<std::int32_t>(at);
+    };
   }
   void sift_up(std::int32_t at) {
-    const Entry e = heap_[at];
-    while (at > 0) {
-      const std::int32_t parent = (at - 1) / 2;
-      if (!less(e, heap_[parent])) break;
-      place(at, heap_[parent]);
-      at = parent;
-    }
-    place(at, e);
+    md::sift_up(heap_.data(), static_cast<std::size_t>(at), less, placer());
   }
   void sift_down(std::int32_t at) {
-    const Entry e = heap_[at];
-    const auto n = static_cast<std::int32_t>(heap_.size());
-    for (;;) {
-      std::int32_t child = 2 * at + 1;
-      if (child >= n) break;
-      if (child + 1 < n && less(heap_[child + 1], heap_[child])) ++child;
-      if (!less(heap_[child], e)) break;
-      place(at, heap_[child]);
-      at = child;
-    }
-    place(at, e);
+    md::sift_down(heap_.data(), heap_.size(), static_cast<std::size_t>(at), less, placer());
   }
   std::vector<Entry> heap_;
   std::vector<std::int32_t> position_;
