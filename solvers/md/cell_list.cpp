@@ -62,4 +62,40 @@ void CellList::remove(std::int32_t p) {
   cell_[p] = -1;
 }
 
+std::string CellList::inconsistency(const std::vector<Particle>& particles, double tolerance) const {
+  const auto n = static_cast<std::int32_t>(particles.size());
+  if (next_.size() != particles.size() || prev_.size() != particles.size() || cell_.size() != particles.size())
+    return fmt::format("{} particles but lists for {}", n, cell_.size());
+  std::vector<bool> listed(particles.size(), false);
+  const auto cells = static_cast<int>(head_.size());
+  for (int c = 0; c < cells; ++c) {
+    std::int32_t before = -1;
+    for (std::int32_t j = head_[static_cast<std::size_t>(c)]; j >= 0; before = j, j = next_[static_cast<std::size_t>(j)]) {
+      if (j >= n) return fmt::format("cell {} lists particle {}; allowed 0 to {}", c, j, n - 1);
+      const auto k = static_cast<std::size_t>(j);
+      if (listed[k]) return fmt::format("particle {} is listed twice", j);
+      listed[k] = true;
+      if (cell_[k] != c) return fmt::format("particle {} is listed in cell {} but its cell is {}", j, c, cell_[k]);
+      if (prev_[k] != before) return fmt::format("particle {}: backward link {}, expected {}", j, prev_[k], before);
+    }
+  }
+  for (std::int32_t i = 0; i < n; ++i)
+    if (!listed[static_cast<std::size_t>(i)]) return fmt::format("particle {} is in no cell list", i);
+  // The lowest row reaches down to the plate and the open top row up to the ceiling.
+  auto outside = [tolerance](double u, int index, double edge, int count, bool open_ends) {
+    const double lo = (open_ends && index == 0) ? -INFINITY : index * edge - tolerance;
+    const double hi = (open_ends && index == count - 1) ? INFINITY : (index + 1) * edge + tolerance;
+    return !(u >= lo && u <= hi);
+  };
+  for (std::int32_t i = 0; i < n; ++i) {
+    const Vec3& r = particles[static_cast<std::size_t>(i)].r;
+    const int c = cell_[static_cast<std::size_t>(i)];
+    if (outside(r.x, ix(c), ex_, nx_, false) || outside(r.y, iy(c), ey_, ny_, false) ||
+        outside(r.z, iz(c), ez_, nz_, !periodic_z_))
+      return fmt::format("particle {} at ({}, {}, {}) is listed in cell ({}, {}, {}) of edges {:.6g} x {:.6g} x {:.6g}, "
+                         "which does not contain it", i, r.x, r.y, r.z, ix(c), iy(c), iz(c), ex_, ey_, ez_);
+  }
+  return {};
+}
+
 }  // namespace shaker::md

@@ -3,6 +3,7 @@
 // the 26 surrounding cells before it leaves its cell (the cell crossing is itself an event).
 // Doubly linked lists per cell keep insertion and removal O(1) without allocation.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "md/geometry.hpp"
@@ -18,6 +19,11 @@ class CellList {
   void build(const Geometry& geometry, std::size_t n);
 
   int cell_of(const Vec3& r) const;
+  /// What is wrong with lists loaded from a checkpoint (empty if nothing): every particle in
+  /// exactly one list, links in both directions, and each particle's position at its local
+  /// time inside its cell (within `tolerance`). A damaged list would make the run miss
+  /// collisions without any sign.
+  std::string inconsistency(const std::vector<Particle>& particles, double tolerance) const;
   void insert(std::int32_t particle, int cell);
   void remove(std::int32_t particle);
   int cell(std::int32_t particle) const { return cell_[particle]; }

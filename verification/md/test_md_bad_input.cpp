@@ -59,39 +59,76 @@ TEST(MdBadInput, MissingCheckpoint) {
   expect_rejected("--set md.initial_state=checkpoint --set md.checkpoint=/nonexistent.h5", "md.checkpoint");
 }
 
-/// A checkpoint of the base case with one particle moved.
-std::string checkpoint_with(const std::filesystem::path& dir, Vec3 moved_to) {
+/// A checkpoint of the base case after a few events, changed by `damage`.
+template <class Damage> std::string checkpoint_with(const std::filesystem::path& dir, Damage damage) {
   Geometry g;
   g.plate = PlateMotion::from(ShakerKinematics{3.0, 0.095});
   CollisionRules rules;
   Simulation sim(g, rules, flat_layer(g, 3937, 1));
+  for (int k = 0; k < 20000; ++k) sim.step();
   SimulationData data = sim.save();
-  data.particles[5].r = moved_to;
+  damage(data);
   const auto path = dir / "bad-checkpoint.h5";
   write_checkpoint(path, data, g, "test");
   return "--set md.initial_state=checkpoint --set md.checkpoint=" + path.string();
 }
 
-TEST(MdBadInput, OverlappingParticlesInCheckpoint) {
+/// A damaged checkpoint is refused with a message containing `names`.
+template <class Damage> void expect_checkpoint_rejected(Damage damage, const std::string& names) {
   const auto dir = testing::test_directory();
-  Simulation probe(Geometry{}, CollisionRules{}, flat_layer(Geometry{}, 3937, 1));
-  Vec3 onto = probe.particles()[6].r;
-  onto.x += 0.3;  // 0.3 from particle 6's centre
-  const std::string arguments = checkpoint_with(dir, onto);
-  const Outcome outcome = run_shaker(dir, arguments);
+  const Outcome outcome = run_shaker(dir, checkpoint_with(dir, damage));
   EXPECT_EQ(outcome.exit_code, 2) << outcome.errors;
-  EXPECT_NE(outcome.errors.find("overlap"), std::string::npos) << outcome.errors;
+  EXPECT_NE(outcome.errors.find(names), std::string::npos) << outcome.errors;
   EXPECT_FALSE(std::filesystem::exists(dir / "out.h5"));
 }
 
-TEST(MdBadInput, ParticleOutsideTheBoxInCheckpoint) {
+TEST(MdBadInput, UndamagedCheckpointIsAccepted) {  // the checks below refuse only the damage
   const auto dir = testing::test_directory();
-  const std::string arguments = checkpoint_with(dir, {5.0, 5.0, 250.0});  // above the ceiling
-  const Outcome outcome = run_shaker(dir, arguments);
-  EXPECT_EQ(outcome.exit_code, 2) << outcome.errors;
-  EXPECT_NE(outcome.errors.find("particle 5"), std::string::npos) << outcome.errors;
-  EXPECT_NE(outcome.errors.find("outside the box"), std::string::npos) << outcome.errors;
-  EXPECT_FALSE(std::filesystem::exists(dir / "out.h5"));
+  const Outcome outcome =
+      run_shaker(dir, checkpoint_with(dir, [](SimulationData&) {}) + " --set run.transient_cycles=0 --set run.sampled_cycles=1");
+  EXPECT_EQ(outcome.exit_code, 0) << outcome.errors;
+  EXPECT_TRUE(std::filesystem::exists(dir / "out.h5"));
+}
+TEST(MdBadInput, CellListLinkOutOfRangeInCheckpoint) {
+  expect_checkpoint_rejected([](SimulationData& d) { d.cell_head[d.cell_of[7]] = 5000; },
+                             "checkpoint cell lists: cell");
+}
+TEST(MdBadInput, CellListCycleInCheckpoint) {
+  expect_checkpoint_rejected([](SimulationData& d) {
+    const std::int32_t first = d.cell_head[d.cell_of[7]];
+    d.cell_next[first] = first;
+  }, "listed twice");
+}
+TEST(MdBadInput, ParticleInTheWrongCellInCheckpoint) {
+  // Moved high above the layer (no overlap, inside the box) but still listed in its old cell:
+  // the run would never test it against its new neighbours.
+  expect_checkpoint_rejected([](SimulationData& d) {
+    d.particles[5].r.z += 40.0;
+    d.particles[5].t = d.time;
+  }, "which does not contain it");
+}
+TEST(MdBadInput, EventPartnerOutOfRangeInCheckpoint) {
+  expect_checkpoint_rejected([](SimulationData& d) { d.events[3].partner = 3937; }, "partner 3937");
+}
+TEST(MdBadInput, EventBeforeTheCheckpointTime) {
+  expect_checkpoint_rejected([](SimulationData& d) { d.events[3].time = d.time - 1.0; }, "not before the checkpoint time");
+}
+
+TEST(MdBadInput, OverlappingParticlesInCheckpoint) {
+  expect_checkpoint_rejected([](SimulationData& d) {
+    Vec3 r, v;
+    state_at(d.particles[6], d.time, Geometry{}.gravity, r, v);
+    r.x += 0.3;  // 0.3 from particle 6's centre
+    d.particles[5].r = r;
+    d.particles[5].t = d.time;
+  }, "overlap");
+}
+
+TEST(MdBadInput, ParticleOutsideTheBoxInCheckpoint) {
+  expect_checkpoint_rejected([](SimulationData& d) {
+    d.particles[5].r = {5.0, 5.0, 250.0};  // above the ceiling
+    d.particles[5].t = d.time;
+  }, "particle 5 at (5, 5, 250) is outside the box");
 }
 
 }  // namespace
