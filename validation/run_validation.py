@@ -443,7 +443,7 @@ def evaluate(check_spec, claim, solver, views, comparer, partial_cases_ok):
     involved = [v for (c, s), v in views.items() if c in claim["cases"] and v.replicates
                 and (solver in (s, "md_vs_continuum"))]
     error = None
-    if involved and isinstance(value, float):
+    if involved and isinstance(value, (float, list)):
         count = min(len(v.replicates) for v in involved)
         kind = involved[0].replicate_kind
         reps = []
@@ -452,18 +452,10 @@ def evaluate(check_spec, claim, solver, views, comparer, partial_cases_ok):
                 reps.append(_as_plain(fn(query(b))))
             except quantities.NotMeasured:
                 pass
-        error = _spread(kind, reps)
-        error = None if math.isnan(error) else error
-    elif involved and isinstance(value, list):
-        count = min(len(v.replicates) for v in involved)
-        kind = involved[0].replicate_kind
-        reps = []
-        for b in range(count):
-            try:
-                reps.append(_as_plain(fn(query(b))))
-            except quantities.NotMeasured:
-                pass
-        if reps:
+        if isinstance(value, float):
+            error = _spread(kind, reps)
+            error = None if math.isnan(error) else error
+        elif reps:
             error = [_spread(kind, [r[i] for r in reps if len(r) == len(value)])
                      for i in range(len(value))]
             error = [None if math.isnan(e) else e for e in error]
