@@ -124,6 +124,13 @@ std::vector<conv::GciRow> three_grid_rows(const std::string& study,
   return rows;
 }
 
+/// The discretisation uncertainty of a study's finest value: its GCI where the three grids are
+/// in the asymptotic range, else the change over the finest pair |phi1 - phi2| (zero for a
+/// quantity that does not change over the three grids, whose GCI is undefined).
+double grid_uncertainty(const conv::GciRow& row) {
+  return row.pass() ? std::abs(row.phi1) * row.result.gci21 : std::abs(row.phi1 - row.phi2);
+}
+
 const std::vector<double> cells_1d{0.4, 0.2, 0.1, 0.05};  // coarse to fine
 
 TEST(NightlyRealProblem, BaseCase1DGridConvergence) {
@@ -176,7 +183,7 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
     const double value = values.at(row.quantity);
     const double difference = std::abs(value - row.phi1);
     const bool asymptotic = row.pass();
-    const double allowed = asymptotic ? std::abs(row.phi1) * row.result.gci21 : std::abs(row.phi1 - row.phi2);
+    const double allowed = grid_uncertainty(row);
     std::printf("%-32s %-26s %.6g vs %.6g  |diff| %.3e  allowed %.3e (%s)\n", label.c_str(),
                 row.quantity.c_str(), value, row.phi1, difference, allowed,
                 asymptotic ? "GCI21" : "finest pair, not asymptotic");
@@ -208,10 +215,15 @@ INSTANTIATE_TEST_SUITE_P(
 // 1.0: the layer stays flat at Gamma = 3, f = 0.095 (the width check C16 found w11 and w20
 // equal to 1e-7 in nu), so the narrow box is the same flow. Two grids give no observed order:
 // the GCI assumes the design order 2 with Fs = 3 (Roache). The check that can fail: on the
-// finer grid every quantity lies within the 3D GCI plus the 1D GCI of the 1D column's value
-// (1D fine triple, 0.05-0.2), i.e. both estimates of the discretisation error account for the
-// difference between the two codes. (At equal cell size the 3D and 1D runs also differ by
-// their time steps, the 3D diffusive limit being 3 times smaller.)
+// finer grid every quantity lies within the 3D GCI plus the grid uncertainty of the 1D
+// column's value (fine triple 0.05-0.2, grid_uncertainty), i.e. both estimates of the
+// discretisation error account for the difference between the two codes. (At equal cell size
+// the 3D and 1D runs also differ by their time steps, the 3D diffusive limit being 3 times
+// smaller.) Measured at 33ca59a (50 min): 7 of 10 quantities agree; the centre of mass at
+// f t = 0.5 (3D 25.8693, 1D 25.8610: the two 3D grids agree to 2e-4 by chance, so the
+// two-grid GCI, 5e-6, misses the 3D error) and the shock speed (4.2742 against 4.2643, 0.23 %,
+// allowed 5.0e-3) do not. The shock width (3D 3.5, 1D 3.6 on all three grids) failed then
+// only because the unchanging 1D triple has no GCI (NaN); now its uncertainty is 0.
 TEST(NightlyRealProblem, BaseCase3DTwoGridsAgreeWithThe1DColumn) {
   const auto dir = study_directory("real-problem-3d");
   const std::vector<std::string> three_d{"continuum.dimension=3", "continuum.box_width=4"};
@@ -236,11 +248,10 @@ TEST(NightlyRealProblem, BaseCase3DTwoGridsAgreeWithThe1DColumn) {
     const auto row_1d = std::find_if(rows_1d.begin(), rows_1d.end(),
                                      [&](const conv::GciRow& r) { return r.quantity == name; });
     if (row_1d == rows_1d.end()) continue;  // the 1D study already failed on it
-    const double allowed = std::abs(fine_3d) * rows.back().result.gci21 +
-                           std::abs(row_1d->phi1) * row_1d->result.gci21;
-    std::printf("3D %-26s h 0.5 %.6g (GCI %.2e)  1D h 0.05 %.6g (GCI %.2e)  |diff| %.3e  allowed %.3e\n",
+    const double allowed = std::abs(fine_3d) * rows.back().result.gci21 + grid_uncertainty(*row_1d);
+    std::printf("3D %-26s h 0.5 %.6g (GCI %.2e)  1D h 0.05 %.6g (uncertainty %.2e)  |diff| %.3e  allowed %.3e\n",
                 name.c_str(), fine_3d, rows.back().result.gci21, row_1d->phi1,
-                row_1d->result.gci21, std::abs(fine_3d - row_1d->phi1), allowed);
+                grid_uncertainty(*row_1d), std::abs(fine_3d - row_1d->phi1), allowed);
     EXPECT_LE(std::abs(fine_3d - row_1d->phi1), allowed)
         << name << ": 3D (cell 0.5) " << fine_3d << ", 1D (cell 0.05) " << row_1d->phi1;
   }
