@@ -181,6 +181,18 @@ def short(commit):
     return commit[:10] if commit else "unknown"
 
 
+MEMORY_COUNTER = re.compile(r"^bytes_per_")
+
+
+def memory_counter(record):
+    """The bytes-per-item counter of a benchmark that measures memory only (no throughput
+    counter), else None: its time is that of allocating and touching the memory, not a speed."""
+    counters = record["counters"]
+    if any(pattern.search(c) for c in counters for _, pattern in THROUGHPUT_KINDS):
+        return None
+    return next((c for c in sorted(counters) if MEMORY_COUNTER.search(c)), None)
+
+
 def compare(previous, latest, threshold, alpha, metric):
     rows, slowdowns = [], []
     for name in sorted(set(previous["benchmarks"]) | set(latest["benchmarks"])):
@@ -188,6 +200,17 @@ def compare(previous, latest, threshold, alpha, metric):
         new = latest["benchmarks"].get(name)
         if old is None or new is None:
             rows.append(f"| {name} | | | | | | {'new' if old is None else 'removed'} |")
+            continue
+        counter = memory_counter(new)
+        if counter is not None and counter in old["counters"]:
+            # Judged by its memory, which is deterministic: any growth over the threshold counts.
+            before, after = np.median(old["counters"][counter]), np.median(new["counters"][counter])
+            change = float(after / before - 1.0)
+            verdict = f"memory only: {counter} {rc.fmt(before, 5)} -> {rc.fmt(after, 5)}"
+            if change > threshold:
+                verdict = f"**MEMORY GROWTH** (> {threshold:.0%}): " + verdict[len("memory only: "):]
+                slowdowns.append(f"{name}: {counter} {change:+.1%}")
+            rows.append(f"| {name} | | | {change:+.1%} | | | {verdict} |")
             continue
         old_t, new_t = np.array(old[metric]), np.array(new[metric])
         change = float(np.median(new_t) / np.median(old_t) - 1.0)

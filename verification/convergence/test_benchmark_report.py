@@ -42,7 +42,9 @@ def google_benchmark_json(commit, benchmarks, rng):
                      "run_name": name, "run_type": "iteration", "repetitions": 9,
                      "repetition_index": k, "threads": 1, "iterations": 100,
                      "real_time": t / 1e3, "cpu_time": t / 1e3 * 0.99, "time_unit": "us"}
-            if counter:
+            if counter and counter.startswith("bytes_per_"):
+                entry[counter] = work  # a memory benchmark: `work` is its bytes per item
+            elif counter:
                 entry[counter] = work / (t * 1e-9)
             entries.append(entry)
         for aggregate in ("mean", "median", "stddev", "cv"):
@@ -106,17 +108,23 @@ try:
     history = os.path.join(work, "history")
     before = {"BM_md_collisions": (2.0e6, "collisions_per_second", 2000.0),
               "BM_continuum_step": (5.0e5, "cell_updates_per_second", 1.0e4),
-              "BM_unchanged": (1.0e5, None, 0.0)}
+              "BM_unchanged": (1.0e5, None, 0.0),
+              "BM_memory": (3.0e6, "bytes_per_cell", 565.0),
+              "BM_memory_grows": (3.0e6, "bytes_per_cell", 565.0)}
     after = {"BM_md_collisions": (2.4e6, "collisions_per_second", 2000.0),   # 20% slower
              "BM_continuum_step": (4.0e5, "cell_updates_per_second", 1.0e4),  # 20% faster
-             "BM_unchanged": (1.0e5, None, 0.0)}
+             "BM_unchanged": (1.0e5, None, 0.0),
+             "BM_memory": (1.2e8, "bytes_per_cell", 565.0),          # 40x the time, same bytes
+             "BM_memory_grows": (3.0e6, "bytes_per_cell", 700.0)}    # same time, 24% more bytes
     write_run(history, "20261120T030000Z-aaaaaaaaaaaa", "a" * 40, before, seed=1)
     write_run(history, "20261121T030000Z-bbbbbbbbbbbb", "b" * 40, after, seed=2)
     out = os.path.join(work, "out", "benchmarks.md")
     result = run("--history", history, "--output", out)
     check(result.returncode == 1, f"a 20% slowdown must exit 1, got {result.returncode}")
     check("BM_md_collisions" in result.stderr and "BM_continuum_step" not in result.stderr
-          and "BM_unchanged" not in result.stderr, f"stderr must name the slow one: {result.stderr}")
+          and "BM_unchanged" not in result.stderr and "BM_memory:" not in result.stderr
+          and "BM_memory_grows: bytes_per_cell +23.9%" in result.stderr,
+          f"stderr must name the slow one and the grown one: {result.stderr}")
     text = open(out).read() if os.path.exists(out) else ""
     check("### collisions per second" in text and "### cell updates per second" in text,
           "throughput sections missing")
@@ -145,6 +153,13 @@ try:
           f"faster row: '{fast}'")
     check("SLOWDOWN" not in same and "faster" not in same, f"unchanged row: '{same}'")
     check("- BM_md_collisions: median real_time +" in text, "slowdown list missing")
+    # A memory benchmark is judged by its bytes, not by the time it takes to allocate them.
+    memory = line_with(text, "| BM_memory |")
+    grows = line_with(text, "| BM_memory_grows |")
+    check("memory only: bytes_per_cell 565 -> 565" in memory and "SLOWDOWN" not in memory
+          and "+0.0%" in memory, f"memory row: '{memory}'")
+    check("**MEMORY GROWTH** (> 10%): bytes_per_cell 565 -> 700" in grows and "+23.9%" in grows,
+          f"memory growth row: '{grows}'")
     png = os.path.join(work, "out", "benchmark-history.png")
     check(os.path.exists(png) and open(png, "rb").read(4) == b"\x89PNG", "history plot missing")
 
