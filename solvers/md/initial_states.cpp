@@ -139,4 +139,12 @@ State homogeneous_gas(const Geometry& geometry, std::size_t n, double nu, double
   return state;
 }
 
+Geometry periodic_box(std::size_t n, double nu) {
+  Geometry g;
+  g.periodic_z = true;
+  g.gravity = 0.0;
+  g.width = g.height = std::cbrt(static_cast<double>(n) * pi / (6.0 * nu));
+  return g;
+}
+
 }  // namespace shaker::md

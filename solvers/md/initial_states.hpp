@@ -34,4 +34,8 @@ State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed);
 State homogeneous_gas(const Geometry& geometry, std::size_t n, double nu, double T,
                       std::uint64_t seed);
 
+/// The periodic cube without gravity that n particles fill at volume fraction nu (the box of
+/// the gas tests and benchmarks).
+Geometry periodic_box(std::size_t n, double nu);
+
 }  // namespace shaker::md

@@ -14,14 +14,6 @@
 namespace shaker::md {
 namespace {
 
-Geometry periodic_box(std::size_t n, double nu) {
-  Geometry g;
-  g.periodic_z = true;
-  g.gravity = 0.0;
-  g.width = g.height = std::cbrt(static_cast<double>(n) * pi / (6.0 * nu));
-  return g;
-}
-
 void run_pair_collisions(Simulation& sim, std::uint64_t count) {
   const std::uint64_t target = sim.tally().pair + count;
   while (sim.tally().pair < target) sim.step();

@@ -6,17 +6,14 @@
 // caches and prints misses per pair collision; on its own it measures nothing.
 #include <valgrind/callgrind.h>
 
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "common/units.hpp"
 #include "md/initial_states.hpp"
 #include "md/simulation.hpp"
 
 int main(int argc, char** argv) {
   using namespace shaker::md;
-  using shaker::pi;
   if (argc != 3) {
     std::fprintf(stderr, "usage: md_cache_lines N COUNT  (N particles >= 100, COUNT pair collisions >= 1)\n");
     return 2;
@@ -26,10 +23,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "md_cache_lines: N = %s (allowed >= 100) and COUNT = %s (allowed >= 1)\n", argv[1], argv[2]);
     return 2;
   }
-  Geometry g;
-  g.periodic_z = true;
-  g.gravity = 0.0;
-  g.width = g.height = std::cbrt(static_cast<double>(n) * pi / (6.0 * 0.3));
+  const Geometry g = periodic_box(static_cast<std::size_t>(n), 0.3);
   CollisionRules rules;
   rules.restitution = shaker::Restitution{shaker::Restitution::Kind::constant, 1.0};
   Simulation sim(g, rules, homogeneous_gas(g, static_cast<std::size_t>(n), 0.3, 1.0, 1));

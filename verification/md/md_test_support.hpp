@@ -23,15 +23,6 @@ inline std::filesystem::path test_directory() {
   return dir;
 }
 
-/// Periodic cube without gravity holding n particles at volume fraction nu.
-inline Geometry periodic_box(std::size_t n, double nu) {
-  Geometry g;
-  g.periodic_z = true;
-  g.gravity = 0.0;
-  g.width = g.height = std::cbrt(static_cast<double>(n) * pi / (6.0 * nu));
-  return g;
-}
-
 inline Vec3 total_momentum(const Simulation& s) {
   std::vector<Vec3> r, v;
   s.positions_at(s.time(), r, v);

@@ -24,7 +24,7 @@ void run_collisions(Simulation& sim, std::uint64_t pair_collisions) {
 
 TEST(MdElasticGas, EnergyAndMomentumConservedOverMillionCollisions) {
   const std::size_t n = 2000;
-  const Geometry g = testing::periodic_box(n, 0.3);
+  const Geometry g = periodic_box(n, 0.3);
   Simulation sim(g, elastic(), homogeneous_gas(g, n, 0.3, 1.0, 11));
   const double e0 = sim.kinetic_energy(sim.time());
   run_collisions(sim, 1000000);
@@ -47,7 +47,7 @@ double maxwell_cdf(double s, double T) {
 TEST(MdElasticGas, SpeedsRelaxToMaxwellian) {
   // Start far from equilibrium: every particle with the same speed in a random direction.
   const std::size_t n = 2000;
-  const Geometry g = testing::periodic_box(n, 0.2);
+  const Geometry g = periodic_box(n, 0.2);
   State start = homogeneous_gas(g, n, 0.2, 1.0, 5);
   for (Particle& p : start.particles) p.v = (std::sqrt(3.0) / std::sqrt(dot(p.v, p.v))) * p.v;
   Simulation sim(g, elastic(), start);
@@ -90,7 +90,7 @@ struct BulkMeasurement {
 };
 
 BulkMeasurement measure_bulk(double nu, std::size_t n, std::uint64_t per_particle) {
-  const Geometry g = testing::periodic_box(n, nu);
+  const Geometry g = periodic_box(n, nu);
   Simulation sim(g, elastic(), homogeneous_gas(g, n, nu, 1.0, 3));
   run_collisions(sim, 20 * n);  // forget the lattice
   const Tally start = sim.tally();
@@ -127,7 +127,7 @@ INSTANTIATE_TEST_SUITE_P(VolumeFractions, MdCarnahanStarling,
 TEST(MdCoolingGas, HaffLaw) {
   const std::size_t n = 8000;  // T fluctuates by about 1/sqrt(n)
   const double nu = 0.1, e = 0.95;
-  const Geometry g = testing::periodic_box(n, nu);
+  const Geometry g = periodic_box(n, nu);
   Simulation sim(g, elastic(), homogeneous_gas(g, n, nu, 1.0, 17));
   run_collisions(sim, 20 * n);  // equilibrate elastically, then switch dissipation on
   sim.set_restitution(Restitution{Restitution::Kind::constant, e});

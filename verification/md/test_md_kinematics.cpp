@@ -98,7 +98,7 @@ TEST(MdKinematics, NoMissedCollisionsAgainstAllPairsReference) {
   // Gas chaos forbids comparing whole trajectories, so after every collision the all-pairs
   // search predicts the next one from the solver's own state.
   const std::size_t n = 40;
-  const Geometry g = testing::periodic_box(n, 0.15);
+  const Geometry g = periodic_box(n, 0.15);
   Simulation sim(g, constant_e(1.0), homogeneous_gas(g, n, 0.15, 1.0, 7));
   std::vector<Vec3> r, v;
   double worst = 0.0;

@@ -84,7 +84,7 @@ struct Start {
 /// Elastic gas of n particles at nu = 0.3 in a periodic box without gravity.
 Start elastic_gas(std::size_t n, std::uint64_t seed) {
   Start s;
-  s.geometry = testing::periodic_box(n, 0.3);
+  s.geometry = periodic_box(n, 0.3);
   s.rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
   s.state = homogeneous_gas(s.geometry, n, 0.3, 1.0, seed);
   return s;
