@@ -63,11 +63,12 @@ class Results:
 
     def analysis(self, case, solver):
         v = self.view(case, solver)
-        if not v or not os.path.exists(v["analysis_csv"]):
+        if not v or not v.get("analysis_json") or not os.path.exists(v["analysis_json"]):
             return None
-        with open(v["analysis_csv"]) as f:
-            rows = list(csv.DictReader(f))
-        return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else None
+        with open(v["analysis_json"]) as f:
+            per_phase = json.load(f)["per_phase"]
+        return {k: np.array([math.nan if x is None else float(x) for x in q["value"]])
+                for k, q in per_phase.items()}
 
     def profiles(self, case, solver):
         v = self.view(case, solver)

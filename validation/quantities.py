@@ -1,10 +1,10 @@
 """The named quantities that reference-data/claims.toml refers to, and the comparisons.
 
-Every quantity is computed from what the project's C++ analysis prints (`shaker analyze --csv`,
-its average shock speed, `shaker compare --csv`) or, where that has no column for it, from the
-run file itself (profiles, time series) or the run's exit status and stderr. No constitutive
-formula is re-typed here: the sound speed, the layer, the shock and the agreement metrics all
-come from solvers/analysis through the `shaker` program.
+Every physical quantity comes from the project's one analysis (solvers/analysis, through
+`shaker analyze --json` and `shaker compare --csv`; definitions in docs/analysis.md) or from
+the run's exit status and stderr. This module only selects (a phase, a window, a case),
+combines values of different runs (differences, ratios, orderings) and compares them with
+the claims' bands.
 
 A quantity is a function f(query) -> value, where the query gives the runs of the claim's
 cases for one solver (or both), the claim's parameters and `shaker compare` results. A value
@@ -13,6 +13,10 @@ is a float, a list of floats (NaN marks "not found at that phase") or raises Not
 import math
 
 import numpy as np
+
+# The span above the layer's top over which `shaker analyze` fits dT/dz
+# (solvers/analysis/run_analysis.hpp, gas_span_above_layer).
+GAS_SPAN_ABOVE_LAYER = 10.0
 
 
 class NotMeasured(Exception):
@@ -26,7 +30,7 @@ class Bound:
         self.value, self.kind = value, kind
 
 
-# ---- helpers on one run's analysis table ---------------------------------------------------
+# ---- selecting from one run's analysis table ------------------------------------------------
 
 def _cyclic_distance(a, b):
     return abs(((a - b + 0.5) % 1.0) - 0.5)
@@ -44,74 +48,6 @@ def _row_at(table, phase):
 def _window(table, lo, hi):
     p = table["phase"]
     return np.nonzero((p >= lo - 1e-9) & (p <= hi + 1e-9))[0]
-
-
-def _has_shock(table):
-    return ~np.isnan(table["shock_location"])
-
-
-def shock_run(table):
-    """Indices of the shock's life in the cycle: the longest run of consecutive stored phases
-    with a shock (the first one on a tie). Empty if no phase has one."""
-    present = _has_shock(table)
-    best, start = (0, 0), None
-    for k, flag in enumerate(list(present) + [False]):
-        if flag and start is None:
-            start = k
-        if not flag and start is not None:
-            if k - start > best[1] - best[0]:
-                best = (start, k)
-            start = None
-    return np.arange(best[0], best[1])
-
-
-def formation_phase(table, periodic=False):
-    """Phase of the first stored phase of the shock's life. In a periodic run the stored
-    phases are one cycle, so a life that starts at f t = 0 may have begun at the end of the
-    cycle before: then the formation phase is that phase minus 1 (e.g. -0.02 for 0.98)."""
-    run = shock_run(table)
-    if not len(run):
-        return math.nan
-    first = int(run[0])
-    present = _has_shock(table)
-    if periodic and first == 0:
-        k = len(present)
-        while k - 1 > run[-1] and present[k - 1]:
-            k -= 1
-        if k < len(present):
-            return float(table["phase"][k]) - 1.0
-    return float(table["phase"][first])
-
-
-def _periodic(view):
-    return view.config.get("run", {}).get("protocol") == "periodic"
-
-
-def exit_phase(table):
-    """Phase at which the shock location crosses the layer top (linear interpolation between
-    the stored phases); if the shock vanishes inside the layer, the first phase without it."""
-    run = shock_run(table)
-    if not len(run):
-        return math.nan
-    phase, loc, top = table["phase"], table["shock_location"], table["layer_top"]
-    above = loc - top
-    for i, k in enumerate(run):
-        if not np.isnan(above[k]) and above[k] >= 0:
-            if i == 0:
-                return float(phase[k])
-            j = run[i - 1]
-            w = -above[j] / (above[k] - above[j])
-            return float(phase[j] + w * (phase[k] - phase[j]))
-    last = run[-1]
-    return float(phase[last + 1]) if last + 1 < len(phase) else math.nan
-
-
-def inside_layer_run(table):
-    """The shock's life from formation until it leaves the layer (indices)."""
-    run = shock_run(table)
-    return [k for k in run
-            if not np.isnan(table["layer_top"][k])
-            and table["shock_location"][k] < table["layer_top"][k]]
 
 
 # ---- the query a quantity sees ----------------------------------------------------------------
@@ -142,21 +78,15 @@ class Query:
 # ---- the quantities -----------------------------------------------------------------------
 
 def q_shock_formation_phase(q):
-    view = q.run(q.cases[0])
-    return formation_phase(view.analysis, periodic=_periodic(view))
+    return q.run(q.cases[0]).per_run["formation_phase"]
 
 
 def q_shock_exit_phase(q):
-    return exit_phase(q.table(q.cases[0]))
+    return q.run(q.cases[0]).per_run["exit_phase"]
 
 
 def q_width_over_mfp_peak_phase(q):
-    t = q.table(q.cases[0])
-    life = inside_layer_run(t)
-    if not life:
-        return math.nan
-    ratios = t["width_over_mfp"][life]
-    return float(t["phase"][life[int(np.nanargmax(ratios))]])
+    return q.run(q.cases[0]).per_run["width_over_mfp_peak_phase"]
 
 
 def q_width_over_mfp_in_window(q):
@@ -188,45 +118,29 @@ def q_min_max_mach_in_window(q):
     return float(np.min(t["max_mach"][idx]))
 
 
-def _layer_mean_temperature(view, k):
-    t, prof = view.analysis, view.profiles()
-    lo, hi = t["layer_bottom"][k], t["layer_top"][k]
-    if np.isnan(lo):
-        return math.nan
-    z, n, T = prof["z"][k], prof["n"][k], prof["T"][k]
-    inside = (z >= lo) & (z <= hi) & (n > 0)
-    if not inside.any():
-        return math.nan
-    return float(np.sum(n[inside] * T[inside]) / np.sum(n[inside]))
-
-
 def q_layer_temperature_fraction_at(q):
     view = q.run(q.cases[0])
     k = _row_at(view.analysis, q.params["phase"])
-    means = [_layer_mean_temperature(view, j) for j in range(len(view.analysis["phase"]))]
-    peak = np.nanmax(means) if not all(np.isnan(means)) else math.nan
-    return float(means[k] / peak) if peak and peak > 0 else math.nan
+    peak = view.per_run["layer_temperature_peak"]
+    return float(view.analysis["layer_temperature"][k] / peak) if peak > 0 else math.nan
 
 
 def q_temperature_slope_above_layer_at(q):
-    view = q.run(q.cases[0])
-    t = view.analysis
-    k = _row_at(t, q.params["phase"])
-    top = t["layer_top"][k]
-    if np.isnan(top):
-        return math.nan
-    prof = view.profiles()
-    z, n, T = prof["z"][k], prof["n"][k], prof["T"][k]
-    sel = (z > top) & (z <= top + q.params["span"]) & (n > 0)
-    if sel.sum() < 3:
-        return math.nan
-    return float(np.polyfit(z[sel], T[sel], 1)[0])
+    t = q.table(q.cases[0])
+    if q.params["span"] != GAS_SPAN_ABOVE_LAYER:
+        raise NotMeasured(f"`shaker analyze` fits the slope over {GAS_SPAN_ABOVE_LAYER:g} "
+                          "above the layer's top")
+    return float(t["temperature_slope_above_layer"][_row_at(t, q.params["phase"])])
 
 
 def q_layer_gap_at(q):
     t = q.table(q.cases[0])
-    k = _row_at(t, q.params["phase"])
-    return float(t["layer_bottom"][k] - t["plate_z"][k])
+    return float(t["layer_gap"][_row_at(t, q.params["phase"])])
+
+
+def q_mass_gap_at(q):
+    t = q.table(q.cases[0])
+    return float(t["mass_gap"][_row_at(t, q.params["phase"])])
 
 
 def q_com_fractional_rms_md_vs_continuum(q):
@@ -252,14 +166,12 @@ def q_com_rms_ratio_deep_over_shallow(q):
 
 def q_com_mean_excess_of_shallow(q):
     p = q.params
-    mean = {c: float(np.mean(q.table(p[c])["center_of_mass"])) for c in ("shallow", "middle",
-                                                                           "deep")}
+    mean = {c: q.run(p[c]).per_run["center_of_mass_mean"] for c in ("shallow", "middle", "deep")}
     return mean["shallow"] - max(mean["middle"], mean["deep"])
 
 
 def q_shock_formation_phase_by_case(q):
-    views = [q.run(c) for c in q.params["order"]]
-    return [formation_phase(v.analysis, periodic=_periodic(v)) for v in views]
+    return [q.run(c).per_run["formation_phase"] for c in q.params["order"]]
 
 
 def q_shock_speed_by_case(q):
@@ -290,10 +202,8 @@ def q_shock_location_fractional_rms(q):
 
 
 def q_particles_per_cycle_above(q):
-    view = q.run(q.cases[0])
-    bound, source = view.particles_per_cycle_above(q.params["height"])
-    view.notes.add(f"particles above z = {q.params['height']:g}: {source}")
-    return bound
+    value, _ = q.run(q.cases[0]).particles_per_cycle_above(q.params["height"])
+    return value
 
 
 def q_collapse_detected(q):
@@ -312,21 +222,13 @@ def q_collapse_detected(q):
 
 
 def q_com_apex_difference(q):
-    hi = np.max(q.table(q.params["high"])["center_of_mass"])
-    lo = np.max(q.table(q.params["low"])["center_of_mass"])
-    return float(hi - lo)
-
-
-def _shock_curvature(table):
-    life = shock_run(table)
-    if len(life) < 4:
-        return math.nan
-    return float(2.0 * np.polyfit(table["time"][life], table["shock_location"][life], 2)[0])
+    return (q.run(q.params["high"]).per_run["center_of_mass_apex"]
+            - q.run(q.params["low"]).per_run["center_of_mass_apex"])
 
 
 def q_shock_curvature_difference(q):
-    return (_shock_curvature(q.table(q.params["high"]))
-            - _shock_curvature(q.table(q.params["low"])))
+    return (q.run(q.params["high"]).per_run["shock_curvature"]
+            - q.run(q.params["low"]).per_run["shock_curvature"])
 
 
 QUANTITIES = {
@@ -340,6 +242,7 @@ QUANTITIES = {
     "layer_temperature_fraction_at": q_layer_temperature_fraction_at,
     "temperature_slope_above_layer_at": q_temperature_slope_above_layer_at,
     "layer_gap_at": q_layer_gap_at,
+    "mass_gap_at": q_mass_gap_at,
     "com_fractional_rms_md_vs_continuum": q_com_fractional_rms_md_vs_continuum,
     "com_rms_ratio_deep_over_shallow": q_com_rms_ratio_deep_over_shallow,
     "com_mean_excess_of_shallow": q_com_mean_excess_of_shallow,
@@ -363,6 +266,7 @@ REQUIRED_PARAMETERS = {
     "layer_temperature_fraction_at": ("phase",),
     "temperature_slope_above_layer_at": ("phase", "span"),
     "layer_gap_at": ("phase",),
+    "mass_gap_at": ("phase",),
     "com_rms_ratio_deep_over_shallow": ("shallow", "middle", "deep"),
     "com_mean_excess_of_shallow": ("shallow", "middle", "deep"),
     "shock_formation_phase_by_case": ("order",),

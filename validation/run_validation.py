@@ -12,8 +12,9 @@ Steps (data flows one way: case file -> solver -> run file -> analysis -> claims
    re-simulated; --rerun forces new runs. MD single-shock cases are run md_pool times from
    consecutive cycles of the periodic state (run.transient_cycles + k).
 2. every finished run is analysed by `shaker analyze --csv` (the project's one analysis
-   implementation); MD uncertainties: single-shock pools get a jackknife over the pooled runs,
-   periodic runs a parametric bootstrap of the profiles with their standard errors.
+   implementation), which pools the runs of a single-shock case and gives every MD number
+   a jackknife error over the independent samples (the pooled runs, or the sampled cycles
+   of a periodic run).
 3. `shaker compare --csv` gives the agreement metrics of every case run by both solvers.
 4. every claim of reference-data/claims.toml is evaluated per solver against its band
    (validation/quantities.py), and reports/make_validation_report.py writes the report.
@@ -82,17 +83,24 @@ def effective_config(shaker, name, overrides):
 # ---- one run and its views ------------------------------------------------------------------
 
 class RunView:
-    """One solver's result for a case (a run, a pool of runs, or a replicate of either) as the
-    quantities see it."""
+    """One solver's result for a case (a run, a pool of runs, or a jackknife replicate of
+    either) as the quantities see it: what `shaker analyze --json` printed for it."""
 
     def __init__(self, case, solver, status, path=None, config=None):
         self.case, self.solver, self.status, self.path = case, solver, status, path
         self.config = config or {}
-        self.analysis, self.shock_speed = None, math.nan
+        self.analysis, self.errors = None, {}      # per-phase columns and their errors
+        self.per_run, self.per_run_errors = {}, {}  # per-run quantities and their errors
+        self.crossings = {}                       # column -> (per cycle, error)
         self.replicates, self.replicate_kind = [], None
+        self.parent, self.replicate_index = None, None
         self.notes, self.runs = set(), []
         self.stderr_tail = ""
         self._profiles = None
+
+    @property
+    def shock_speed(self):
+        return self.per_run.get("shock_speed", math.nan)
 
     @property
     def switch_e(self):
@@ -104,64 +112,71 @@ class RunView:
                 self._profiles = {k: np.array(f["profiles"][k]) for k in f["profiles"]}
         return self._profiles
 
-    def timeseries(self):
-        with h5py.File(self.path, "r") as f:
-            return {k: np.array(f["timeseries"][k]) for k in f["timeseries"]}
-
     def particles_per_cycle_above(self, height):
-        """Particles per cycle reaching z >= height (lab frame). Preferred source: a cumulative
-        time-series column crossings_z<height> (upward crossings counted by the solver); the
-        fallback is a lower bound from the profiles: the largest mean number of particles above
-        the height at any stored phase."""
-        series = self.timeseries()
+        """Upward crossings of z = height per cycle, counted by the solver (time-series column
+        crossings_z<height>) and averaged over cycles by `shaker analyze`."""
         column = f"crossings_z{height:g}"
-        if column in series and len(series[column]) > 1:
-            t, count = series["t"], series[column]
-            frequency = float(self.config["shaker"]["frequency"])
-            cycles = (t[-1] - t[0]) * frequency
-            return quantities.Bound(float((count[-1] - count[0]) / cycles), None), \
-                f"time-series column {column}"
-        prof = self.profiles()
-        width = float(self.config["md"]["box_width"])
-        per_phase = [float(np.sum(prof["n"][k][prof["z"][k] >= height])
-                           * width * width * prof["bin_height"][k])
-                     for k in range(len(prof["phase"]))]
-        return quantities.Bound(max(per_phase), "lower"), (
-            "lower bound from the profiles (largest mean count above the height at a stored "
-            f"phase); the MD time series has no column {column}")
+        if column not in self.crossings:
+            raise quantities.NotMeasured(f"the run has no time-series column {column}")
+        return self.crossings[column]
 
 
-def read_analysis_csv(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else None
+def _number(x):
+    return math.nan if x is None else float(x)
 
 
-def analyze(shaker, run_file, with_profiles=False):
-    """`shaker analyze --csv`: the analysis table and the average shock speed (and, with
-    with_profiles, RUN.profiles.csv: every profile with its Mach number, for the plots)."""
-    csv_path = run_file + ".analysis.csv"
-    cmd = [shaker, "analyze", run_file, "--csv", csv_path]
+def _array(values):
+    return np.array([_number(v) for v in values], dtype=float)
+
+
+def analyze(shaker, run_files, json_path, pooled=None, with_profiles=False):
+    """`shaker analyze RUN... --json`: the analysis of docs/analysis.md of one run (or the pool
+    of several), with jackknife errors and replicates over its samples. Returns the view's
+    fields: (per-phase columns, their errors, per-run values, their errors, crossings,
+    replicates as (per-phase, per-run) pairs)."""
+    cmd = [shaker, "analyze", *run_files, "--json", json_path, "--quiet"]
+    if pooled:
+        cmd += ["--pooled", pooled]
     if with_profiles:
-        cmd += ["--profiles-csv", run_file + ".profiles.csv"]
+        cmd += ["--profiles-csv", (pooled or run_files[0]) + ".profiles.csv"]
     result = subprocess.run(cmd, capture_output=True, text=True)
     if result.returncode != 0:
-        raise RuntimeError(f"shaker analyze {run_file}: {result.stderr.strip()}")
-    speed = math.nan
-    for line in result.stdout.splitlines():
-        if line.startswith("# average shock speed"):
-            text = line.rsplit(":", 1)[1].strip()
-            speed = float(text) if text != "-" else math.nan
-    return read_analysis_csv(csv_path), speed
+        raise RuntimeError(f"shaker analyze {' '.join(run_files)}: {result.stderr.strip()}")
+    with open(json_path) as f:
+        data = json.load(f)
+    return data
+
+
+def fill_view(view, data):
+    """Puts `shaker analyze --json` output into a view and builds its jackknife replicates."""
+    view.analysis = {k: _array(v["value"]) for k, v in data["per_phase"].items()}
+    view.errors = {k: _array(v["error"]) for k, v in data["per_phase"].items()}
+    view.per_run = {k: _number(v["value"]) for k, v in data["per_run"].items()}
+    view.per_run_errors = {k: _number(v["error"]) for k, v in data["per_run"].items()}
+    view.crossings = {k: (_number(v["value"]), _number(v["error"]))
+                      for k, v in data["crossings"].items()}
+    count = data["samples"] if data["samples"] >= 2 else 0
+    view.replicate_kind = "jackknife" if count else None
+    view.replicates = []
+    for i in range(count):
+        rep = RunView(view.case, view.solver, "ok", None, view.config)
+        rep.parent, rep.replicate_index = view, i
+        rep.analysis = {k: _array(v["replicates"][i]) for k, v in data["per_phase"].items()}
+        rep.per_run = {k: _number(v["replicates"][i]) for k, v in data["per_run"].items()}
+        rep.crossings = view.crossings
+        view.replicates.append(rep)
 
 
 class Comparer:
-    """`shaker compare --csv A B`, cached per pair of files."""
+    """`shaker compare --csv A B`, cached per pair of files; a replicate view gets the
+    matching jackknife replicate of the comparison."""
 
     def __init__(self, shaker, directory):
         self.shaker, self.directory, self.cache = shaker, directory, {}
 
     def __call__(self, a, b):
+        index = a.replicate_index if a.replicate_index is not None else b.replicate_index
+        a, b = a.parent or a, b.parent or b
         key = (a.path, b.path)
         if key not in self.cache:
             name = hashlib.sha256(f"{a.path}|{b.path}".encode()).hexdigest()[:16]
@@ -171,8 +186,14 @@ class Comparer:
             if result.returncode != 0:
                 raise quantities.NotMeasured(f"shaker compare failed: {result.stderr.strip()}")
             with open(out) as f:
-                self.cache[key] = {r["metric"]: float(r["value"]) for r in csv.DictReader(f)}
-        return self.cache[key]
+                self.cache[key] = list(csv.DictReader(f))
+        rows = self.cache[key]
+        if index is None:
+            return {r["metric"]: float(r["value"]) for r in rows}
+        replicates = {r["metric"]: r["replicates"].split(";") for r in rows}
+        if any(index >= len(v) for v in replicates.values()):
+            raise quantities.NotMeasured("no such replicate of the comparison")
+        return {m: float(v[index]) for m, v in replicates.items()}
 
 
 # ---- running the solvers --------------------------------------------------------------------
@@ -204,8 +225,11 @@ def plan_runs(shaker, studies, case_names, quick):
 
 
 def run_key(shaker, run):
+    """The effective configuration and its key: the hash of its values (not of its text, so
+    that comments and formatting in `shaker config` do not invalidate finished runs)."""
     text = effective_config(shaker, run["case"], run["overrides"])
-    return text, hashlib.sha256(text.encode()).hexdigest()
+    canonical = json.dumps(tomllib.loads(text), sort_keys=True)
+    return text, hashlib.sha256(canonical.encode()).hexdigest()
 
 
 def solver_environment(jobs):
@@ -289,49 +313,12 @@ def execute_all(shaker, workdir, plan, jobs, rerun, reuse_only):
     return plan
 
 
-# ---- pooling and replicates ----------------------------------------------------------------
+# ---- analysis of the runs -------------------------------------------------------------------
 
-def _write_profiles_like(template, path, fields, variant_note):
-    """A copy of a run file with replaced profile fields (a pool or a replicate). The copy
-    keeps the template's attributes (configuration included) and notes how it was made."""
-    tmp = path + ".partial"
-    shutil.copyfile(template, tmp)
-    with h5py.File(tmp, "r+") as f:
-        group = f["profiles"]
-        for name, values in fields.items():
-            if name in group:
-                del group[name]
-            group.create_dataset(name, data=values)
-        f.attrs["model_variant"] = f"{f.attrs['model_variant']} ({variant_note})"
-    os.replace(tmp, path)
-
-
-def pooled_fields(profile_sets):
-    """Pools the profiles of runs of the same configuration started from different cycles, as
-    the MD sampler pools cycles (physics.md): n and nu averaged, u_z and T over all particles
-    (weights: samples if stored, else n; T gains the spread of the runs' mean u_z, the only
-    mean velocity component stored). Standard errors from the scatter between the runs."""
-    stack = {k: np.array([p[k] for p in profile_sets]) for k in PROFILE_FIELDS}
-    weights = (np.array([p["samples"] for p in profile_sets]) if all("samples" in p for p in
-                                                                     profile_sets)
-               else stack["n"])
-    total = weights.sum(axis=0)
-    safe = np.where(total > 0, total, 1.0)
-    uz = (weights * stack["uz"]).sum(axis=0) / safe
-    T = (weights * (stack["T"] + (stack["uz"] - uz) ** 2 / 3.0)).sum(axis=0) / safe
-    runs = len(profile_sets)
-    fields = {"n": stack["n"].mean(axis=0), "nu": stack["nu"].mean(axis=0), "uz": uz, "T": T}
-    if runs > 1:
-        for k in ("n", "uz", "T"):
-            fields[f"{k}_se"] = stack[k].std(axis=0, ddof=1) / math.sqrt(runs)
-    if all("samples" in p for p in profile_sets):
-        fields["samples"] = weights.sum(axis=0)
-    return fields
-
-
-def build_view(shaker, case, solver, records, workdir, bootstrap, seed):
-    """The view of one case in one solver: a run, or the pool of an MD single-shock case,
-    with its replicates (jackknife for pools, parametric bootstrap for periodic MD runs)."""
+def build_view(shaker, case, solver, records, workdir):
+    """The view of one case in one solver: a run, or the pool of an MD single-shock case, as
+    `shaker analyze` sees it; MD views carry the jackknife replicates over their samples
+    (sampled cycles of a run, or the pooled runs)."""
     ok = [r for r in records if r["status"] == "ok"]
     statuses = sorted({r["status"] for r in records})
     config = tomllib.loads(records[0]["config"]) if records else {}
@@ -341,50 +328,18 @@ def build_view(shaker, case, solver, records, workdir, bootstrap, seed):
         view.runs = records
         view.stderr_tail = " | ".join(r.get("stderr", "").strip()[-300:] for r in records)
         return view
-    pool_dir = os.path.join(workdir, "derived")
-    os.makedirs(pool_dir, exist_ok=True)
-    if len(records) > 1:
-        sets = []
-        for r in ok:
-            with h5py.File(r["path"], "r") as f:
-                sets.append({k: np.array(f["profiles"][k]) for k in f["profiles"]})
-        key = hashlib.sha256("|".join(r["key"] for r in ok).encode()).hexdigest()[:20]
-        path = os.path.join(pool_dir, f"pool-{solver}-{key}.h5")
-        _write_profiles_like(ok[0]["path"], path, pooled_fields(sets),
-                             f"pooled over {len(ok)} single-shock runs")
-        view = RunView(case, solver, "ok", path, config)
-        view.analysis, view.shock_speed = analyze(shaker, path, with_profiles=True)
-        if len(ok) >= 3:
-            view.replicate_kind = "jackknife"
-            for i in range(len(ok)):
-                rest = sets[:i] + sets[i + 1:]
-                rpath = os.path.join(pool_dir, f"pool-{solver}-{key}-without{i}.h5")
-                _write_profiles_like(ok[0]["path"], rpath, pooled_fields(rest),
-                                     f"jackknife: pool without run {i}")
-                rep = RunView(case, solver, "ok", rpath, config)
-                rep.analysis, rep.shock_speed = analyze(shaker, rpath)
-                view.replicates.append(rep)
-        if len(ok) < len(records):
-            view.notes.add(f"{len(records) - len(ok)} of {len(records)} pooled runs failed")
-    else:
-        view = RunView(case, solver, "ok", ok[0]["path"], config)
-        view.analysis, view.shock_speed = analyze(shaker, ok[0]["path"], with_profiles=True)
-        prof = view.profiles()
-        if solver == "md" and bootstrap > 0 and all(f"{k}_se" in prof for k in ("n", "uz", "T")):
-            view.replicate_kind = "bootstrap"
-            rng = np.random.default_rng(seed)
-            for b in range(bootstrap):
-                n = np.maximum(prof["n"] + prof["n_se"] * rng.standard_normal(prof["n"].shape), 0)
-                ratio = np.divide(n, prof["n"], out=np.zeros_like(n), where=prof["n"] > 0)
-                fields = {"n": n, "nu": prof["nu"] * ratio,
-                          "uz": prof["uz"] + prof["uz_se"] * rng.standard_normal(n.shape),
-                          "T": np.maximum(prof["T"] + prof["T_se"]
-                                          * rng.standard_normal(n.shape), 0.0)}
-                rpath = os.path.join(pool_dir, f"boot-{solver}-{ok[0]['key'][:20]}-{b}.h5")
-                _write_profiles_like(ok[0]["path"], rpath, fields, f"bootstrap replicate {b}")
-                rep = RunView(case, solver, "ok", rpath, config)
-                rep.analysis, rep.shock_speed = analyze(shaker, rpath)
-                view.replicates.append(rep)
+    derived = os.path.join(workdir, "derived")
+    os.makedirs(derived, exist_ok=True)
+    key = hashlib.sha256("|".join(r["key"] for r in ok).encode()).hexdigest()[:20]
+    pooled = os.path.join(derived, f"pool-{solver}-{key}.h5") if len(ok) > 1 else None
+    view = RunView(case, solver, "ok", pooled or ok[0]["path"], config)
+    data = analyze(shaker, [r["path"] for r in ok],
+                   os.path.join(derived, f"analysis-{solver}-{key}.json"), pooled=pooled,
+                   with_profiles=True)
+    fill_view(view, data)
+    view.analysis_json = os.path.join(derived, f"analysis-{solver}-{key}.json")
+    if len(ok) < len(records):
+        view.notes.add(f"{len(records) - len(ok)} of {len(records)} pooled runs failed")
     guarded = [r for r in records if r.get("fallback")]
     if guarded:
         view.notes.add(f"{len(guarded)} of {len(records)} MD runs stopped by inelastic collapse "
@@ -551,7 +506,6 @@ def main(argv=None):
                                       "uncertainty; default: the report generator's)")
     parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
     parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
-    parser.add_argument("--bootstrap", type=int, help="bootstrap replicates of MD profiles")
     parser.add_argument("--require", default="",
                         help="comma-separated claim ids that must pass (else exit status 1); "
                         "ID:SOLVER requires only that solver's check (e.g. C1:md)")
@@ -575,8 +529,6 @@ def main(argv=None):
     if unknown:
         parser.error(f"unknown case(s) {', '.join(unknown)}; known: "
                      + ", ".join(studies["by_name"]))
-    bootstrap = args.bootstrap if args.bootstrap is not None else \
-        studies["quick" if args.quick else "defaults"]["bootstrap"]
 
     started = time.monotonic()
     plan = execute_all(shaker, workdir, plan_runs(shaker, studies, names, args.quick), args.jobs,
@@ -585,9 +537,7 @@ def main(argv=None):
     for name in names:
         for solver in studies["by_name"][name]["solvers"]:
             records = [r["record"] for r in plan if r["case"] == name and r["solver"] == solver]
-            seed = int(hashlib.sha256(f"{name}/{solver}".encode()).hexdigest()[:8], 16)
-            views[(name, solver)] = build_view(shaker, name, solver, records, workdir,
-                                               bootstrap, seed)
+            views[(name, solver)] = build_view(shaker, name, solver, records, workdir)
     comparer = Comparer(shaker, os.path.join(workdir, "derived"))
     metrics = {}
     for name in names:
@@ -617,11 +567,9 @@ def main(argv=None):
         simulated_seconds=sum(r["seconds"] for r in runs if not r["reused"]),
         runs=runs, metrics=metrics, claims=results,
         views={f"{c}/{s}": dict(case=c, solver=s, status=v.status, path=v.path,
-                                analysis_csv=(v.path + ".analysis.csv") if v.path else None,
+                                analysis_json=getattr(v, "analysis_json", None),
                                 shock_speed=v.shock_speed,
-                                shock_speed_error=_spread(v.replicate_kind, [
-                                    r.shock_speed for r in v.replicates]) if v.replicates else
-                                None,
+                                shock_speed_error=v.per_run_errors.get("shock_speed"),
                                 replicate_kind=v.replicate_kind, replicates=len(v.replicates),
                                 switch_e=v.config.get("run", {}).get("switch_e"),
                                 continuum_cell_size=v.config.get("continuum", {}).get(

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "analysis/analysis.hpp"
+
 namespace shaker {
 
 struct RunOptions {
@@ -18,8 +20,13 @@ CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::
 int command_md(const RunOptions& options);
 int command_continuum(const RunOptions& options);
 int command_config(const RunOptions& options);
-int command_analyze(const std::string& run_file, const std::string& csv_file,
-                    const std::string& profiles_csv = "");
+struct AnalyzeOptions {
+  std::vector<std::string> run_files;  ///< one run, or runs of one configuration to pool
+  std::string csv_file, json_file, profiles_csv, pooled_file;
+  analysis::ShockCriteria criteria;
+  bool quiet = false;
+};
+int command_analyze(const AnalyzeOptions& options);
 int command_compare(const std::string& first, const std::string& second,
                     const std::string& csv_file);
 

@@ -25,14 +25,30 @@ int main(int argc, char** argv) {
       show_config);
   config->get_option("CONFIG")->required(false);
 
-  std::string run_file, analysis_csv, profiles_csv;
+  AnalyzeOptions analysis;
   auto* analyze = app.add_subcommand(
-      "analyze", "Print the analysis of a run per stored phase: layer, centre of mass, "
-                 "shock location and width, d/xi, maximum Ma");
-  analyze->add_option("RUN", run_file, "HDF5 run file")->required();
-  analyze->add_option("--csv", analysis_csv, "also write the table as CSV to this file");
-  analyze->add_option("--profiles-csv", profiles_csv,
+      "analyze", "The analysis of docs/analysis.md: per stored phase (layer, centre of mass, "
+                 "shock location and width, d/xi, maximum Ma, layer temperature) and per run "
+                 "(shock formation, exit, lifetime, speed; crossings per cycle), with jackknife "
+                 "errors over the samples of MD runs; several runs of one configuration are pooled");
+  analyze->add_option("RUN", analysis.run_files, "HDF5 run file(s)")->required();
+  analyze->add_option("--csv", analysis.csv_file, "also write the per-phase table as CSV");
+  analyze->add_option("--json", analysis.json_file,
+                      "also write every quantity with its unit, error and jackknife replicates");
+  analyze->add_option("--profiles-csv", analysis.profiles_csv,
                       "also write every profile with its Mach number (phase,z,n,nu,uz,T,mach)");
+  analyze->add_option("--pooled", analysis.pooled_file,
+                      "also write the pooled run (profiles and samples of all RUNs) to this file");
+  analyze->add_flag("--quiet", analysis.quiet, "print nothing (with --json or --csv)");
+  analyze->add_option("--relative-drop", analysis.criteria.relative_drop,
+                      "shock rule: minimum (T_max - T_min) / T_max")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  analyze->add_option("--standard-errors", analysis.criteria.standard_errors,
+                      "shock rule: minimum drop in combined standard errors")
+      ->check(CLI::Range(0.0, 100.0))->capture_default_str();
+  analyze->add_option("--deceleration", analysis.criteria.deceleration,
+                      "shock rule: minimum fraction of the incoming velocity lost")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
 
   std::string first, second, compare_csv;
   auto* compare = app.add_subcommand(
@@ -55,7 +71,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
     if (app.got_subcommand("config")) return command_config(show_config);
-    if (app.got_subcommand("analyze")) return command_analyze(run_file, analysis_csv, profiles_csv);
+    if (app.got_subcommand("analyze")) return command_analyze(analysis);
     if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
   } catch (const InputError& error) {
     fmt::print(stderr, "shaker: error: {}\n", error.what());

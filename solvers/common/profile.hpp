@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "common/cycle_samples.hpp"
+
 namespace shaker {
 
 /// Horizontally averaged fields at one instant, heights in the lab frame.
@@ -40,6 +42,8 @@ struct RunRecord {
   std::string configuration;  ///< effective configuration, TOML
   double e = 0.9;             ///< restitution the analysis uses for the sound speed
   std::vector<Profile> profiles;
+  /// MD: the sums of each sampled cycle behind the profiles (empty for the continuum).
+  CycleSamples samples;
   TimeSeries series;
   // Filled when read back from a file:
   int schema_version = 0;

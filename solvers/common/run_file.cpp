@@ -5,6 +5,8 @@
 #include <fmt/ranges.h>
 
 #include <chrono>
+#include <cmath>
+#include <utility>
 #include <sstream>
 
 #include "common/errors.hpp"
@@ -93,6 +95,65 @@ std::vector<Profile> read_profiles(hid_t file) {
   return profiles;
 }
 
+// The sums of each sample, one [phases * samples x bins] matrix per sum; "cycles" gives the
+// cycles pooled into each sample, [phases x samples].
+constexpr std::pair<const char*, double BinSums::*> sample_sums[] = {
+    {"count", &BinSums::count}, {"vx", &BinSums::vx}, {"vy", &BinSums::vy},
+    {"vz", &BinSums::vz},       {"v2", &BinSums::v2}};
+
+void write_samples(hid_t file, const CycleSamples& samples) {
+  if (samples.empty()) return;
+  const std::size_t phases = samples.phases(), m = samples.samples(), bins = samples.bins();
+  h5::Handle group = h5::create_group(file, "cycle_samples");
+  h5::write_attribute(group.id(), "bin_volume", samples.bin_volume());
+  std::vector<double> cycles;
+  for (std::size_t k = 0; k < phases; ++k) {
+    if (samples.samples(k) != m) throw std::logic_error("phases hold different sample counts");
+    cycles.insert(cycles.end(), samples.cycles(k).begin(), samples.cycles(k).end());
+  }
+  h5::write(group.id(), "cycles", cycles, phases, m);
+  for (const auto& [name, member] : sample_sums) {
+    std::vector<double> matrix;
+    matrix.reserve(phases * m * bins);
+    for (std::size_t k = 0; k < phases; ++k)
+      for (const BinSums& b : samples.sums(k)) matrix.push_back(b.*member);
+    h5::write(group.id(), name, matrix, phases * m, bins);
+  }
+}
+
+CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
+  if (!h5::exists(file, "cycle_samples")) return {};
+  h5::Handle group = h5::open_group(file, "cycle_samples");
+  const double bin_volume = h5::read_double_attribute(group.id(), "bin_volume");
+  const auto shape = h5::shape(group.id(), "cycles");
+  if (shape.size() != 2 || shape[0] != phases || shape[1] == 0)
+    throw InputError(fmt::format("cycle_samples/cycles is not a [{} phases x samples] matrix",
+                                 phases));
+  const std::size_t m = shape[1];
+  const auto flat_cycles = h5::read_doubles(group.id(), "cycles");
+  std::vector<std::vector<double>> cycles(phases);
+  std::vector<std::vector<BinSums>> sums(phases, std::vector<BinSums>(m * bins));
+  for (std::size_t k = 0; k < phases; ++k) {
+    cycles[k].assign(flat_cycles.begin() + static_cast<long>(k * m),
+                     flat_cycles.begin() + static_cast<long>((k + 1) * m));
+    for (double c : cycles[k])
+      if (!(c >= 1.0 && c == std::floor(c)))
+        throw InputError(fmt::format("cycle_samples/cycles holds {}, allowed: whole numbers >= 1", c));
+  }
+  for (const auto& [name, member] : sample_sums) {
+    const auto dims = h5::shape(group.id(), name);
+    if (dims.size() != 2 || dims[0] != phases * m || dims[1] != bins)
+      throw InputError(fmt::format("cycle_samples/{} is not a [{} x {}] matrix", name,
+                                   phases * m, bins));
+    const auto values = h5::read_doubles(group.id(), name);
+    for (std::size_t k = 0; k < phases; ++k)
+      for (std::size_t i = 0; i < m * bins; ++i) sums[k][i].*member = values[k * m * bins + i];
+  }
+  if (!(bin_volume > 0.0 && std::isfinite(bin_volume)))
+    throw InputError(fmt::format("cycle_samples: bin_volume = {}, allowed: > 0", bin_volume));
+  return CycleSamples::from_arrays(bins, bin_volume, std::move(cycles), std::move(sums));
+}
+
 }  // namespace
 
 void write_run_file(const std::filesystem::path& path, const RunRecord& record) {
@@ -108,6 +169,7 @@ void write_run_file(const std::filesystem::path& path, const RunRecord& record) 
     h5::write_attribute(file.id(), "configuration", record.configuration);
     h5::write_attribute(file.id(), "restitution_for_analysis", record.e);
     write_profiles(file.id(), record.profiles);
+    write_samples(file.id(), record.samples);
     h5::Handle series = h5::create_group(file.id(), "timeseries");
     h5::write_attribute(series.id(), "columns", fmt::format("{}", fmt::join(record.series.names, ",")));
     for (std::size_t i = 0; i < record.series.names.size(); ++i)
@@ -132,6 +194,8 @@ RunRecord read_run_file(const std::filesystem::path& path) {
     record.configuration = h5::read_string_attribute(file.id(), "configuration");
     record.e = h5::read_double_attribute(file.id(), "restitution_for_analysis");
     record.profiles = read_profiles(file.id());
+    record.samples = read_samples(file.id(), record.profiles.size(),
+                                  record.profiles.empty() ? 0 : record.profiles.front().size());
     h5::Handle series = h5::open_group(file.id(), "timeseries");
     std::stringstream names(h5::read_string_attribute(series.id(), "columns"));
     for (std::string name; std::getline(names, name, ',');)

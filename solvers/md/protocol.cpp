@@ -143,6 +143,7 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   out.profiles = sampler.profiles(shaker);
+  out.samples = sampler.samples();
   out.series = rows.finish();
   out.budget = budget_now(sim.kinetic_energy(end) + sim.potential_energy(end));
   out.overlaps = sim.count_overlaps(end, 1e-9);

@@ -39,6 +39,7 @@ struct EnergyBudget {
 
 struct RunOutcome {
   std::vector<Profile> profiles;
+  CycleSamples samples;  ///< the per-cycle sums behind the profiles
   /// One row per sampling instant (every phase of every cycle, and the end of the run):
   /// t, phase, plate_z, com_z (centre of mass), kinetic, potential (g z, lab frame),
   /// plate_work, collisional_loss (pair + wall, since the start of this run), energy_closure

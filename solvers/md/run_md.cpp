@@ -96,6 +96,7 @@ int run(const config::Config& config) {
   record.configuration = config.to_toml();
   record.e = final_restitution.e;
   record.profiles = outcome.profiles;
+  record.samples = outcome.samples;
   record.series = outcome.series;
   write_run_file(parameters.run.output, record);
   if (!settings.checkpoint_output.empty())

@@ -76,6 +76,23 @@ def fields_at(config, solver, phase, z_lab, plate_z, plate_v, rng):
     return np.clip(nu, 0, 0.6), uz, np.maximum(T, 1e-6)
 
 
+def write_cycle_samples(h, config, out, rng):
+    """Per-cycle sums (docs/output-schema.md, cycle_samples) that pool to the profiles within
+    1 % noise per cycle: count n V, momentum count u_z, energy count (3 T + u_z^2)."""
+    cycles = 1 if config["run"]["protocol"] == "single_shock" else config["run"]["sampled_cycles"]
+    volume = config["md"]["box_width"] ** 2 * config["md"]["bin_height"]
+    n, uz, T = (np.array(out[k], dtype=float) for k in ("n", "uz", "T"))
+    count = n[:, None, :] * volume * (1 + 0.01 * rng.standard_normal((n.shape[0], cycles,
+                                                                      n.shape[1])))
+    sums = {"count": count, "vx": 0 * count, "vy": 0 * count, "vz": count * uz[:, None, :],
+            "v2": count * (3 * T + uz ** 2)[:, None, :]}
+    g = h.create_group("cycle_samples")
+    g.attrs["bin_volume"] = float(volume)
+    g.create_dataset("cycles", data=np.ones((n.shape[0], cycles)))
+    for name, values in sums.items():
+        g.create_dataset(name, data=values.reshape(n.shape[0] * cycles, n.shape[1]))
+
+
 def write_run(path, config_text, solver, seed):
     config = tomllib.loads(config_text)
     rng = np.random.default_rng(seed)
@@ -119,10 +136,15 @@ def write_run(path, config_text, solver, seed):
                                               if solver == "md" else ())
         for name in keep:
             g.create_dataset(name, data=np.array(out[name], dtype=float))
+        if solver == "md":
+            write_cycle_samples(h, config, out, rng)
         s = h.create_group("timeseries")
+        # One row per stored phase and one at the end of the cycle, as the solvers write them.
+        com = [float(np.sum(n * z) / np.sum(n)) for n, z in zip(out["n"], out["z"])]
         columns = ["t", "phase", "plate_z", "com_z"]
-        data = {"t": times, "phase": phases, "plate_z": pz,
-                "com_z": [float(np.sum(n * z) / np.sum(n)) for n, z in zip(out["n"], out["z"])]}
+        data = {"t": np.append(times, times[0] + 1 / f), "phase": np.append(phases, 0.0),
+                "plate_z": np.append(pz, pz[0]), "com_z": com + com[:1]}
+        times = data["t"]
         if solver == "md":
             per_cycle = 0.3 if config["layer"]["particles"] > 3000 else 5.0
             data["crossings_z80"] = per_cycle * (times - times[0]) * f

@@ -1,0 +1,323 @@
+#include "analysis/run_analysis.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numeric>
+
+#include "common/errors.hpp"
+
+namespace shaker::analysis {
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+double mass_quantile_height(const Profile& p, double fraction) {
+  const double total = std::accumulate(p.n.begin(), p.n.end(), 0.0);
+  if (!(total > 0.0)) return nan;
+  double below = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (below + p.n[i] >= fraction * total)
+      return p.z[i] - 0.5 * p.bin_height + p.bin_height * (fraction * total - below) / p.n[i];
+    below += p.n[i];
+  }
+  return p.z.back() + 0.5 * p.bin_height;
+}
+
+double layer_temperature(const Profile& p, const std::optional<Layer>& layer) {
+  if (!layer) return nan;
+  double n = 0.0, nT = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.z[i] >= layer->bottom && p.z[i] <= layer->top) {
+      n += p.n[i];
+      nT += p.n[i] * p.T[i];
+    }
+  return n > 0.0 ? nT / n : nan;
+}
+
+/// The longest run of consecutive stored phases with a shock (the first on a tie); in a
+/// periodic run the last stored phase is followed by the first.
+std::vector<std::size_t> longest_life(const std::vector<PhaseQuantities>& q, bool periodic) {
+  const std::size_t m = q.size();
+  const auto has = [&](std::size_t k) { return q[k % m].shock.has_value(); };
+  std::vector<std::size_t> life;
+  if (std::all_of(q.begin(), q.end(), [](const auto& x) { return x.shock.has_value(); })) {
+    for (std::size_t k = 0; k < m; ++k) life.push_back(k);
+    return life;
+  }
+  std::size_t best_start = 0, best_length = 0;
+  for (std::size_t start = 0; start < m; ++start) {
+    const bool continues = start > 0 ? has(start - 1) : periodic && has(m - 1);
+    if (!has(start) || continues) continue;
+    std::size_t length = 0;
+    while (has(start + length) && (periodic || start + length < m)) ++length;
+    if (length > best_length) best_start = start, best_length = length;
+  }
+  for (std::size_t j = 0; j < best_length; ++j) life.push_back((best_start + j) % m);
+  return life;
+}
+
+/// Least-squares line y = a + b x: the slope and its standard error from the residuals.
+std::pair<double, double> fitted_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  const double xm = std::accumulate(x.begin(), x.end(), 0.0) / n;
+  const double ym = std::accumulate(y.begin(), y.end(), 0.0) / n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    sxy += (x[k] - xm) * (y[k] - ym);
+    sxx += (x[k] - xm) * (x[k] - xm);
+  }
+  const double slope = sxy / sxx;
+  if (x.size() < 3) return {slope, nan};
+  double residuals = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double r = y[k] - ym - slope * (x[k] - xm);
+    residuals += r * r;
+  }
+  return {slope, std::sqrt(residuals / (n - 2.0) / sxx)};
+}
+
+double temperature_slope_above(const Profile& p, const std::optional<Layer>& layer) {
+  if (!layer) return nan;
+  std::vector<double> z, T;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.z[i] > layer->top && p.z[i] <= layer->top + gas_span_above_layer && p.n[i] > 0.0) {
+      z.push_back(p.z[i]);
+      T.push_back(p.T[i]);
+    }
+  return z.size() >= 3 ? fitted_slope(z, T).first : nan;
+}
+
+/// 2 c of the least-squares parabola a + b x + c x^2.
+double fitted_curvature(const std::vector<double>& x, const std::vector<double>& y) {
+  if (x.size() < 4) return nan;
+  const double x0 = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+  double s[5] = {0, 0, 0, 0, 0}, r[3] = {0, 0, 0};
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double u = x[k] - x0;
+    double power = 1.0;
+    for (int j = 0; j < 5; ++j, power *= u) {
+      s[j] += power;
+      if (j < 3) r[j] += power * y[k];
+    }
+  }
+  // Normal equations [s0 s1 s2; s1 s2 s3; s2 s3 s4] (a b c) = r, solved for c by Cramer.
+  const auto det3 = [](double a, double b, double c, double d, double e, double f, double g,
+                       double h, double i) { return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g); };
+  const double d = det3(s[0], s[1], s[2], s[1], s[2], s[3], s[2], s[3], s[4]);
+  const double dc = det3(s[0], s[1], r[0], s[1], s[2], r[1], s[2], s[3], r[2]);
+  return 2.0 * dc / d;
+}
+
+std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
+                                    const AnalysisOptions& o) {
+  const auto life = longest_life(q, o.periodic);
+  if (life.empty()) return std::nullopt;
+  ShockLife s;
+  s.phases = life;
+  // Phases on one axis: a life that wraps the cycle starts in the cycle before.
+  std::vector<double> phase, t, height, location;
+  const bool wraps = std::adjacent_find(life.begin(), life.end(), std::greater<>()) != life.end();
+  double offset = wraps ? -1.0 : 0.0;
+  for (std::size_t j = 0; j < life.size(); ++j) {
+    const std::size_t k = life[j];
+    if (j > 0 && k < life[j - 1]) offset += 1.0;
+    const double p = q[k].phase + offset;
+    phase.push_back(p);
+    t.push_back(p / o.frequency);
+    height.push_back(q[k].shock->location - q[k].plate_z);
+    location.push_back(q[k].shock->location);
+  }
+  s.formation_phase = phase.front();
+  // Exit: where the line through the last two gaps (layer top - shock) reaches zero, between
+  // the last phase with a shock and the next stored phase.
+  const std::size_t last = life.back(), m = q.size();
+  const double spacing = m > 1 ? 1.0 / static_cast<double>(m) : 1.0;
+  const double next_phase = phase.back() + spacing;
+  double exit = next_phase;
+  if (life.size() >= 2) {
+    const std::size_t before = life[life.size() - 2];
+    const double gap_last = q[last].layer->top - q[last].shock->location;
+    const double gap_before = q[before].layer->top - q[before].shock->location;
+    if (gap_before > gap_last)
+      exit = phase.back() + (phase.back() - phase[phase.size() - 2]) * gap_last / (gap_before - gap_last);
+  }
+  s.exit_phase = std::clamp(exit, phase.back(), next_phase);
+  if (!o.periodic && last + 1 == m) s.exit_phase = nan;  // the run ended with the shock inside
+  s.lifetime = s.exit_phase - s.formation_phase;
+  if (t.size() >= 2) std::tie(s.speed, s.speed_fit_error) = fitted_slope(t, height);
+  else s.speed = s.speed_fit_error = nan;
+  s.curvature = fitted_curvature(t, location);
+  return s;
+}
+
+}  // namespace
+
+RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
+                               const AnalysisOptions& options) {
+  RunQuantities r;
+  for (const Profile& p : profiles) {
+    PhaseQuantities q;
+    q.phase = p.phase;
+    q.time = p.time;
+    q.plate_z = p.plate_z;
+    q.center_of_mass = center_of_mass(p);
+    q.max_mach = max_mach_in_layer(p, e);
+    q.layer = find_layer(p);
+    q.mass_bottom = mass_quantile_height(p, 0.01);
+    q.layer_temperature = layer_temperature(p, q.layer);
+    q.temperature_slope_above = temperature_slope_above(p, q.layer);
+    q.shock = find_shock(p, options.criteria);
+    r.phases.push_back(std::move(q));
+  }
+  if (r.phases.empty()) return r;
+  double com = 0.0;
+  r.center_of_mass_apex = -std::numeric_limits<double>::infinity();
+  r.layer_temperature_peak = nan;
+  for (const auto& q : r.phases) {
+    com += q.center_of_mass;
+    r.center_of_mass_apex = std::max(r.center_of_mass_apex, q.center_of_mass);
+    if (std::isfinite(q.layer_temperature) && !(q.layer_temperature <= r.layer_temperature_peak))
+      r.layer_temperature_peak = q.layer_temperature;
+  }
+  r.center_of_mass_mean = com / static_cast<double>(r.phases.size());
+  r.shock = shock_life(r.phases, options);
+  r.width_over_mfp_peak_phase = nan;
+  if (r.shock) {
+    double best = -1.0;
+    for (std::size_t k : r.shock->phases)
+      if (r.phases[k].shock->width_over_mfp() > best) {
+        best = r.phases[k].shock->width_over_mfp();
+        r.width_over_mfp_peak_phase = r.phases[k].phase;
+      }
+  }
+  return r;
+}
+
+std::vector<NamedValues> phase_columns(const RunQuantities& r) {
+  const auto column = [&](std::string name, std::string unit, auto get) {
+    NamedValues c{std::move(name), std::move(unit), {}};
+    for (const auto& q : r.phases) c.values.push_back(get(q));
+    return c;
+  };
+  const auto layer = [](auto member) {
+    return [member](const PhaseQuantities& q) { return q.layer ? (*q.layer).*member : nan; };
+  };
+  const auto shock = [](auto get) {
+    return [get](const PhaseQuantities& q) { return q.shock ? get(*q.shock) : nan; };
+  };
+  return {
+      column("phase", "1", [](auto& q) { return q.phase; }),
+      column("time", "sqrt(sigma/g)", [](auto& q) { return q.time; }),
+      column("plate_z", "sigma", [](auto& q) { return q.plate_z; }),
+      column("layer_bottom", "sigma", layer(&Layer::bottom)),
+      column("layer_top", "sigma", layer(&Layer::top)),
+      column("mass_bottom", "sigma", [](auto& q) { return q.mass_bottom; }),
+      column("center_of_mass", "sigma", [](auto& q) { return q.center_of_mass; }),
+      column("layer_temperature", "g sigma", [](auto& q) { return q.layer_temperature; }),
+      column("layer_gap", "sigma",
+             [](auto& q) { return q.layer ? q.layer->bottom - q.plate_z : nan; }),
+      column("mass_gap", "sigma", [](auto& q) { return q.mass_bottom - q.plate_z; }),
+      column("temperature_slope_above_layer", "g",
+             [](auto& q) { return q.temperature_slope_above; }),
+      column("max_mach", "1", [](auto& q) { return q.max_mach; }),
+      column("shock_present", "1", [](auto& q) { return q.shock ? 1.0 : 0.0; }),
+      column("shock_location", "sigma", shock([](const Shock& s) { return s.location; })),
+      column("shock_width", "sigma", shock([](const Shock& s) { return s.width; })),
+      column("width_over_mfp", "1", shock([](const Shock& s) { return s.width_over_mfp(); })),
+      column("mean_free_path", "sigma", shock([](const Shock& s) { return s.mean_free_path; })),
+      column("shock_compressed_top", "sigma", shock([](const Shock& s) { return s.compressed_top; })),
+      column("shock_undisturbed_bottom", "sigma",
+             shock([](const Shock& s) { return s.undisturbed_bottom; })),
+  };
+}
+
+std::vector<NamedValues> run_values(const RunQuantities& r) {
+  const auto life = [&](auto member) { return r.shock ? (*r.shock).*member : nan; };
+  return {
+      {"formation_phase", "1", {life(&ShockLife::formation_phase)}},
+      {"exit_phase", "1", {life(&ShockLife::exit_phase)}},
+      {"lifetime", "1/f", {life(&ShockLife::lifetime)}},
+      {"shock_speed", "sqrt(g sigma)", {life(&ShockLife::speed)}},
+      {"shock_speed_fit_error", "sqrt(g sigma)", {life(&ShockLife::speed_fit_error)}},
+      {"shock_curvature", "g", {life(&ShockLife::curvature)}},
+      {"shock_phases", "1", {r.shock ? static_cast<double>(r.shock->phases.size()) : 0.0}},
+      {"center_of_mass_mean", "sigma", {r.center_of_mass_mean}},
+      {"center_of_mass_apex", "sigma", {r.center_of_mass_apex}},
+      {"width_over_mfp_peak_phase", "1", {r.width_over_mfp_peak_phase}},
+      {"layer_temperature_peak", "g sigma", {r.layer_temperature_peak}},
+  };
+}
+
+std::vector<double> crossings_per_cycle(const RunRecord& run, const std::string& column) {
+  if (!run.series.has(column) || !run.series.has("t") || run.profiles.empty()) return {};
+  const auto& t = run.series.column("t");
+  const auto& count = run.series.column(column);
+  const double first = std::min_element(run.profiles.begin(), run.profiles.end(),
+                                        [](auto& a, auto& b) { return a.time < b.time; })->time;
+  // The sampled cycles start at the cycle boundary at or before the first stored profile.
+  const double period = (run.profiles.size() > 1 && run.profiles[1].phase > run.profiles[0].phase)
+                            ? (run.profiles[1].time - run.profiles[0].time) /
+                                  (run.profiles[1].phase - run.profiles[0].phase)
+                            : nan;
+  if (!std::isfinite(period) || period <= 0.0) return {};
+  const double start = std::floor(first / period + 1e-9) * period;
+  const auto row_at = [&](double time) -> std::optional<std::size_t> {
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (std::abs(t[i] - time) < 1e-9 * std::max(1.0, time)) return i;
+    return std::nullopt;
+  };
+  std::vector<double> per_cycle;
+  for (double c = start;; c += period) {
+    const auto a = row_at(c), b = row_at(c + period);
+    if (!a || !b) break;
+    per_cycle.push_back(count[*b] - count[*a]);
+  }
+  return per_cycle;
+}
+
+RunRecord pool_runs(const std::vector<RunRecord>& runs) {
+  if (runs.empty()) throw InputError("no run to pool");
+  RunRecord pooled = runs.front();
+  if (runs.size() == 1) return pooled;
+  for (std::size_t r = 1; r < runs.size(); ++r) {
+    if (runs[r].samples.empty() || runs.front().samples.empty())
+      throw InputError("only MD runs that keep their per-cycle sums can be pooled");
+    if (runs[r].profiles.size() != pooled.profiles.size())
+      throw InputError(fmt::format("the runs to pool store {} and {} phases",
+                                   pooled.profiles.size(), runs[r].profiles.size()));
+    try {
+      pooled.samples.append(runs[r].samples);
+    } catch (const std::invalid_argument& error) {
+      throw InputError(error.what());
+    }
+  }
+  for (std::size_t k = 0; k < pooled.profiles.size(); ++k) pooled.samples.pool(k, pooled.profiles[k]);
+  pooled.model_variant += fmt::format(" (pooled over {} runs)", runs.size());
+  return pooled;
+}
+
+std::vector<Profile> profiles_without(const RunRecord& run, std::size_t left_out) {
+  std::vector<Profile> profiles = run.profiles;
+  std::vector<char> use(run.samples.samples(), 1);
+  use.at(left_out) = 0;
+  for (std::size_t k = 0; k < profiles.size(); ++k) run.samples.pool(k, profiles[k], use);
+  return profiles;
+}
+
+double jackknife_error(const std::vector<double>& leave_one_out) {
+  std::vector<double> v;
+  for (double x : leave_one_out)
+    if (std::isfinite(x)) v.push_back(x);
+  if (v.size() < 2) return nan;
+  const double n = static_cast<double>(v.size());
+  const double mean = std::accumulate(v.begin(), v.end(), 0.0) / n;
+  double squares = 0.0;
+  for (double x : v) squares += (x - mean) * (x - mean);
+  return std::sqrt((n - 1.0) / n * squares);
+}
+
+}  // namespace shaker::analysis

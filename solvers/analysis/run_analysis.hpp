@@ -1,0 +1,87 @@
+#pragma once
+// The analysis of a whole run (docs/analysis.md): every per-phase quantity, the shock's life
+// over the cycle, and, for MD runs that keep their per-cycle sums, the jackknife standard
+// error of every number over the independent samples (cycles, or repeated runs pooled).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/analysis.hpp"
+#include "common/profile.hpp"
+
+namespace shaker::analysis {
+
+/// Everything the analysis derives at one stored phase.
+struct PhaseQuantities {
+  double phase = 0.0, time = 0.0, plate_z = 0.0, center_of_mass = 0.0, max_mach = 0.0;
+  std::optional<Layer> layer;
+  /// Height below which 1 % of the material lies: a layer bottom that does not depend on a
+  /// volume-fraction threshold in the dilute gas.
+  double mass_bottom = 0.0;
+  double layer_temperature = 0.0;  ///< number-weighted mean T inside the layer (NaN without)
+  /// dT/dz of a least-squares line through the bins with material in the span above the
+  /// layer's top (the dilute gas above the layer); NaN with fewer than 3 such bins.
+  double temperature_slope_above = 0.0;
+  std::optional<Shock> shock;
+};
+
+/// The shock's life over the stored phases.
+struct ShockLife {
+  std::vector<std::size_t> phases;  ///< indices, in time order (may wrap the cycle)
+  double formation_phase = 0.0;     ///< first phase of the life (negative if it wraps)
+  double exit_phase = 0.0;          ///< where the shock meets the layer top (interpolated)
+  double lifetime = 0.0;            ///< exit - formation, in cycles
+  double speed = 0.0;               ///< slope of location - plate_z against t, plate frame
+  double speed_fit_error = 0.0;     ///< standard error of that slope from the fit residuals
+  double curvature = 0.0;           ///< 2 x the t^2 coefficient of location(t); NaN if < 4 points
+};
+
+struct RunQuantities {
+  std::vector<PhaseQuantities> phases;
+  std::optional<ShockLife> shock;
+  double center_of_mass_mean = 0.0, center_of_mass_apex = 0.0;
+  double width_over_mfp_peak_phase = 0.0;  ///< phase of the largest d/xi in the life (NaN)
+  double layer_temperature_peak = 0.0;     ///< largest layer_temperature over the phases
+};
+
+/// Height above the layer's top over which temperature_slope_above is fitted.
+inline constexpr double gas_span_above_layer = 10.0;
+
+struct AnalysisOptions {
+  ShockCriteria criteria;
+  bool periodic = true;  ///< the stored phases are one periodic cycle (a life may wrap)
+  double frequency = 1.0;  ///< f, to place phases of a wrapped life on one time axis
+};
+
+/// The analysis of a set of profiles (one per stored phase, in phase order).
+RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
+                               const AnalysisOptions& options);
+
+/// A named quantity with its unit (docs/units.md) and one value per stored phase, or a single
+/// value for a per-run quantity; NaN where it does not exist (no layer, no shock).
+struct NamedValues {
+  std::string name, unit;
+  std::vector<double> values;
+};
+/// The per-phase quantities as columns, in a fixed order (the columns of `shaker analyze`).
+std::vector<NamedValues> phase_columns(const RunQuantities& r);
+/// The per-run quantities, one value each, in a fixed order.
+std::vector<NamedValues> run_values(const RunQuantities& r);
+
+/// Upward crossings of a height per cycle over the sampled cycles of a run (time-series
+/// column crossings_z<h>): one count per cycle.
+std::vector<double> crossings_per_cycle(const RunRecord& run, const std::string& column);
+
+/// Runs of one configuration pooled into one record: their samples appended, the profiles
+/// rebuilt from all samples. Throws InputError if a run lacks samples or the runs differ in
+/// their phases or bins.
+RunRecord pool_runs(const std::vector<RunRecord>& runs);
+
+/// The profiles of `run` rebuilt from every sample but `left_out`.
+std::vector<Profile> profiles_without(const RunRecord& run, std::size_t left_out);
+
+/// Jackknife standard error of an estimate from its leave-one-out values (NaN entries are
+/// dropped; NaN if fewer than two remain).
+double jackknife_error(const std::vector<double>& leave_one_out);
+
+}  // namespace shaker::analysis
