@@ -40,15 +40,6 @@ std::optional<std::size_t> lowest_bin_above_plate(const Profile& p) {
   return std::nullopt;
 }
 
-double interpolate(const std::vector<double>& z, const std::vector<double>& f, double at) {
-  const auto upper = std::upper_bound(z.begin(), z.end(), at);
-  if (upper == z.begin()) return f.front();
-  if (upper == z.end()) return f.back();
-  const auto j = static_cast<std::size_t>(upper - z.begin());
-  const double s = (at - z[j - 1]) / (z[j] - z[j - 1]);
-  return f[j - 1] + s * (f[j] - f[j - 1]);
-}
-
 /// Where T falls steepest, to a fraction of a bin: the vertex of the parabola through the
 /// drops T_j - T_{j+1} at the faces k - 1, k, k + 1, k being the face of the largest drop.
 /// The face itself would quantise the location to the bin grid, so a grid study would see it
@@ -68,6 +59,15 @@ double steepest_descent_height(const Profile& p, std::size_t k) {
 }
 
 }  // namespace
+
+double interpolate(const std::vector<double>& z, const std::vector<double>& f, double at) {
+  const auto upper = std::upper_bound(z.begin(), z.end(), at);
+  if (upper == z.begin()) return f.front();
+  if (upper == z.end()) return f.back();
+  const auto j = static_cast<std::size_t>(upper - z.begin());
+  const double s = (at - z[j - 1]) / (z[j] - z[j - 1]);
+  return f[j - 1] + s * (f[j] - f[j - 1]);
+}
 
 std::optional<Layer> find_layer(const Profile& p) {
   std::optional<std::size_t> first, last;

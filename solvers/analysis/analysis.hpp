@@ -19,6 +19,9 @@ struct Layer {
 /// The layer, or nothing if no bin exceeds the threshold.
 std::optional<Layer> find_layer(const Profile& p);
 
+/// f at height `at`, linearly interpolated between the centres z (held constant beyond them).
+double interpolate(const std::vector<double>& z, const std::vector<double>& f, double at);
+
 /// Centre-of-mass height of all the material, sum(n z) / sum(n).
 double center_of_mass(const Profile& p);
 

@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "common/errors.hpp"
+#include "common/granular_model.hpp"
 
 namespace shaker::analysis {
 namespace {
@@ -36,6 +37,16 @@ double layer_temperature(const Profile& p, const std::optional<Layer>& layer) {
       nT += p.n[i] * p.T[i];
     }
   return n > 0.0 ? nT / n : nan;
+}
+
+/// T across the shock fitted by a tanh front, within the layer, if the fit resolves it.
+std::optional<FrontFit> fitted_front(const Profile& p, const Shock& shock, const Layer& layer) {
+  const double half = std::max(1.5 * shock.width, front_window_minimum);
+  const double lo = std::max(shock.location - half, layer.bottom);
+  const double hi = std::min(shock.location + half, layer.top);
+  auto fit = fit_front(p.z, p.T, p.T_se, lo, hi);
+  if (!fit || !(fit->width_error < fit->width) || !(fit->high < fit->low)) return std::nullopt;
+  return fit;
 }
 
 /// The longest run of consecutive stored phases with a shock (the first on a tie); in a
@@ -171,6 +182,8 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
     q.layer_temperature = layer_temperature(p, q.layer);
     q.temperature_slope_above = temperature_slope_above(p, q.layer);
     q.shock = find_shock(p, options.criteria);
+    if (q.shock) q.front = fitted_front(p, *q.shock, *q.layer);
+    if (q.front) q.front_mean_free_path = model::mean_free_path(interpolate(p.z, p.n, q.front->location));
     r.phases.push_back(std::move(q));
   }
   if (r.phases.empty()) return r;
@@ -229,6 +242,11 @@ std::vector<NamedValues> phase_columns(const RunQuantities& r) {
       column("shock_width", "sigma", shock([](const Shock& s) { return s.width; })),
       column("width_over_mfp", "1", shock([](const Shock& s) { return s.width_over_mfp(); })),
       column("mean_free_path", "sigma", shock([](const Shock& s) { return s.mean_free_path; })),
+      column("front_width", "sigma", [](auto& q) { return q.front ? q.front->width : nan; }),
+      column("front_width_fit_error", "sigma",
+             [](auto& q) { return q.front ? q.front->width_error : nan; }),
+      column("front_width_over_mfp", "1",
+             [](auto& q) { return q.front ? q.front->width / q.front_mean_free_path : nan; }),
       column("shock_compressed_top", "sigma", shock([](const Shock& s) { return s.compressed_top; })),
       column("shock_undisturbed_bottom", "sigma",
              shock([](const Shock& s) { return s.undisturbed_bottom; })),

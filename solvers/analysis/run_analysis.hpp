@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "analysis/analysis.hpp"
+#include "analysis/front_fit.hpp"
 #include "common/profile.hpp"
 
 namespace shaker::analysis {
@@ -23,7 +24,14 @@ struct PhaseQuantities {
   /// layer's top (the dilute gas above the layer); NaN with fewer than 3 such bins.
   double temperature_slope_above = 0.0;
   std::optional<Shock> shock;
+  /// A tanh front fitted to T across the shock (front_fit.hpp), where the fit resolves it
+  /// (width error below the width): a width that does not depend on the bin.
+  std::optional<FrontFit> front;
+  double front_mean_free_path = 0.0;  ///< xi at the fitted front's centre
 };
+
+/// Half-width of the window fitted around a shock: the larger of 1.5 paper widths and this.
+inline constexpr double front_window_minimum = 4.0;
 
 /// The shock's life over the stored phases.
 struct ShockLife {

@@ -36,6 +36,10 @@ EXPECTED = {
                            "run.switch_restitution": "velocity_dependent",
                            "run.switch_phase": -0.33},
 }
+for tag, bin_height in (("1", 1.0), ("0p5", 0.5), ("0p25", 0.25)):
+    EXPECTED[f"base_bin{tag}"] = {"layer.particles": 3937, "material.e": 0.9,
+                                  "md.box_width": 20.0, "md.bin_height": bin_height,
+                                  "run.sampled_cycles": 40}
 for tag, e in (("0p80", 0.80), ("0p85", 0.85), ("0p90", 0.90), ("0p95", 0.95), ("0p99", 0.99),
                ("1p00", 1.0)):
     EXPECTED[f"single_shock_e{tag}"] = {"run.protocol": "single_shock", "material.e": 0.9,
