@@ -117,6 +117,27 @@ def main():
     expect(claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None,
            "C14 has a jackknife error from the pooled runs")
 
+    # The report's numbers are those `shaker analyze` prints: run it again, by hand, on the
+    # pooled single-shock runs of e = 0.9 and on the base case, and compare.
+    for claim, solver, case, name in (("C4", "md", "base", "exit_phase"),
+                                      ("C1", "md", "base", "formation_phase"),
+                                      ("C14", "md", "single_shock_e0p90", None)):
+        view = results["views"].get(f"{case}/{solver}")
+        if not view or not view.get("path"):
+            expect(False, f"{case}/{solver} has no run file")
+            continue
+        out = os.path.join(tmp, f"again-{case}.json")
+        subprocess.run([shaker, "analyze", view["path"], "--json", out, "--quiet"], check=True)
+        per_run = json.load(open(out))["per_run"]
+        if name:
+            expect(per_run[name]["value"] == value(claim, solver),
+                   f"{claim}: report {value(claim, solver)} = shaker analyze {name} "
+                   f"{per_run[name]['value']}")
+        else:
+            expect(per_run["shock_speed"]["value"] == view["shock_speed"],
+                   f"{case}: report shock speed {view['shock_speed']} = shaker analyze "
+                   f"{per_run['shock_speed']['value']}")
+
     md_views = [v for v in results["views"].values() if v["solver"] == "md" and v["status"] == "ok"]
     for view in md_views:
         seconds = sum(r["seconds"] for r in results["runs"] if r["case"] == view["case"]
