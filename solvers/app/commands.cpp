@@ -6,6 +6,7 @@
 
 #include "analysis/analysis.hpp"
 #include "common/config.hpp"
+#include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
@@ -35,8 +36,12 @@ CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::
   return sub;
 }
 
-int command_md(const RunOptions& options) { return md::run(load(options)); }
-int command_continuum(const RunOptions& options) { return continuum::run(load(options)); }
+int command_md(const RunOptions& options) {
+  return md::run(load(options), {{"configuration file", options.config_file}});
+}
+int command_continuum(const RunOptions& options) {
+  return continuum::run(load(options), {{"configuration file", options.config_file}});
+}
 
 int command_config(const RunOptions& options) {
   fmt::print("{}", load(options).to_toml());
@@ -57,8 +62,17 @@ void write_profiles_csv(const RunRecord& run, const std::string& path) {
 }
 }  // namespace
 
+namespace {
+/// The CSV outputs given (empty: not asked for), checked against the run files read.
+void check_csv_outputs(std::vector<NamedPath> outputs, const std::vector<NamedPath>& inputs) {
+  std::erase_if(outputs, [](const NamedPath& p) { return p.path.empty(); });
+  check_output_paths(outputs, inputs);
+}
+}  // namespace
+
 int command_analyze(const std::string& run_file, const std::string& csv_file,
                     const std::string& profiles_csv) {
+  check_csv_outputs({{"--csv", csv_file}, {"--profiles-csv", profiles_csv}}, {{"run file", run_file}});
   const RunRecord run = read_run_file(run_file);
   fmt::print("# {}: solver {}, {}, e = {}, program {} ({})\n", run_file, run.solver,
              run.model_variant, run.e, run.program_version, run.git_commit);
@@ -95,9 +109,26 @@ int command_analyze(const std::string& run_file, const std::string& csv_file,
   return 0;
 }
 
+namespace {
+/// Profile norms interpolate in the reference's bins: a run with fewer than two bins in a
+/// stored phase has nothing to compare, and would report a perfect 0.
+void require_comparable_profiles(const RunRecord& run, const std::string& path) {
+  for (const auto& p : run.profiles)
+    if (p.size() < 2)
+      throw InputError(fmt::format("run file '{}': the profile at phase {} has {} bin(s); compare "
+                                   "needs at least 2 bins in every phase", path, p.phase, p.size()));
+  if (run.profiles.empty())
+    throw InputError(fmt::format("run file '{}' stores no profile; compare needs at least one phase "
+                                 "with at least 2 bins", path));
+}
+}  // namespace
+
 int command_compare(const std::string& first, const std::string& second,
                     const std::string& csv_file) {
+  check_csv_outputs({{"--csv", csv_file}}, {{"run file A", first}, {"run file B", second}});
   const RunRecord a = read_run_file(first), b = read_run_file(second);
+  require_comparable_profiles(a, first);
+  require_comparable_profiles(b, second);
   const auto r = analysis::compare_runs(a, b);
   fmt::print("# A = {} ({}), B = {} ({}, reference)\n", first, a.solver, second, b.solver);
   fmt::print("shock location: fractional RMS {:.4f}, absolute RMS {:.3f} sigma over {} phases\n",
