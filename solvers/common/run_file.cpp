@@ -132,8 +132,9 @@ RunRecord read_run_file(const std::filesystem::path& path) {
     RunRecord record;
     const std::int64_t version = h5::read_integer_attribute(file.id(), "schema_version");
     if (version != output_schema_version)
-      throw InputError(fmt::format("schema_version = {} is not supported; allowed: {} (the version "
-                                   "this program reads)", version, output_schema_version));
+      throw InputError(fmt::format("schema version {} is not supported (attribute schema_version; "
+                                   "allowed: {}, the version this program reads)", version,
+                                   output_schema_version));
     record.schema_version = static_cast<int>(version);
     record.program_version = h5::read_string_attribute(file.id(), "program_version");
     record.git_commit = h5::read_string_attribute(file.id(), "git_commit");
