@@ -5,7 +5,6 @@
 #include <fmt/ranges.h>
 
 #include <cmath>
-#include <filesystem>
 
 #include "analysis/run_analysis.hpp"
 #include "app/commands.hpp"
@@ -193,32 +192,15 @@ void write_profiles_csv(const RunRecord& run, const std::string& path) {
   write_text_atomically(path, csv);
 }
 
-/// An output must not replace an input or another output.
-void refuse_clobbering(const AnalyzeOptions& o) {
-  namespace fs = std::filesystem;
-  std::vector<std::pair<std::string, std::string>> outputs;
-  for (const auto& [flag, path] : {std::pair{"--csv", o.csv_file}, {"--json", o.json_file},
-                                   {"--profiles-csv", o.profiles_csv}, {"--pooled", o.pooled_file}})
-    if (!path.empty()) outputs.emplace_back(flag, path);
-  const auto same = [](const std::string& a, const std::string& b) {
-    return fs::weakly_canonical(a) == fs::weakly_canonical(b);
-  };
-  for (std::size_t i = 0; i < outputs.size(); ++i) {
-    for (const auto& input : o.run_files)
-      if (same(outputs[i].second, input))
-        throw InputError(fmt::format("{} {} would overwrite the input run file; allowed: a path "
-                                     "that is not an input", outputs[i].first, outputs[i].second));
-    for (std::size_t j = 0; j < i; ++j)
-      if (same(outputs[i].second, outputs[j].second))
-        throw InputError(fmt::format("{} and {} name the same file {}; allowed: distinct paths",
-                                     outputs[j].first, outputs[i].first, outputs[i].second));
-  }
-}
-
 }  // namespace
 
 int command_analyze(const AnalyzeOptions& o) {
-  refuse_clobbering(o);
+  std::vector<NamedPath> outputs, inputs;
+  for (const auto& [flag, path] : {std::pair{"--csv", o.csv_file}, {"--json", o.json_file},
+                                   {"--profiles-csv", o.profiles_csv}, {"--pooled", o.pooled_file}})
+    if (!path.empty()) outputs.push_back({flag, path});
+  for (const auto& file : o.run_files) inputs.push_back({"run file", file});
+  check_output_paths(outputs, inputs);
   std::vector<RunRecord> runs;
   for (const auto& file : o.run_files) runs.push_back(read_run_file(file));
   const RunRecord run = analysis::pool_runs(runs);

@@ -8,6 +8,7 @@
 #include "analysis/analysis.hpp"
 #include "analysis/run_analysis.hpp"
 #include "common/config.hpp"
+#include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
@@ -33,8 +34,12 @@ CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::
   return sub;
 }
 
-int command_md(const RunOptions& options) { return md::run(load(options)); }
-int command_continuum(const RunOptions& options) { return continuum::run(load(options)); }
+int command_md(const RunOptions& options) {
+  return md::run(load(options), {{"configuration file", options.config_file}});
+}
+int command_continuum(const RunOptions& options) {
+  return continuum::run(load(options), {{"configuration file", options.config_file}});
+}
 
 int command_config(const RunOptions& options) {
   fmt::print("{}", load(options).to_toml());
@@ -82,11 +87,31 @@ std::vector<std::vector<std::pair<std::string, double>>> comparison_replicates(c
   return out;
 }
 
+/// The CSV outputs given (empty: not asked for), checked against the run files read.
+void check_csv_outputs(std::vector<NamedPath> outputs, const std::vector<NamedPath>& inputs) {
+  std::erase_if(outputs, [](const NamedPath& p) { return p.path.empty(); });
+  check_output_paths(outputs, inputs);
+}
+
+/// Profile norms interpolate in the reference's bins: a run with fewer than two bins in a
+/// stored phase has nothing to compare, and would report a perfect 0.
+void require_comparable_profiles(const RunRecord& run, const std::string& path) {
+  for (const auto& p : run.profiles)
+    if (p.size() < 2)
+      throw InputError(fmt::format("run file '{}': the profile at phase {} has {} bin(s); compare "
+                                   "needs at least 2 bins in every phase", path, p.phase, p.size()));
+  if (run.profiles.empty())
+    throw InputError(fmt::format("run file '{}' stores no profile; compare needs at least one phase "
+                                 "with at least 2 bins", path));
+}
 }  // namespace
 
 int command_compare(const std::string& first, const std::string& second,
                     const std::string& csv_file) {
+  check_csv_outputs({{"--csv", csv_file}}, {{"run file A", first}, {"run file B", second}});
   const RunRecord a = read_run_file(first), b = read_run_file(second);
+  require_comparable_profiles(a, first);
+  require_comparable_profiles(b, second);
   const auto r = analysis::compare_runs(a, b);
   const auto metrics = comparison_metrics(r);
   const auto replicates = comparison_replicates(a, b);

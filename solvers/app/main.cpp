@@ -7,6 +7,7 @@
 
 #include "app/commands.hpp"
 #include "common/errors.hpp"
+#include "common/hdf5_file.hpp"
 #include "common/version.hpp"
 
 int main(int argc, char** argv) {
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  install_signal_cleanup();  // SIGTERM/SIGINT/SIGHUP: remove partial files, exit 128 + signal
   try {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);

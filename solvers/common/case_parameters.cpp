@@ -1,5 +1,9 @@
 #include "common/case_parameters.hpp"
 
+#include <fmt/format.h>
+
+#include "common/errors.hpp"
+
 namespace shaker {
 
 CaseParameters CaseParameters::from(const config::Config& c) {
@@ -20,6 +24,13 @@ CaseParameters CaseParameters::from(const config::Config& c) {
                                    c.real("run.switch_e")};
   p.run.seed = static_cast<std::uint64_t>(c.integer("run.seed"));
   p.run.output = c.text("run.output");
+  // The switch lies run.switch_phase (in [-1, 0)) before the recorded cycle, i.e. inside the
+  // transient: without a transient cycle it would lie before the start of the run.
+  if (p.run.kind == RunProtocol::Kind::single_shock && static_cast<double>(p.run.transient_cycles) + p.run.switch_phase < 0.0)
+    throw InputError(fmt::format(
+        "run.transient_cycles = {} with run.protocol = \"single_shock\" puts the switch at "
+        "run.switch_phase = {} cycles, before the start of the run; allowed: run.transient_cycles "
+        ">= 1 for a single shock", p.run.transient_cycles, p.run.switch_phase));
   return p;
 }
 

@@ -7,6 +7,8 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <optional>
 #include <sstream>
 #include <toml.hpp>
 
@@ -194,7 +196,61 @@ template <class T> bool parse_number(const std::string& s, T& out) {
   return ec == std::errc() && ptr == end;
 }
 
+/// Deepest nesting of arrays and inline tables in a TOML text (brackets in strings and
+/// comments not counted). toml11 parses nesting by recursion: a hostile depth overflows the
+/// stack, so texts deeper than max_toml_nesting are refused before parsing.
+constexpr int max_toml_nesting = 32;
+int toml_nesting(const std::string& text) {
+  int depth = 0, deepest = 0;
+  char quote = 0;  // inside a string: its quote character
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quote) {
+      if (c == '\\' && quote == '"') ++i;
+      else if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '#') {
+      i = text.find('\n', i);
+      if (i == std::string::npos) break;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+void check_nesting(const std::string& text, const std::string& origin) {
+  const int depth = toml_nesting(text);
+  if (depth > max_toml_nesting)
+    throw InputError(fmt::format("{}: arrays or tables nested {} deep; allowed: at most {}",
+                                 origin, depth, max_toml_nesting));
+}
+
+/// The value of "key = RAW" read as TOML, or nothing if RAW is not a TOML value.
+std::optional<toml::value> toml_value(const std::string& raw) {
+  try {
+    std::istringstream in("value = " + raw + "\n");
+    const toml::value document = toml::parse(in, "--set");
+    if (document.as_table().size() == 1) return toml::find(document, "value");
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
 Value parse_override(const ParameterSpec& spec, const std::string& raw) {
+  check_nesting(raw, fmt::format("--set {}", spec.key));
+  // A TOML value ("foo" with its quotes, 1e-6, [10, 20.5], true) is read as TOML; a bare word
+  // is a string for text keys, and numbers and lists keep the plain forms below (80,90).
+  if (const auto v = toml_value(raw)) {
+    if (spec.kind == Kind::text) {
+      if (v->is_string()) return v->as_string().str;
+    } else if (spec.kind != Kind::real_list || v->is_array() || v->is_string()) {
+      return from_toml_value(spec.key, *v);
+    }
+  }
   auto bad = [&] {
     return InputError(fmt::format("--set {}={}: cannot read '{}' as {}", spec.key, raw, raw,
                                   kind_name(spec.kind)));
@@ -260,7 +316,12 @@ namespace {
 Config parse_document(std::istream& in, const std::string& origin) {
   toml::value document;
   try {
-    document = toml::parse(in, origin);
+    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    check_nesting(text, origin);
+    std::istringstream copy(text);
+    document = toml::parse(copy, origin);
+  } catch (const InputError&) {
+    throw;
   } catch (const std::exception& error) {
     throw InputError(fmt::format("{}: not valid TOML:\n{}", origin, error.what()));
   }
@@ -283,6 +344,9 @@ Config parse_document(std::istream& in, const std::string& origin) {
 Config Config::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   Config config;
   if (!file.empty()) {
+    if (std::filesystem::is_directory(file))
+      throw InputError(fmt::format("configuration file '{}' is a directory: give the case file (TOML)",
+                                   file.string()));
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(fmt::format("cannot open configuration file '{}'", file.string()));
     config = parse_document(in, file.string());
@@ -352,6 +416,23 @@ std::string Config::hash() const {
     h *= 1099511628211ULL;
   }
   return fmt::format("{:016x}", h);
+}
+
+void require_same_keys(const Config& now, const std::string& saved_toml,
+                       const std::vector<std::string>& keys, const std::string& checkpoint) {
+  Config saved;
+  try {
+    saved = Config::from_toml(saved_toml, "its stored configuration");
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("{} is not a valid checkpoint: {}", checkpoint, error.what()));
+  }
+  for (const auto& key : keys)
+    if (now.value_text(key) != saved.value_text(key))
+      throw InputError(fmt::format(
+          "{} = {} but the checkpoint {} was written with {} = {}; a restart keeps the checkpoint's "
+          "{}: allowed: {} = {} (or start a new run without the checkpoint)", key,
+          now.value_text(key), checkpoint, key, saved.value_text(key), key, key,
+          saved.value_text(key)));
 }
 
 }  // namespace shaker::config

@@ -53,6 +53,8 @@ std::vector<ParameterSpec> common_parameters();
 std::vector<ParameterSpec> md_parameters();
 std::vector<ParameterSpec> continuum_parameters();
 
+std::string format_value(const Value& value);  ///< TOML literal
+
 class Config {
  public:
   /// Defaults only.
@@ -74,6 +76,8 @@ class Config {
 
   /// The full effective configuration as TOML, every key of the schema, in schema order.
   std::string to_toml() const;
+  /// The value of `key` as a TOML literal.
+  std::string value_text(const std::string& key) const { return format_value(values_.at(key)); }
   /// A short stable hash of to_toml(), for reusing finished runs.
   std::string hash() const;
 
@@ -82,7 +86,12 @@ class Config {
   std::map<std::string, Value> values_;
 };
 
+/// The restart rule (docs/output-schema.md): a run continued from a checkpoint must state the
+/// values of `keys` that the checkpoint's run had (its stored configuration, `saved_toml`);
+/// a difference is refused with InputError naming the key and both values.
+void require_same_keys(const Config& now, const std::string& saved_toml,
+                       const std::vector<std::string>& keys, const std::string& checkpoint);
+
 const ParameterSpec& find_spec(const std::string& key);  ///< throws InputError if unknown
-std::string format_value(const Value& value);           ///< TOML literal
 
 }  // namespace shaker::config

@@ -1,8 +1,14 @@
 #include "common/hdf5_file.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstring>
 #include <stdexcept>
 
 #include "common/errors.hpp"
@@ -11,8 +17,14 @@ namespace shaker::h5 {
 namespace {
 
 // HDF5 prints its error stack to stderr by default; the project reports errors itself.
+// Files are closed by their handles; HDF5's own atexit clean-up is turned off, because after
+// a failed write (a full disk) it closes the failed file again and crashes (SIGSEGV in
+// H5F__close_cb, HDF5 1.10) instead of letting the program exit with its message.
 struct SilenceHdf5 {
-  SilenceHdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+  SilenceHdf5() {
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
 };
 const SilenceHdf5 silence;
 
@@ -94,6 +106,11 @@ Handle::~Handle() {
 Handle create_file(const std::filesystem::path& path) {
   return Handle(checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
                         "create file " + path.string()));
+}
+
+void close_file(Handle& file) {
+  checked_status(H5Fflush(file.id(), H5F_SCOPE_GLOBAL), "flush file");
+  checked_status(H5Fclose(file.release()), "close file");  // the handle no longer owns it
 }
 
 Handle open_file(const std::filesystem::path& path) {
@@ -198,14 +215,41 @@ std::string read_string_attribute(hid_t object, const std::string& name) {
   H5free_memory(text);
   return value;
 }
-double read_double_attribute(hid_t object, const std::string& name) {
+namespace {
+/// The attribute's value as a number, whether stored as an integer or a real; InputError for a
+/// string or any other type, or for more than one value.
+Handle open_number_attribute(hid_t object, const std::string& name, H5T_class_t& type_class) {
   Handle attribute = open_attribute(object, name);
+  const Handle type(checked(H5Aget_type(attribute.id()), "type of attribute " + name));
+  const Handle space(checked(H5Aget_space(attribute.id()), "dataspace of attribute " + name));
+  type_class = H5Tget_class(type.id());
+  if (type_class != H5T_INTEGER && type_class != H5T_FLOAT)
+    throw InputError(fmt::format("attribute '{}' is not a number (it is stored as {})", name,
+                                 type_class == H5T_STRING ? "a string" : "another type"));
+  if (H5Sget_simple_extent_npoints(space.id()) != 1)
+    throw InputError(fmt::format("attribute '{}' holds {} values, not one number", name,
+                                 H5Sget_simple_extent_npoints(space.id())));
+  return attribute;
+}
+}  // namespace
+
+double read_double_attribute(hid_t object, const std::string& name) {
+  H5T_class_t type_class;
+  const Handle attribute = open_number_attribute(object, name, type_class);
   double value = 0.0;
   checked_status(H5Aread(attribute.id(), H5T_NATIVE_DOUBLE, &value), "read attribute " + name);
   return value;
 }
 std::int64_t read_integer_attribute(hid_t object, const std::string& name) {
-  Handle attribute = open_attribute(object, name);
+  H5T_class_t type_class;
+  const Handle attribute = open_number_attribute(object, name, type_class);
+  if (type_class == H5T_FLOAT) {  // only an exact integer stored as a real is one
+    double value = 0.0;
+    checked_status(H5Aread(attribute.id(), H5T_NATIVE_DOUBLE, &value), "read attribute " + name);
+    if (!(std::trunc(value) == value && std::fabs(value) < 9.0e18))
+      throw InputError(fmt::format("attribute '{}' = {} is not an integer", name, value));
+    return static_cast<std::int64_t>(value);
+  }
   std::int64_t value = 0;
   checked_status(H5Aread(attribute.id(), H5T_NATIVE_INT64, &value), "read attribute " + name);
   return value;
@@ -218,9 +262,71 @@ bool has_attribute(hid_t object, const std::string& name) {
 
 namespace shaker {
 
+namespace {
+
+// Temporary files in the making, for the signal handler: fixed slots of fixed size, claimed
+// with an atomic flag, so that the handler reads them without locks or allocation.
+constexpr int cleanup_slots = 32;
+constexpr std::size_t cleanup_path_size = 4096;
+struct CleanupSlot {
+  std::atomic<bool> used{false};
+  std::atomic<bool> ready{false};
+  char path[cleanup_path_size];
+};
+CleanupSlot cleanup_registry[cleanup_slots];
+
+int register_for_cleanup(const std::filesystem::path& path) {
+  const std::string& text = path.native();
+  if (text.size() >= cleanup_path_size) return -1;
+  for (int k = 0; k < cleanup_slots; ++k) {
+    bool expected = false;
+    if (!cleanup_registry[k].used.compare_exchange_strong(expected, true)) continue;
+    std::memcpy(cleanup_registry[k].path, text.c_str(), text.size() + 1);
+    cleanup_registry[k].ready.store(true);
+    return k;
+  }
+  return -1;  // more than 32 files at once: not removed on a signal, still on an exception
+}
+
+void unregister_for_cleanup(int slot) {
+  if (slot < 0) return;
+  cleanup_registry[slot].ready.store(false);
+  cleanup_registry[slot].used.store(false);
+}
+
+void write_stderr(const char* text) {
+  const ssize_t ignored = ::write(2, text, std::strlen(text));
+  (void)ignored;
+}
+
+extern "C" void remove_partial_files_and_exit(int signal) {
+  int removed = 0;
+  for (auto& slot : cleanup_registry)
+    if (slot.ready.load() && ::unlink(slot.path) == 0) ++removed;
+  // Only async-signal-safe calls here: write(2), unlink(2), _exit(2).
+  char number[4] = {static_cast<char>('0' + signal / 10 % 10), static_cast<char>('0' + signal % 10), 0, 0};
+  write_stderr("shaker: stopped by signal ");
+  write_stderr(signal >= 10 ? number : number + 1);
+  write_stderr(signal == SIGTERM ? " (SIGTERM)" : signal == SIGINT ? " (SIGINT)" : " (SIGHUP)");
+  write_stderr(removed ? "; partial output files removed" : "; no partial output file");
+  write_stderr(", nothing written under the output names\n");
+  ::_exit(128 + signal);
+}
+
+}  // namespace
+
+void install_signal_cleanup() {
+  struct sigaction action {};
+  action.sa_handler = remove_partial_files_and_exit;
+  sigemptyset(&action.sa_mask);
+  for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&action.sa_mask, s);
+  for (int s : {SIGTERM, SIGINT, SIGHUP}) ::sigaction(s, &action, nullptr);
+}
+
 AtomicOutput::AtomicOutput(std::filesystem::path final_path) : final_(std::move(final_path)) {
   temporary_ = final_;
   temporary_ += fmt::format(".partial-{}", ::getpid());
+  cleanup_slot_ = register_for_cleanup(temporary_);
 }
 
 AtomicOutput::~AtomicOutput() {
@@ -228,11 +334,69 @@ AtomicOutput::~AtomicOutput() {
     std::error_code ignored;
     std::filesystem::remove(temporary_, ignored);
   }
+  unregister_for_cleanup(cleanup_slot_);
 }
 
 void AtomicOutput::commit() {
   std::filesystem::rename(temporary_, final_);  // atomic within one file system
   committed_ = true;
+  unregister_for_cleanup(cleanup_slot_);
+  cleanup_slot_ = -1;
+}
+
+namespace {
+std::filesystem::path resolved(const std::filesystem::path& path) {
+  std::error_code error;
+  auto full = std::filesystem::weakly_canonical(std::filesystem::absolute(path), error);
+  return error ? std::filesystem::absolute(path).lexically_normal() : full;
+}
+}  // namespace
+
+void check_output_paths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
+  namespace fs = std::filesystem;
+  for (std::size_t k = 0; k < outputs.size(); ++k) {
+    const auto& [what, path] = outputs[k];
+    if (path.empty())
+      throw InputError(fmt::format("{} is empty: it must name the output file", what));
+    if (fs::is_directory(path))
+      throw InputError(fmt::format("{} = \"{}\" is a directory: it must name a file", what, path.string()));
+    const fs::path directory = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    if (!fs::is_directory(directory))
+      throw InputError(fmt::format("{} = \"{}\": the directory '{}' does not exist", what,
+                                   path.string(), directory.string()));
+    // Writable for this process (root included): create and remove a probe file.
+    const fs::path probe = directory / fmt::format(".shaker-probe-{}", ::getpid());
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd < 0)
+      throw InputError(fmt::format("{} = \"{}\": the directory '{}' is not writable ({})", what,
+                                   path.string(), directory.string(), std::strerror(errno)));
+    ::close(fd);
+    ::unlink(probe.c_str());
+    const fs::path full = resolved(path);
+    for (const auto& input : inputs)
+      if (!input.path.empty() && resolved(input.path) == full)
+        throw InputError(fmt::format("{} = \"{}\" is the {} '{}': an output must not overwrite "
+                                     "an input", what, path.string(), input.what, input.path.string()));
+    for (std::size_t m = 0; m < k; ++m)
+      if (resolved(outputs[m].path) == full)
+        throw InputError(fmt::format("{} = \"{}\" and {} = \"{}\" are the same file: each output "
+                                     "needs its own name", outputs[m].what, outputs[m].path.string(),
+                                     what, path.string()));
+  }
+}
+
+void write_hdf5_atomically(const std::filesystem::path& path, const std::function<void(hid_t)>& fill) {
+  AtomicOutput output(path);
+  try {
+    h5::Handle file = h5::create_file(output.temporary_path());
+    fill(file.id());
+    h5::close_file(file);
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(fmt::format("cannot write '{}' (disk full or an I/O error?): {}; "
+                                         "nothing was written under that name", path.string(),
+                                         error.what()));
+  }
+  output.commit();
 }
 
 void write_text_atomically(const std::filesystem::path& path, const std::string& text) {

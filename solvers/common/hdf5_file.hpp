@@ -5,7 +5,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shaker::h5 {
@@ -21,12 +23,17 @@ class Handle {
   Handle& operator=(Handle&& other) noexcept;
   ~Handle();
   hid_t id() const { return id_; }
+  /// Gives up ownership without closing.
+  hid_t release() { return std::exchange(id_, H5I_INVALID_HID); }
 
  private:
   hid_t id_ = H5I_INVALID_HID;
 };
 
 Handle create_file(const std::filesystem::path& path);  ///< truncates
+/// Flushes and closes a file being written, throwing if either fails (a full disk, an I/O
+/// error): call it before AtomicOutput::commit, so that a failed write is never committed.
+void close_file(Handle& file);
 Handle open_file(const std::filesystem::path& path);    ///< read only; InputError if not HDF5
 Handle create_group(hid_t parent, const std::string& name);
 Handle open_group(hid_t parent, const std::string& name);
@@ -70,9 +77,30 @@ class AtomicOutput {
  private:
   std::filesystem::path final_, temporary_;
   bool committed_ = false;
+  int cleanup_slot_ = -1;  ///< slot in the signal handler's registry
 };
+
+/// Writes an HDF5 file atomically: `fill` writes into the new file (given its id), which is
+/// then flushed and closed; any failure (a full disk) throws std::runtime_error naming `path`
+/// and leaves nothing under that name.
+void write_hdf5_atomically(const std::filesystem::path& path, const std::function<void(hid_t)>& fill);
 
 /// Writes a text file atomically.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+/// Removes the temporary files of every live AtomicOutput when SIGTERM, SIGINT or SIGHUP
+/// arrives, says so on stderr and exits with 128 + signal. The registry is signal safe (fixed
+/// slots, no allocation in the handler). Installed once by the program's main.
+void install_signal_cleanup();
+
+/// A file the program reads or writes, named by the key or option that gave it.
+struct NamedPath {
+  std::string what;  ///< "run.output", "--csv", "configuration file", ...
+  std::filesystem::path path;
+};
+/// Checked before any work (InputError naming the key and the path): every output is not empty,
+/// not a directory, in an existing writable directory, and differs from every input and from
+/// every other output (compared after resolving ".", ".." and symbolic links).
+void check_output_paths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
 
 }  // namespace shaker

@@ -9,7 +9,8 @@ std::vector<ParameterSpec> md_parameters() {
            "periodic box edge in x and y (units sigma); must exceed one diameter"),
       real("md.ceiling", 200.0, positive(1e6),
            "height of the fixed ceiling in the lab frame; must lie above the plate's top 2A + 1"),
-      real("md.bin_height", 1.0, positive(10.0), "height of the sampling bins"),
+      real("md.bin_height", 1.0, at_least(1e-3, 10.0),
+           "height of the sampling bins (at least 1e-3: finer bins hold no particle)"),
       text("md.initial_state", "flat_layer", {"flat_layer", "gas", "checkpoint"},
            "flat_layer: slightly randomised layer at rest on the plate; gas: homogeneous gas "
            "at md.gas_volume_fraction and md.gas_temperature; checkpoint: md.checkpoint"),

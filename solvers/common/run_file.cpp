@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <utility>
 #include <sstream>
 
@@ -82,12 +83,23 @@ std::vector<Profile> read_profiles(hid_t file) {
                                    profiles.size()));
     for (std::size_t k = 0; k < profiles.size(); ++k) profiles[k].*field = values[k];
   }
+  std::optional<std::size_t> bins;  // of the first field (z); every other field must agree
   for (const auto& [name, field, optional] : profile_fields) {
     if (optional && !h5::exists(group.id(), name)) continue;
     const auto dims = h5::shape(group.id(), name);
     if (dims.size() != 2 || dims[0] != profiles.size())
-      throw InputError(fmt::format("profiles/{} is not a [phases x bins] matrix", name));
+      throw InputError(fmt::format("profiles/{} is not a [phases x bins] matrix of {} phases "
+                                   "(profiles/phase has {})", name, profiles.size(), profiles.size()));
+    if (!bins) bins = dims[1];
+    if (dims[1] != *bins)
+      throw InputError(fmt::format("profiles/{} has {} bins, profiles/z has {}; allowed: the same "
+                                   "number of bins in every profile field", name, dims[1], *bins));
     const auto values = h5::read_doubles(group.id(), name);
+    if (!optional)  // the fields the analysis computes with: finite
+      for (std::size_t i = 0; i < values.size(); ++i)
+        if (!std::isfinite(values[i]))
+          throw InputError(fmt::format("profiles/{} holds {} at phase index {}, bin {}; allowed: "
+                                       "finite values", name, values[i], i / *bins, i % *bins));
     for (std::size_t k = 0; k < profiles.size(); ++k)
       profiles[k].*field = std::vector<double>(values.begin() + static_cast<long>(k * dims[1]),
                                                values.begin() + static_cast<long>((k + 1) * dims[1]));
@@ -157,35 +169,34 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
 }  // namespace
 
 void write_run_file(const std::filesystem::path& path, const RunRecord& record) {
-  AtomicOutput output(path);
-  {
-    h5::Handle file = h5::create_file(output.temporary_path());
-    h5::write_attribute(file.id(), "schema_version", std::int64_t{output_schema_version});
-    h5::write_attribute(file.id(), "program_version", std::string(program_version()));
-    h5::write_attribute(file.id(), "git_commit", std::string(git_commit()));
-    h5::write_attribute(file.id(), "created", utc_now());
-    h5::write_attribute(file.id(), "solver", record.solver);
-    h5::write_attribute(file.id(), "model_variant", record.model_variant);
-    h5::write_attribute(file.id(), "configuration", record.configuration);
-    h5::write_attribute(file.id(), "restitution_for_analysis", record.e);
-    write_profiles(file.id(), record.profiles);
-    write_samples(file.id(), record.samples);
-    h5::Handle series = h5::create_group(file.id(), "timeseries");
+  write_hdf5_atomically(path, [&](hid_t file) {
+    h5::write_attribute(file, "schema_version", std::int64_t{output_schema_version});
+    h5::write_attribute(file, "program_version", std::string(program_version()));
+    h5::write_attribute(file, "git_commit", std::string(git_commit()));
+    h5::write_attribute(file, "created", utc_now());
+    h5::write_attribute(file, "solver", record.solver);
+    h5::write_attribute(file, "model_variant", record.model_variant);
+    h5::write_attribute(file, "configuration", record.configuration);
+    h5::write_attribute(file, "restitution_for_analysis", record.e);
+    write_profiles(file, record.profiles);
+    write_samples(file, record.samples);
+    h5::Handle series = h5::create_group(file, "timeseries");
     h5::write_attribute(series.id(), "columns", fmt::format("{}", fmt::join(record.series.names, ",")));
     for (std::size_t i = 0; i < record.series.names.size(); ++i)
       h5::write(series.id(), record.series.names[i], record.series.columns[i]);
-  }
-  output.commit();
+  });
 }
 
 RunRecord read_run_file(const std::filesystem::path& path) {
   try {
     h5::Handle file = h5::open_file(path);
     RunRecord record;
-    record.schema_version = static_cast<int>(h5::read_integer_attribute(file.id(), "schema_version"));
-    if (record.schema_version != output_schema_version)
-      throw InputError(fmt::format("schema version {} is not supported (this program reads {})",
-                                   record.schema_version, output_schema_version));
+    const std::int64_t version = h5::read_integer_attribute(file.id(), "schema_version");
+    if (version != output_schema_version)
+      throw InputError(fmt::format("schema version {} is not supported (attribute schema_version; "
+                                   "allowed: {}, the version this program reads)", version,
+                                   output_schema_version));
+    record.schema_version = static_cast<int>(version);
     record.program_version = h5::read_string_attribute(file.id(), "program_version");
     record.git_commit = h5::read_string_attribute(file.id(), "git_commit");
     record.created = h5::read_string_attribute(file.id(), "created");

@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/units.hpp"
 
 namespace shaker::continuum {
 
@@ -14,24 +17,22 @@ const char* const names[variable_count] = {"density", "momentum_x", "momentum_y"
 void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
                       const std::string& configuration_toml) {
   const Grid& g = solver.op().grid();
-  AtomicOutput output(path);
-  {
-    h5::Handle file = h5::create_file(output.temporary_path());
-    h5::write_attribute(file.id(), "kind", std::string("shaker continuum checkpoint"));
-    h5::write_attribute(file.id(), "time", solver.time());
-    h5::write_attribute(file.id(), "dimension", std::int64_t{g.dimension});
-    h5::write_attribute(file.id(), "nx", std::int64_t{g.nx});
-    h5::write_attribute(file.id(), "ny", std::int64_t{g.ny});
-    h5::write_attribute(file.id(), "nz", std::int64_t{g.nz});
-    h5::write_attribute(file.id(), "cell_size", g.h);
+  write_hdf5_atomically(path, [&](const hid_t file) {
+    h5::write_attribute(file, "kind", std::string("shaker continuum checkpoint"));
+    h5::write_attribute(file, "time", solver.time());
+    h5::write_attribute(file, "dimension", std::int64_t{g.dimension});
+    h5::write_attribute(file, "nx", std::int64_t{g.nx});
+    h5::write_attribute(file, "ny", std::int64_t{g.ny});
+    h5::write_attribute(file, "nz", std::int64_t{g.nz});
+    h5::write_attribute(file, "cell_size", g.h);
     // The e in effect (after a single-shock switch, the switched one): a restart uses it.
-    h5::write_attribute(file.id(), "e", solver.op().settings().e);
+    h5::write_attribute(file, "e", solver.op().settings().e);
     const EnergyBudget& b = solver.budget();
-    h5::write(file.id(), "energy_budget",
+    h5::write(file, "energy_budget",
               std::vector<double>{b.body_work, b.collisional_loss, b.floor_energy});
-    h5::write_attribute(file.id(), "configuration", configuration_toml);
+    h5::write_attribute(file, "configuration", configuration_toml);
     const Counters& k = solver.counters();
-    h5::write(file.id(), "counters",
+    h5::write(file, "counters",
               std::vector<std::int64_t>{k.steps, k.rejected_steps, k.temperature_floor_uses,
                                         k.diffusion_stages});
     for (int v = 0; v < variable_count; ++v) {
@@ -40,20 +41,32 @@ void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& s
       for (int kz = 0; kz < g.nz; ++kz)
         for (int j = 0; j < g.ny; ++j)
           for (int i = 0; i < g.nx; ++i) data.push_back(solver.state().q[v][g.index(i, j, kz)]);
-      h5::write(file.id(), names[v], data);
+      h5::write(file, names[v], data);
     }
-  }
-  output.commit();
+  });
 }
 
-void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver) {
+namespace {
+
+/// The dataset `name` with exactly `expected` entries, all finite.
+std::vector<double> read_finite(hid_t file, const char* name, std::size_t expected) {
+  std::vector<double> data = h5::read_doubles(file, name);
+  if (data.size() != expected)
+    throw InputError(fmt::format("dataset '{}' has {} entries; allowed: {} (the grid's interior "
+                                 "cells, or the fixed length)", name, data.size(), expected));
+  for (std::size_t m = 0; m < data.size(); ++m)
+    if (!std::isfinite(data[m]))
+      throw InputError(fmt::format("dataset '{}' holds {} at entry {}; allowed: finite values", name,
+                                   data[m], m));
+  return data;
+}
+
+/// The whole checkpoint checked before any of it is used: shapes against the grid, finite
+/// values, 0 < nu < nu_max, T >= 0 (to round-off), 0 <= e <= 1, a finite time, counters >= 0.
+void load_checked(hid_t file, const std::filesystem::path& path, TimeIntegrator& solver) {
   const Grid& g = solver.op().grid();
-  h5::Handle file = h5::open_file(path);
-  if (!h5::has_attribute(file.id(), "kind") ||
-      h5::read_string_attribute(file.id(), "kind") != "shaker continuum checkpoint")
-    throw InputError(fmt::format("continuum.restart = \"{}\" is not a continuum checkpoint", path.string()));
   const auto check = [&](const char* key, std::int64_t expected) {
-    const std::int64_t found = h5::read_integer_attribute(file.id(), key);
+    const std::int64_t found = h5::read_integer_attribute(file, key);
     if (found != expected)
       throw InputError(fmt::format("continuum.restart = \"{}\": checkpoint has {} = {}, the "
                                    "configuration needs {}", path.string(), key, found, expected));
@@ -62,25 +75,77 @@ void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver) 
   check("nx", g.nx);
   check("ny", g.ny);
   check("nz", g.nz);
-  if (h5::read_double_attribute(file.id(), "cell_size") != g.h)
+  if (h5::read_double_attribute(file, "cell_size") != g.h)
     throw InputError(fmt::format("continuum.restart = \"{}\": cell size differs from continuum.cell_size = {}",
                                  path.string(), g.h));
+  const double time = h5::read_double_attribute(file, "time");
+  if (!std::isfinite(time))
+    throw InputError(fmt::format("attribute 'time' = {}; allowed: a finite time", time));
+  const double e = h5::read_double_attribute(file, "e");
+  if (!(e >= 0.0 && e <= 1.0))
+    throw InputError(fmt::format("attribute 'e' = {}; allowed: 0 <= e <= 1", e));
+  const std::vector<double> budget = read_finite(file, "energy_budget", 3);
+  const auto counters = h5::read_integers(file, "counters");
+  if (counters.size() != 4)
+    throw InputError(fmt::format("dataset 'counters' has {} entries; allowed: 4", counters.size()));
+  for (std::int64_t k : counters)
+    if (k < 0)
+      throw InputError(fmt::format("dataset 'counters' holds {}; allowed: counts >= 0", k));
+  const std::size_t cells = g.interior_cells();
+  State interior;
+  for (int v = 0; v < variable_count; ++v) interior.q[v] = read_finite(file, names[v], cells);
+  for (std::size_t m = 0; m < cells; ++m) {
+    const double nu = volume_fraction(interior.q[density][m]);
+    if (!(nu > 0.0 && nu < nu_max))
+      throw InputError(fmt::format("dataset 'density' holds n = {} (nu = {}) at cell {}; allowed: "
+                                   "0 < nu < nu_max = {}", interior.q[density][m], nu, m, nu_max));
+    double kinetic = 0.0;
+    for (int v : {momentum_x, momentum_y, momentum_z})
+      kinetic += 0.5 * interior.q[v][m] * interior.q[v][m] / interior.q[density][m];
+    const double internal = interior.q[energy][m] - kinetic;
+    if (internal < -1e-9 * std::max(std::fabs(interior.q[energy][m]), kinetic))
+      throw InputError(fmt::format("dataset 'energy' holds E = {} at cell {}, below the kinetic "
+                                   "energy {}: a negative temperature; allowed: T >= 0",
+                                   interior.q[energy][m], m, kinetic));
+  }
+  // Valid: now the solver takes it over.
   for (int v = 0; v < variable_count; ++v) {
-    const std::vector<double> data = h5::read_doubles(file.id(), names[v]);
     std::size_t m = 0;
     for (int kz = 0; kz < g.nz; ++kz)
       for (int j = 0; j < g.ny; ++j)
-        for (int i = 0; i < g.nx; ++i) solver.state().q[v][g.index(i, j, kz)] = data[m++];
+        for (int i = 0; i < g.nx; ++i) solver.state().q[v][g.index(i, j, kz)] = interior.q[v][m++];
   }
-  solver.set_time(h5::read_double_attribute(file.id(), "time"));
-  solver.op().settings().e = h5::read_double_attribute(file.id(), "e");
-  const std::vector<double> budget = h5::read_doubles(file.id(), "energy_budget");
-  if (budget.size() != 3)
-    throw InputError(fmt::format("continuum.restart = \"{}\": energy_budget has {} entries, not 3",
-                                 path.string(), budget.size()));
+  solver.set_time(time);
+  solver.op().settings().e = e;
   solver.budget() = EnergyBudget{budget[0], budget[1], budget[2]};
-  const auto counters = h5::read_integers(file.id(), "counters");
   solver.counters() = Counters{counters[0], counters[1], counters[2], counters[3]};
+}
+
+}  // namespace
+
+void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver) {
+  h5::Handle file = h5::open_file(path);
+  if (!h5::has_attribute(file.id(), "kind") ||
+      h5::read_string_attribute(file.id(), "kind") != "shaker continuum checkpoint")
+    throw InputError(fmt::format("continuum.restart = \"{}\" is not a continuum checkpoint", path.string()));
+  try {
+    load_checked(file.id(), path, solver);
+  } catch (const std::exception& error) {
+    const std::string what = error.what();
+    if (what.rfind("continuum.restart", 0) == 0) throw InputError(what);  // a grid mismatch
+    throw InputError(fmt::format("continuum.restart = \"{}\" is not a valid checkpoint: {}",
+                                 path.string(), what));
+  }
+}
+
+std::string checkpoint_configuration(const std::filesystem::path& path) {
+  const h5::Handle file = h5::open_file(path);
+  try {
+    return h5::read_string_attribute(file.id(), "configuration");
+  } catch (const std::exception& error) {
+    throw InputError(fmt::format("continuum.restart = \"{}\" is not a valid checkpoint: {}",
+                                 path.string(), error.what()));
+  }
 }
 
 }  // namespace shaker::continuum

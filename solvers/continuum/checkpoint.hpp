@@ -12,7 +12,10 @@ namespace shaker::continuum {
 
 void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
                       const std::string& configuration_toml);
-/// Loads a checkpoint into the solver; throws InputError if it does not match the grid.
+/// Loads a checkpoint into the solver; throws InputError ("not a valid checkpoint: ...") if it
+/// does not match the grid or holds a damaged value (the solver is then left unchanged).
 void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver);
+/// The effective configuration (TOML) of the run that wrote the checkpoint.
+std::string checkpoint_configuration(const std::filesystem::path& path);
 
 }  // namespace shaker::continuum

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <stdexcept>
+
 #include "common/hdf5_file.hpp"
 
 namespace shaker::continuum {
@@ -89,23 +91,23 @@ void write_3d(hid_t group, const std::string& name, const std::vector<double>& d
   h5::Handle space(H5Screate_simple(3, dims, nullptr));
   h5::Handle set(H5Dcreate2(group, name.c_str(), H5T_NATIVE_DOUBLE, space.id(), H5P_DEFAULT,
                             H5P_DEFAULT, H5P_DEFAULT));
-  H5Dwrite(set.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data());
+  if (space.id() < 0 || set.id() < 0 ||
+      H5Dwrite(set.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
+    throw std::runtime_error("HDF5: write dataset " + name + " failed");
 }
 }  // namespace
 
 void write_fields(const std::filesystem::path& h5_path, const Grid& g,
                   const std::vector<FieldSnapshot>& snapshots) {
-  AtomicOutput output(h5_path);
   std::string xdmf = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
                      "<Grid Name=\"fields\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   const std::string dims = fmt::format("{} {} {}", g.nz, g.ny, g.nx);
   const std::string node_dims = fmt::format("{} {} {}", g.nz + 1, g.ny + 1, g.nx + 1);
-  {
-    h5::Handle file = h5::create_file(output.temporary_path());
+  write_hdf5_atomically(h5_path, [&](const hid_t file) {
     for (std::size_t s = 0; s < snapshots.size(); ++s) {
       const FieldSnapshot& f = snapshots[s];
       const std::string group_name = fmt::format("snapshot_{:03d}", s);
-      h5::Handle group = h5::create_group(file.id(), group_name);
+      h5::Handle group = h5::create_group(file, group_name);
       h5::write_attribute(group.id(), "time", f.time);
       h5::write_attribute(group.id(), "phase", f.phase);
       xdmf += fmt::format("<Grid Name=\"{}\" GridType=\"Uniform\">\n<Time Value=\"{}\"/>\n"
@@ -126,9 +128,8 @@ void write_fields(const std::filesystem::path& h5_path, const Grid& g,
       }
       xdmf += "</Grid>\n";
     }
-  }
+  });
   xdmf += "</Grid>\n</Domain>\n</Xdmf>\n";
-  output.commit();
   std::filesystem::path sidecar = h5_path;
   sidecar.replace_extension(".xdmf");
   write_text_atomically(sidecar, xdmf);

@@ -119,8 +119,32 @@ void finish_average(Profile& p, double count) {
   }
 }
 
-int execute(const config::Config& config) {
+/// Where a step failure leaves the last good state: OUTPUT.last_good.h5.
+std::filesystem::path last_good_path(std::filesystem::path output) {
+  return output.replace_extension(".last_good.h5");
+}
+
+/// Every file the run may write, none equal to an input or to another (checked before work).
+void check_outputs(const ContinuumCase& c, std::vector<NamedPath> inputs) {
+  const std::filesystem::path output = c.parameters.run.output;
+  std::vector<NamedPath> outputs{{"run.output", output}};
+  if (!output.empty()) outputs.push_back({"run.output's last-good checkpoint", last_good_path(output)});
+  if (!c.checkpoint.empty()) outputs.push_back({"continuum.checkpoint", c.checkpoint});
+  if (c.grid.dimension == 3 && !c.field_phases.empty() && !output.empty()) {
+    std::filesystem::path fields = output;
+    outputs.push_back({"run.output's fields file", fields.replace_extension(".fields.h5")});
+  }
+  inputs.push_back({"continuum.restart", c.restart});
+  check_output_paths(outputs, inputs);
+}
+
+int execute(const config::Config& config, const std::vector<NamedPath>& inputs) {
   const ContinuumCase c = continuum_case(config);
+  check_outputs(c, inputs);
+  if (!c.restart.empty())
+    config::require_same_keys(config, checkpoint_configuration(c.restart),
+                              {"material.restitution", "material.e", "layer.particles", "md.box_width"},
+                              fmt::format("continuum.restart = \"{}\"", c.restart));
   const RunProtocol& run = c.parameters.run;
   const ShakerKinematics& shaker = c.parameters.shaker;
   TimeIntegrator solver = make_solver(c);
@@ -162,8 +186,7 @@ int execute(const config::Config& config) {
     }
     solver.advance_to((start / period + static_cast<double>(cycles)) * period);
   } catch (const StepFailure& failure) {
-    std::filesystem::path last_good = output;
-    last_good.replace_extension(".last_good.h5");
+    const std::filesystem::path last_good = last_good_path(output);
     write_checkpoint(last_good, solver, config.to_toml());
     fmt::print(stderr, "shaker continuum: {}\nThe last good state is in {}\n", failure.what(),
                last_good.string());
@@ -201,6 +224,8 @@ int execute(const config::Config& config) {
 
 }  // namespace
 
-int run(const config::Config& config) { return execute(config); }
+int run(const config::Config& config, const std::vector<NamedPath>& inputs) {
+  return execute(config, inputs);
+}
 
 }  // namespace shaker::continuum

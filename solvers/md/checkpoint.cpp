@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <utility>
+
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 
@@ -24,10 +27,7 @@ template <class T> std::vector<T> narrow(const std::vector<std::int64_t>& values
 
 void write_checkpoint(const std::filesystem::path& path, const SimulationData& d,
                       const Geometry& geometry, const std::string& configuration) {
-  AtomicOutput output(path);
-  {
-    const h5::Handle file = h5::create_file(output.temporary_path());
-    const hid_t f = file.id();
+  write_hdf5_atomically(path, [&](const hid_t f) {
     h5::write_attribute(f, "kind", std::string("shaker md checkpoint"));
     h5::write_attribute(f, "time", d.time);
     h5::write_attribute(f, "box_width", geometry.width);
@@ -70,8 +70,7 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
               std::vector<std::int64_t>{widen(std::vector<std::uint64_t>{
                   t.pair, t.plate, t.ceiling, t.cell, t.stale, t.guard_activations, t.grazes})});
     h5::write(f, "tally_energy", std::vector<double>{t.plate_work, t.pair_loss, t.wall_loss, t.virial});
-  }
-  output.commit();
+  });
 }
 
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
@@ -85,9 +84,21 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     d.time = h5::read_double_attribute(f, "time");
     c.width = h5::read_double_attribute(f, "box_width");
     c.height = h5::read_double_attribute(f, "box_height");
+    for (const auto& [name, x] : {std::pair{"time", d.time}, {"box_width", c.width}, {"box_height", c.height}})
+      if (!std::isfinite(x))
+        throw InputError(fmt::format("attribute '{}' = {}; allowed: a finite number", name, x));
     c.configuration = h5::read_string_attribute(f, "configuration");
+    const auto dims = h5::shape(f, "particles");
+    if (dims.size() != 2 || dims[1] != particle_columns)
+      throw InputError(fmt::format("dataset 'particles' is not an [N x {}] matrix", particle_columns));
     const std::vector<double> table = h5::read_doubles(f, "particles");
-    const std::size_t n = table.size() / particle_columns;
+    const std::size_t n = dims[0];
+    // Every per-particle array has N entries, the tallies their fixed lengths.
+    const auto require_length = [&](const char* name, std::size_t found, std::size_t expected) {
+      if (found != expected)
+        throw InputError(fmt::format("dataset '{}' has {} entries; allowed: {} ({})", name, found,
+                                     expected, expected == n ? "one per particle" : "fixed length"));
+    };
     d.particles.resize(n);
     d.last_collision.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -103,6 +114,11 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     const auto partner = h5::read_integers(f, "event_partner");
     const auto partner_counter = h5::read_integers(f, "event_partner_counter");
     const auto kind = h5::read_integers(f, "event_kind");
+    require_length("event_time", event_time.size(), n);
+    require_length("event_cell_time", cell_time.size(), n);
+    require_length("event_partner", partner.size(), n);
+    require_length("event_partner_counter", partner_counter.size(), n);
+    require_length("event_kind", kind.size(), n);
     d.events.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       d.events[i].time = event_time.at(i);
@@ -114,7 +130,8 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     }
     const auto counters = narrow<std::uint32_t>(h5::read_integers(f, "counters"));
     const auto streaks = narrow<std::uint32_t>(h5::read_integers(f, "streaks"));
-    if (counters.size() != n || streaks.size() != n) throw InputError("inconsistent array lengths");
+    require_length("counters", counters.size(), n);
+    require_length("streaks", streaks.size(), n);
     for (std::size_t i = 0; i < n; ++i) {
       d.particles[i].counter = counters[i];
       d.particles[i].streak = streaks[i];
@@ -125,6 +142,11 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     d.cell_of = narrow<std::int32_t>(h5::read_integers(f, "cell_of"));
     const auto counts = h5::read_integers(f, "tally_counts");
     const auto energy = h5::read_doubles(f, "tally_energy");
+    require_length("tally_counts", counts.size(), 7);
+    require_length("tally_energy", energy.size(), 4);
+    require_length("cell_next", d.cell_next.size(), n);
+    require_length("cell_prev", d.cell_prev.size(), n);
+    require_length("cell_of", d.cell_of.size(), n);
     Tally& t = d.tally;
     std::uint64_t* fields[] = {&t.pair, &t.plate, &t.ceiling, &t.cell, &t.stale,
                                &t.guard_activations, &t.grazes};
@@ -133,9 +155,6 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     t.pair_loss = energy.at(1);
     t.wall_loss = energy.at(2);
     t.virial = energy.at(3);
-    if (d.cell_next.size() != n ||
-        d.cell_prev.size() != n || d.cell_of.size() != n)
-      throw InputError("inconsistent array lengths");
   } catch (const std::exception& error) {
     throw InputError(fmt::format("md.checkpoint = \"{}\" is not a valid checkpoint: {}",
                                  path.string(), error.what()));
@@ -156,7 +175,8 @@ void validate_state(const Geometry& g, const SimulationData& d, double tolerance
                            y <= g.width + tolerance;
     const double z_lo = g.periodic_z ? -tolerance : g.plate.position(d.time) + 0.5 - tolerance;
     const double z_hi = g.periodic_z ? g.height + tolerance : g.height - 0.5 + tolerance;
-    if (!inside_xy || z < z_lo || z > z_hi || !std::isfinite(dot(v[i], v[i])))
+    const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
+    if (!finite || !inside_xy || z < z_lo || z > z_hi || !std::isfinite(dot(v[i], v[i])))
       throw InputError(fmt::format(
           "checkpoint particle {} at ({}, {}, {}) is outside the box: allowed 0 <= x, y <= {} "
           "and {} <= z <= {} at t = {}", i, x, y, z, g.width, z_lo + tolerance, z_hi - tolerance,

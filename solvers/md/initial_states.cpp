@@ -63,6 +63,10 @@ void set_temperature(std::vector<Particle>& particles, double T, Random& random)
 
 State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed) {
   constexpr double spacing = 1.05;  // leaves room for the random displacements
+  if (!(geometry.width >= spacing))
+    throw InputError(fmt::format("md.box_width = {} is narrower than one site of the flat layer; "
+                                 "allowed: md.box_width >= {} (and >= 3 for the cell list)",
+                                 geometry.width, spacing));
   const auto per_row = static_cast<std::size_t>(std::floor(geometry.width / spacing));
   const double pitch = geometry.width / static_cast<double>(per_row);
   const std::size_t per_layer = per_row * per_row;
@@ -75,6 +79,14 @@ State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed) {
         "md.ceiling - 1/2 = {:.4g}; allowed: at most {} particles for this box and ceiling",
         n, per_layer, top, geometry.height - 0.5,
         per_layer * static_cast<std::size_t>(std::floor((geometry.height - 1.0 - 0.04) / spacing) + 1)));
+  // The layer rests on the plate: at the plate's highest point (2A) its top must stay below
+  // the ceiling, or the layer is squeezed against it (a collapse that never finishes a cycle).
+  const double needed = geometry.plate_top() + top + 0.5;
+  if (needed > geometry.height)
+    throw InputError(fmt::format(
+        "md.ceiling = {} is below the top of the initial flat layer ({} particles, {} layers) when "
+        "the plate is at its highest point 2A = {:.4g}; allowed: md.ceiling at least {:.4g}",
+        geometry.height, n, layers, geometry.plate_top(), needed));
   Random random(seed);
   const std::vector<std::size_t> sites = choose_sites(per_layer * layers, n, random);
   const double jitter = 0.45 * (pitch - 1.0);

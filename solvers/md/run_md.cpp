@@ -4,11 +4,14 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "common/case_parameters.hpp"
 #include "common/errors.hpp"
+#include "common/memory.hpp"
 #include "common/run_file.hpp"
 #include "md/checkpoint.hpp"
 #include "md/initial_states.hpp"
@@ -40,8 +43,8 @@ std::string variant_name(const Restitution& r, const MdSettings& s) {
   return model + ", " + guard;
 }
 
-Simulation make_simulation(const CaseParameters& c, const MdSettings& s, const Geometry& g,
-                           const CollisionRules& rules) {
+Simulation make_simulation(const config::Config& config, const CaseParameters& c,
+                           const MdSettings& s, const Geometry& g, const CollisionRules& rules) {
   const auto n = static_cast<std::size_t>(c.particles);
   if (s.initial_state == "flat_layer") return Simulation(g, rules, flat_layer(g, n, c.run.seed), s.queue);
   if (s.initial_state == "gas")
@@ -54,6 +57,9 @@ Simulation make_simulation(const CaseParameters& c, const MdSettings& s, const G
     throw InputError(fmt::format("layer.particles = {} but the checkpoint {} holds {} particles; "
                                  "allowed: {}", n, s.checkpoint, saved.data.particles.size(),
                                  saved.data.particles.size()));
+  // The restart rule (docs/output-schema.md); another box is allowed (see below).
+  config::require_same_keys(config, saved.configuration, {"material.restitution", "material.e"},
+                            fmt::format("md.checkpoint = \"{}\"", s.checkpoint));
   validate_state(g, saved.data);
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
@@ -61,17 +67,43 @@ Simulation make_simulation(const CaseParameters& c, const MdSettings& s, const G
   return Simulation(g, rules, state, s.queue);
 }
 
+/// The memory of the particles, the cell list and the phase sampler, before any is allocated.
+void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometry& g) {
+  const double n = static_cast<double>(c.particles);
+  // Per particle: its state, event, last collision, cell links, queue node, sampled r and v,
+  // and the flat layer's site list; per cell a list head; per sampling bin and phase the
+  // pooled sums (13 doubles) and the profile's fields written out (2 x 9 doubles).
+  const double per_particle = sizeof(Particle) + sizeof(Event) + 8.0 + 16.0 + 64.0 + 2.0 * sizeof(Vec3) + 16.0;
+  const double rows = std::min(std::floor(g.height), g.plate_top() + 8.0 * n / (g.width * g.width) + 3.0);
+  const double cells = std::floor(g.width) * std::floor(g.width) * std::max(rows, 3.0);
+  const double bins = std::ceil(s.ceiling / s.bin_height);
+  const double phases = static_cast<double>(c.run.phases_per_cycle);
+  check_memory(n * per_particle + 4.0 * cells + bins * phases * (13.0 + 18.0) * 8.0,
+               fmt::format("the MD run ({} particles, {:.3g} cells, {:.3g} sampling bins x {} phases)",
+                           c.particles, cells, bins, c.run.phases_per_cycle),
+               "allowed: fewer layer.particles, a larger md.bin_height, a lower md.ceiling or fewer "
+               "run.phases_per_cycle");
+}
+
 }  // namespace
 
-int run(const config::Config& config) {
+int run(const config::Config& config, const std::vector<NamedPath>& inputs) {
   const CaseParameters parameters = CaseParameters::from(config);
   const MdSettings settings = MdSettings::from(config);
   const Geometry geometry = geometry_of(parameters, settings);
+  {
+    std::vector<NamedPath> outputs{{"run.output", parameters.run.output}}, read = inputs;
+    if (!settings.checkpoint_output.empty())
+      outputs.push_back({"md.checkpoint_output", settings.checkpoint_output});
+    if (settings.initial_state == "checkpoint") read.push_back({"md.checkpoint", settings.checkpoint});
+    check_output_paths(outputs, read);
+  }
+  check_md_memory(parameters, settings, geometry);
   CollisionRules rules;
   rules.restitution = parameters.restitution;
   rules.tc_guard = settings.tc_guard;
   rules.tc = settings.tc;
-  Simulation simulation = make_simulation(parameters, settings, geometry, rules);
+  Simulation simulation = make_simulation(config, parameters, settings, geometry, rules);
 
   const bool terminal = ::isatty(::fileno(stderr)) != 0;
   Progress progress;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 
+#include "common/config.hpp"
 #include "md/checkpoint.hpp"
 #include "md/initial_states.hpp"
 #include "md_test_support.hpp"
@@ -69,7 +70,7 @@ template <class Damage> std::string checkpoint_with(const std::filesystem::path&
   SimulationData data = sim.save();
   damage(data);
   const auto path = dir / "bad-checkpoint.h5";
-  write_checkpoint(path, data, g, "test");
+  write_checkpoint(path, data, g, config::Config().to_toml());
   return "--set md.initial_state=checkpoint --set md.checkpoint=" + path.string();
 }
 
