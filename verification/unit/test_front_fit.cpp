@@ -18,23 +18,13 @@
 #include <vector>
 
 #include "analysis/front_fit.hpp"
+#include "synthetic_fronts.hpp"
 
 namespace {
 
 using shaker::analysis::fit_front;
 using shaker::analysis::FrontFit;
-
-/// ln cosh u; cosh overflows for |u| > 710, so it is written through |u|.
-double log_cosh(double u) {
-  const double a = std::abs(u);
-  return a + std::log1p(std::exp(-2.0 * a)) - std::log(2.0);
-}
-
-/// The mean of a + b tanh((z - z0) / w) over the bin [zc - h/2, zc + h/2]: the closed form
-/// the issue states, written independently of the library's (which avoids its cancellation).
-double bin_mean(double zc, double h, double a, double b, double z0, double w) {
-  return a + b * (w / h) * (log_cosh((zc + 0.5 * h - z0) / w) - log_cosh((zc - 0.5 * h - z0) / w));
-}
+using shaker::testing::bin_mean;
 
 struct Front {
   double a = 1.0, b = -0.5;  ///< jump 2 b = -1: T falls across the shock going up
