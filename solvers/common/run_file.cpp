@@ -134,7 +134,7 @@ void write_samples(hid_t file, const CycleSamples& samples) {
 }
 
 CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
-  if (!h5::exists(file, "cycle_samples")) return {};
+  if (!h5::exists(file, "cycle_samples") || bins == 0) return {};
   h5::Handle group = h5::open_group(file, "cycle_samples");
   const double bin_volume = h5::read_double_attribute(group.id(), "bin_volume");
   const auto shape = h5::shape(group.id(), "cycles");
@@ -163,7 +163,11 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
   }
   if (!(bin_volume > 0.0 && std::isfinite(bin_volume)))
     throw InputError(fmt::format("cycle_samples: bin_volume = {}, allowed: > 0", bin_volume));
-  return CycleSamples::from_arrays(bins, bin_volume, std::move(cycles), std::move(sums));
+  try {
+    return CycleSamples::from_arrays(bins, bin_volume, std::move(cycles), std::move(sums));
+  } catch (const std::invalid_argument& error) {
+    throw InputError(error.what());
+  }
 }
 
 }  // namespace

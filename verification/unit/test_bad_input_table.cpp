@@ -189,7 +189,8 @@ void apply_damage(const fs::path& dir, const toml::value& step) {
     }
     for (const auto& full : names) {
       const auto dims = shaker::h5::shape(file, full);
-      if (dims.size() != 2) continue;
+      // cycle_samples/cycles counts cycles per [phase x sample], not bins: it keeps its shape.
+      if (dims.size() != 2 || (op == "bins" && full.ends_with("/cycles"))) continue;
       const auto data = shaker::h5::read_doubles(file, full);
       const std::size_t rows = op == "phases" ? toml::find<std::size_t>(step, "rows") : dims[0];
       const std::size_t cols = op == "bins" ? toml::find<std::size_t>(step, "bins") : dims[1];
