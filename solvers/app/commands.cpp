@@ -6,6 +6,7 @@
 
 #include "analysis/analysis.hpp"
 #include "common/config.hpp"
+#include "common/describe.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
@@ -39,7 +40,12 @@ int command_md(const RunOptions& options) { return md::run(load(options)); }
 int command_continuum(const RunOptions& options) { return continuum::run(load(options)); }
 
 int command_config(const RunOptions& options) {
-  fmt::print("{}", load(options).to_toml());
+  fmt::print("{}", config::annotate_units(load(options).to_toml()));
+  return 0;
+}
+
+int command_describe(bool markdown) {
+  fmt::print("{}", config::describe_schema(markdown));
   return 0;
 }
 
