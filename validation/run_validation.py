@@ -308,7 +308,7 @@ def _write_profiles_like(template, path, fields, variant_note):
 
 def pooled_fields(profile_sets):
     """Pools the profiles of runs of the same configuration started from different cycles, as
-    the MD sampler pools cycles (physics.md): n and nu averaged, u_z and T over all particles
+    the MD sampler pools cycles (docs/models.md, "Sampling"): n and nu averaged, u_z and T over all particles
     (weights: samples if stored, else n; T gains the spread of the runs' mean u_z, the only
     mean velocity component stored). Standard errors from the scatter between the runs."""
     stack = {k: np.array([p[k] for p in profile_sets]) for k in PROFILE_FIELDS}
