@@ -13,8 +13,12 @@ import sys
 def main():
     shaker, source_dir = sys.argv[1], sys.argv[2]
     document = os.path.join(source_dir, "docs", "configuration.md")
-    generated = subprocess.run([shaker, "config", "--describe", "--markdown"], check=True,
-                               capture_output=True, text=True).stdout
+    run = subprocess.run([shaker, "config", "--describe", "--markdown"], capture_output=True,
+                         text=True)
+    if run.returncode != 0:  # e.g. a key declared without units
+        print(f"shaker config --describe --markdown failed ({run.returncode}):\n{run.stderr}")
+        return 1
+    generated = run.stdout
     try:
         with open(document) as f:
             stored = f.read()
