@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cctype>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -49,9 +50,18 @@ std::string units_of(const ParameterSpec& spec) {
 
 std::string section_of(const std::string& key) { return key.substr(0, key.find('.')); }
 
-std::string escape_cell(std::string s) {  // a Markdown table cell: no bare '|'
-  for (std::size_t i = 0; (i = s.find('|', i)) != std::string::npos; i += 2) s.replace(i, 1, "\\|");
-  return s;
+/// A Markdown table cell: no bare '|', and no '<' that would open an HTML tag ("<h>"); a '<'
+/// before a space or digit ("0 < value") stays as it is.
+std::string escape_cell(const std::string& s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const char next = i + 1 < s.size() ? s[i + 1] : ' ';
+    if (s[i] == '|') out += "\\|";
+    else if (s[i] == '<' && (std::isalpha(static_cast<unsigned char>(next)) || next == '/' || next == '!'))
+      out += "&lt;";
+    else out += s[i];
+  }
+  return out;
 }
 
 }  // namespace
