@@ -293,7 +293,7 @@ def main(argv=None):
              f"- commit: {latest['commit'] if latest else 'no run'}",
              f"- date: {rc.utc_now()}",
              f"- machine: {rc.machine_description()}",
-             f"- history: {os.path.abspath(args.history)} ({len(runs)} runs)",
+             f"- history: {rc.repository_path(args.history)} ({len(runs)} runs)",
              f"- slowdown threshold: {args.threshold:.0%} in {args.metric} with Mann-Whitney "
              f"p < {args.alpha:g}", ""]
     slowdowns = []

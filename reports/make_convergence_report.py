@@ -472,7 +472,7 @@ def main(argv=None):
              f"- date: {rc.utc_now()}",
              f"- machine: {rc.machine_description()}",
              f"- build type: {build_type}",
-             f"- input: {os.path.abspath(args.input)} ({len(files)} files)", "",
+             f"- input: {rc.repository_path(args.input)} ({len(files)} files)", "",
              "## Summary", "",
              f"{checks} checks: {checks - len(failures)} pass, {len(failures)} fail."]
     if not files:

@@ -550,8 +550,8 @@ def metrics_section(results):
 def header(results, counts):
     d = results.data
     lines = ["# Validation: MD against continuum against the paper", "",
-             "Bougie, Moon, Swift and Swinney, Phys. Rev. E 66, 051301 (2002); claims from "
-             "../shared/spec/paper-claims.md. Written by reports/make_validation_report.py from "
+             "Bougie, Moon, Swift and Swinney, Phys. Rev. E 66, 051301 (2002); its claims as data in "
+             "reference-data/claims.toml. Written by reports/make_validation_report.py from "
              "validation/run_validation.py.", "",
              f"- commit: {d['commit']}{' (with uncommitted changes)' if d['dirty'] else ''}",
              f"- date: {d['date']}", f"- program: {d['shaker_version']}",

@@ -19,6 +19,17 @@ def git_commit(repository):
         return "unknown"
 
 
+def repository_path(path):
+    """How a report names an input: relative to the repository root when it is inside the
+    repository, else only its last component, marked as outside (a report never carries an
+    absolute path of the machine it was written on)."""
+    root = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
+    full = os.path.realpath(path)
+    if os.path.commonpath([root, full]) == root:
+        return os.path.relpath(full, root)
+    return f"{os.path.basename(full.rstrip(os.sep)) or full} (outside the repository)"
+
+
 def machine_description():
     cpu = platform.processor() or platform.machine()
     try:

@@ -9,6 +9,7 @@
 #include "analysis/run_analysis.hpp"
 #include "common/config.hpp"
 #include "common/errors.hpp"
+#include "common/describe.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
@@ -42,7 +43,12 @@ int command_continuum(const RunOptions& options) {
 }
 
 int command_config(const RunOptions& options) {
-  fmt::print("{}", load(options).to_toml());
+  fmt::print("{}", config::annotate_units(load(options).to_toml()));
+  return 0;
+}
+
+int command_describe(bool markdown) {
+  fmt::print("{}", config::describe_schema(markdown));
   return 0;
 }
 

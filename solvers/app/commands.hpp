@@ -27,6 +27,7 @@ struct AnalyzeOptions {
   bool quiet = false;
 };
 int command_analyze(const AnalyzeOptions& options);
+int command_describe(bool markdown);  ///< shaker config --describe [--markdown]
 int command_compare(const std::string& first, const std::string& second,
                     const std::string& csv_file);
 

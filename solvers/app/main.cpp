@@ -25,6 +25,12 @@ int main(int argc, char** argv) {
       app, "config", "Print the effective configuration (defaults, file, --set overrides)",
       show_config);
   config->get_option("CONFIG")->required(false);
+  bool describe = false, markdown = false;
+  auto* describe_flag = config->add_flag(
+      "--describe", describe,
+      "instead: every key with its type, default, allowed values, units and meaning");
+  config->add_flag("--markdown", markdown, "with --describe: as Markdown (docs/configuration.md)")
+      ->needs(describe_flag);
 
   AnalyzeOptions analysis;
   auto* analyze = app.add_subcommand(
@@ -53,7 +59,7 @@ int main(int argc, char** argv) {
 
   std::string first, second, compare_csv;
   auto* compare = app.add_subcommand(
-      "compare", "Agreement metrics between two runs (physics.md): fractional RMS of shock "
+      "compare", "Agreement metrics between two runs (docs/analysis.md): fractional RMS of shock "
                  "location and centre of mass, profile norms of nu and T");
   compare->add_option("A", first, "HDF5 run file")->required();
   compare->add_option("B", second, "HDF5 run file (the reference)")->required();
@@ -72,7 +78,8 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
-    if (app.got_subcommand("config")) return command_config(show_config);
+    if (app.got_subcommand("config"))
+      return describe ? command_describe(markdown) : command_config(show_config);
     if (app.got_subcommand("analyze")) return command_analyze(analysis);
     if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
   } catch (const InputError& error) {

@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -34,7 +35,13 @@ struct ParameterSpec {
   Value default_value;
   Range range;                       ///< numbers and each element of a list
   std::vector<std::string> choices;  ///< text: allowed values (empty: any text)
-  std::string meaning;               ///< units of physics.md and what it controls
+  std::string meaning;               ///< what it controls
+  std::string units = {};  ///< docs/units.md: "sigma", "g sigma", ...; "1" dimensionless; "-" no quantity
+  /// Declares the units: real("md.tc", ...).in("sqrt(sigma/g)"); every key has them.
+  ParameterSpec in(std::string u) && {
+    units = std::move(u);
+    return std::move(*this);
+  }
 };
 
 // Builders keep the schema tables short and readable.

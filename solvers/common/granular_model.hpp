@@ -1,6 +1,6 @@
 #pragma once
-// The constitutive functions of the Jenkins–Richman / Goldshtein model (physics.md,
-// "Continuum") and the hard-sphere kinetic-theory results used to check the MD solver.
+// The constitutive functions of the Jenkins–Richman / Goldshtein model (docs/models.md,
+// "The continuum model") and the hard-sphere kinetic-theory results used to check the MD solver.
 //
 // Written once, as templates over the scalar type, so that double, long double and
 // automatic-differentiation scalars (Eigen::AutoDiffScalar) share one definition: the

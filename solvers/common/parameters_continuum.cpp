@@ -1,54 +1,54 @@
-// Keys of the continuum solver (physics.md, "Continuum").
+// Keys of the continuum solver (docs/models.md, "The continuum model").
 #include "common/config.hpp"
 
 namespace shaker::config {
 
 std::vector<ParameterSpec> continuum_parameters() {
   return {
-      integer("continuum.dimension", 1, closed(1, 3), "1: vertical column; 3: periodic x, y"),
-      real("continuum.cell_size", 0.1, positive(10.0), "grid spacing in every direction"),
+      integer("continuum.dimension", 1, closed(1, 3), "1: vertical column; 3: periodic x, y").in("-"),
+      real("continuum.cell_size", 0.1, positive(10.0), "grid spacing in every direction").in("sigma"),
       real("continuum.box_width", 11.0, Range{1.0, 1e4, true, false},
-           "periodic box edge in x and y (3D)"),
-      real("continuum.ceiling", 80.0, positive(1e5), "height of the ceiling above the plate"),
+           "periodic box edge in x and y (3D)").in("sigma"),
+      real("continuum.ceiling", 80.0, positive(1e5), "height of the ceiling above the plate").in("sigma"),
       real("continuum.initial_volume_fraction", 0.5, Range{0.0, 0.65, true, true},
-           "volume fraction of the initial flat layer (below nu_max = 0.65)"),
+           "volume fraction of the initial flat layer (below nu_max = 0.65)").in("1"),
       text("continuum.transport", "paper", {"paper", "full"},
-           "paper: 1/G terms dropped plus low-density artificial dissipation; full: all terms"),
+           "paper: 1/G terms dropped plus low-density artificial dissipation; full: all terms").in("-"),
       text("continuum.limiter", "mc", {"minmod", "mc", "van_leer", "none"},
-           "slope limiter; none = unlimited central slopes (smooth-solution verification only)"),
-      text("continuum.riemann", "hllc", {"hllc", "hll"}, "approximate Riemann solver"),
-      real("continuum.cfl", 0.4, positive(1.0), "Courant number of each forward-Euler stage of the adaptive step"),
+           "slope limiter; none = unlimited central slopes (smooth-solution verification only)").in("-"),
+      text("continuum.riemann", "hllc", {"hllc", "hll"}, "approximate Riemann solver").in("-"),
+      real("continuum.cfl", 0.4, positive(1.0), "Courant number of each forward-Euler stage of the adaptive step").in("1"),
       real("continuum.perturbation", 1e-3, closed(0.0, 0.5),
-           "3D: relative amplitude of the seeded random perturbation of the initial layer"),
+           "3D: relative amplitude of the seeded random perturbation of the initial layer").in("1"),
       real("continuum.initial_temperature", 1e-2, positive(1e6),
-           "temperature of the initial layer and background gas"),
+           "temperature of the initial layer and background gas").in("g sigma"),
       real("continuum.background_volume_fraction", 1e-5, Range{0.0, 0.1, true, false},
-           "volume fraction of the dilute gas above the initial layer"),
-      integer("continuum.integrator_order", 2, closed(2, 3), "SSP Runge-Kutta order (2 or 3)"),
+           "volume fraction of the dilute gas above the initial layer").in("1"),
+      integer("continuum.integrator_order", 2, closed(2, 3), "SSP Runge-Kutta order (2 or 3)").in("-"),
       integer("continuum.integrator_stages", 2, closed(2, 10),
               "order 2: stages s of SSP-RK(s,2) (2 = Heun); each stage is a forward-Euler step "
-              "at continuum.cfl, so the step grows as s - 1. Order 3 (Shu-Osher) takes only 2"),
+              "at continuum.cfl, so the step grows as s - 1. Order 3 (Shu-Osher) takes only 2").in("-"),
       real("continuum.diffusion_number", 0.8, positive(1.0),
-           "time step as a fraction of the forward-Euler diffusive limit h^2 / (2 dim D)"),
+           "time step as a fraction of the forward-Euler diffusive limit h^2 / (2 dim D)").in("1"),
       text("continuum.diffusion_integrator", "auto", {"auto", "explicit", "rkl2", "implicit", "implicit_extrapolated"},
            "diffusive terms: explicit in the SSP-RK step, or Strang-split RKL2 super time "
            "stepping, or Strang-split backward Euler (Eigen sparse; first order in time), or that "
            "Richardson-extrapolated to second order (two half steps against one whole, 3 solves); "
            "auto = implicit_extrapolated for full transport (plain backward Euler's time error "
            "exceeds the base case's grid uncertainty at cell 0.1 in 6 of 9 quantities), "
-           "explicit for paper"),
+           "explicit for paper").in("-"),
       real("continuum.temperature_floor", 1e-12, positive(1.0),
-           "lowest temperature; every raise to it is counted and reported"),
+           "lowest temperature; every raise to it is counted and reported").in("g sigma"),
       real("continuum.artificial_viscosity", 0.5, at_least(0.0, 100.0),
-           "paper transport: mu_art = coefficient * n h c / (1 + (nu / nu_art)^4)"),
+           "paper transport: mu_art = coefficient * n h c / (1 + (nu / nu_art)^4)").in("1"),
       real("continuum.artificial_conductivity", 0.5, at_least(0.0, 100.0),
-           "paper transport: kappa_art = coefficient * n h c / (1 + (nu / nu_art)^4)"),
+           "paper transport: kappa_art = coefficient * n h c / (1 + (nu / nu_art)^4)").in("1"),
       real("continuum.artificial_volume_fraction", 0.01, positive(0.65),
-           "paper transport: nu_art, the volume fraction below which artificial dissipation acts"),
+           "paper transport: nu_art, the volume fraction below which artificial dissipation acts").in("1"),
       real_list("continuum.field_phases", {}, closed(0.0, 1.0),
-                "3D: phases f t of the last sampled cycle whose full fields are written (HDF5 + XDMF)"),
-      text("continuum.checkpoint", "", {}, "file for the final state (empty: none)"),
-      text("continuum.restart", "", {}, "checkpoint to start from (empty: the flat layer)"),
+                "3D: phases f t of the last sampled cycle whose full fields are written (HDF5 + XDMF)").in("1 (f t)"),
+      text("continuum.checkpoint", "", {}, "file for the final state (empty: none)").in("-"),
+      text("continuum.restart", "", {}, "checkpoint to start from (empty: the flat layer)").in("-"),
   };
 }
 

@@ -11,7 +11,7 @@ struct Restitution {
   double e = 0.9;  ///< the constant value; for velocity_dependent, the value the continuum uses
 
   /// e as a function of the normal impact velocity v_n (either sign) (units sqrt(g sigma)):
-  /// velocity_dependent is e = 1 - 0.1 |v_n|^(3/4) below |v_n| = 1 and 0.9 above (physics.md).
+  /// velocity_dependent is e = 1 - 0.1 |v_n|^(3/4) below |v_n| = 1 and 0.9 above (docs/models.md).
   double operator()(double normal_velocity) const {
     if (kind == Kind::constant) return e;
     const double speed = std::abs(normal_velocity);

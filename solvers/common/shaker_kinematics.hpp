@@ -1,5 +1,5 @@
 #pragma once
-// Plate motion z_p(t) = A (1 - cos(omega t)), lowest at phase f t = 0 (physics.md, "The shaker").
+// Plate motion z_p(t) = A (1 - cos(omega t)), lowest at phase f t = 0 (docs/models.md, "The shaker").
 #include <cmath>
 
 #include "common/units.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Dimensionless units of physics.md: particle diameter, particle mass and gravity are 1.
+// Dimensionless units (docs/units.md): particle diameter, particle mass and gravity are 1.
 #include <numbers>
 
 namespace shaker {

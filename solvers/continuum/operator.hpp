@@ -1,6 +1,6 @@
 #pragma once
 // The right-hand side dU/dt = -div F(U) + S(U, t) of the Jenkins–Richman equations
-// (physics.md, "Continuum") on a Grid, callable on its own: every physical term can be
+// (docs/models.md, "The continuum model") on a Grid, callable on its own: every physical term can be
 // switched off and an external source per cell and time can be added (the manufactured-
 // solution harness needs both). Frame: the container's; walls at z = 0 and z = height.
 #include <array>

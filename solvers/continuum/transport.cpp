@@ -1,7 +1,7 @@
 // Primitive variables and the closure (pressure, sound speed, transport coefficients) per
 // cell, from the constitutive functions of common/granular_model.hpp only.
 //
-// Transport variants (physics.md): `full` keeps every term of mu and kappa; `paper` drops
+// Transport variants (docs/models.md): `full` keeps every term of mu and kappa; `paper` drops
 // their 1/G terms (the model functions do that) and adds the artificial dissipation of
 // ArtificialDissipation (operator.hpp), which acts only where nu is well below
 // artificial.volume_fraction.

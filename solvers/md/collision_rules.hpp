@@ -1,5 +1,5 @@
 #pragma once
-// Collision rules (physics.md): instantaneous binary collisions with the restitution model of
+// Collision rules (docs/models.md): instantaneous binary collisions with the restitution model of
 // solvers/common/restitution.hpp, infinitely massive walls with the same e, the optional TC
 // guard against inelastic collapse, and the floor speed that keeps a particle resting on the
 // plate from colliding infinitely often.

@@ -1,5 +1,5 @@
 #pragma once
-// Horizontally averaged fields in bins at fixed phases of the cycle (physics.md, Sampling):
+// Horizontally averaged fields in bins at fixed phases of the cycle (docs/models.md, "Sampling"):
 // n, u and T pooled over all particles found in a bin at that phase in all sampled cycles.
 // The sums of each cycle are kept (common/cycle_samples.hpp) for standard errors and for the
 // analysis's jackknife.

@@ -1,4 +1,4 @@
-// Exact solutions of verification.md for the granular model: homogeneous cooling (Haff's
+// Exact solutions for the granular model: homogeneous cooling (Haff's
 // law, and the integrator's temporal order) and the hydrostatic rest state (spurious
 // velocities converge at the scheme's order).
 #include <cmath>

@@ -1,6 +1,6 @@
 // Riemann problems in Euler mode (transport, loss and body forces off; dilute ideal gas,
 // gamma = 5/3) against the exact solution (exact_riemann.hpp): the L1 error converges and no
-// oscillation exceeds 1% of the jump (verification.md).
+// oscillation exceeds 1% of the jump.
 #include <algorithm>
 
 #include "exact_riemann.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Convergence arithmetic of verification.md: observed orders, least-squares order fits,
+// Convergence arithmetic: observed orders, least-squares order fits,
 // Richardson extrapolation, Roache's grid convergence index (GCI) in the form of
 // Celik et al., J. Fluids Eng. 130 (2008) 078001, and discrete error norms.
 //

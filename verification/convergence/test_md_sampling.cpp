@@ -1,4 +1,4 @@
-// MD sampling convergence of the real problem (verification.md; issue 5, "MD sampling
+// MD sampling convergence of the real problem (issue 5, "MD sampling
 // convergence"): the base case (validation/cases/base.toml: H = 9, e = 0.9, 3937 particles).
 //
 // 1. Standard error against the number K of sampled cycles. One trajectory (explicit seed,

@@ -1,5 +1,5 @@
 #pragma once
-// Manufactured fields n, u, T for the method of manufactured solutions (verification.md).
+// Manufactured fields n, u, T for the method of manufactured solutions.
 //
 // Written once, as a template over the scalar, so that the source terms (automatic
 // differentiation, mms_source.hpp), the independent finite-difference check (long double) and
@@ -8,7 +8,7 @@
 // Geometry: 0 <= z <= Lz between the plate and the ceiling (container frame), x and y periodic
 // with periods Lx, Ly. Every z dependence is cos(j pi z / Lz + phase) or, for u_z,
 // sin(j pi z / Lz + phase); with wall_compatible (phase 0) the fields satisfy the wall
-// conditions of physics.md at z = 0 and z = Lz for all t, x, y: u_z = 0 and zero normal
+// conditions of docs/models.md at z = 0 and z = Lz for all t, x, y: u_z = 0 and zero normal
 // gradients of u_x, u_y, T (and of n). Otherwise the phases are shifted so the solution needs
 // exact (Dirichlet) boundary data instead.
 //

@@ -1,6 +1,5 @@
 #pragma once
-// Manufactured-solution runs of the continuum solver (verification.md, "Manufactured
-// solutions"): the solver integrates dU/dt = L(U) + S with S the cell average of the
+// Manufactured-solution runs of the continuum solver: the solver integrates dU/dt = L(U) + S with S the cell average of the
 // conservative-form source of mms_source.hpp, from the exact cell averages at t = 0, and the
 // result at t_end is compared with the exact cell averages then.
 //

@@ -1,6 +1,6 @@
 #pragma once
 // Source terms of the method of manufactured solutions: the residual of the full continuum
-// equations of physics.md for the fields of manufactured_solution.hpp, by automatic
+// equations of docs/models.md for the fields of manufactured_solution.hpp, by automatic
 // differentiation through the constitutive functions of common/granular_model.hpp (no
 // hand-expanded formula: the solver and the source share those functions).
 //
@@ -8,7 +8,7 @@
 // fields once more, so that the velocity and temperature gradients entering P and q are
 // themselves differentiable and div P, div q come out exact to rounding.
 //
-// Primitive form (as physics.md writes the equations), residual R = left side - right side:
+// Primitive form (as docs/models.md writes the equations), residual R = left side - right side:
 //   R_n = dn/dt + div(n u)
 //   R_i = n (du_i/dt + u . grad u_i) - d_j P_ij - n b_i
 //   R_E = (3/2) n (dT/dt + u . grad T) + div q - P : E + gamma

@@ -1,6 +1,6 @@
 // Manufactured-solution runs of the continuum solver: spatial and temporal orders of every
-// field in L1, L2 and Linf, fitted over the 3 finest levels, within 0.1 of the design order
-// (verification.md). Tables go through write_study (SHAKER_CONVERGENCE_DIR for the nightly
+// field in L1, L2 and Linf, fitted over the 3 finest levels, within 0.1 of the design order.
+// Tables go through write_study (SHAKER_CONVERGENCE_DIR for the nightly
 // report). Suites whose name starts with Nightly carry the ctest label `nightly`.
 #include <fmt/format.h>
 #include <gtest/gtest.h>

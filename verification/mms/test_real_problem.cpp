@@ -1,6 +1,6 @@
-// Grid convergence of the real problem (verification.md, "Convergence of the real problem"):
+// Grid convergence of the real problem:
 // the 1D base case (H = 9, e = 0.9, validation/cases/base.toml) at cell sizes 0.4, 0.2, 0.1,
-// 0.05 with the quantities of interest of physics.md computed by solvers/analysis. For each:
+// 0.05 with the quantities of interest of docs/analysis.md computed by solvers/analysis. For each:
 // the observed order, Richardson extrapolation and Roache's GCI (Fs = 1.25) on the three finest
 // grids and on the three coarsest, and the asymptotic-range check; and the 3D base case on two
 // grids against the 1D column. Nightly only (minutes; the 3D test about half an hour).

@@ -2,7 +2,7 @@
 """Independent reference values for verification/unit/test_granular_model.cpp.
 
 Every value is computed here with 50-digit arithmetic (mpmath), straight from the formulas of
-physics.md and the kinetic-theory literature, without looking at the C++ code:
+docs/models.md and the kinetic-theory literature, without looking at the C++ code:
   * state inputs are the exact binary values of the C++ double literals (mpf(float(text)));
   * model constants are the spec's decimal values (nu_max = 0.65 exactly, pi to 50 digits);
   * dG/dnu, dchi/dnu and the dchi/dnu inside the sound speed are obtained by mpmath's
@@ -34,7 +34,7 @@ def exact(text):
     return mp.mpf(float(text))
 
 
-# ---- the model of physics.md ---------------------------------------------------------------
+# ---- the model of docs/models.md ----------------------------------------------------------
 def g0(nu):
     return 1 / (1 - (nu / NU_MAX) ** (mp.mpf(4) / 3 * NU_MAX))
 
@@ -124,7 +124,7 @@ HAFF_CASES = [("0.0", "1.0", "0.5", "0.9"), ("2.5", "1.0", "0.5", "0.9"),
 # (Gamma, f, t): the base case and two others; t away from zeros of sin and cos.
 SHAKER_CASES = [("3.0", "0.095", "0.7"), ("3.0", "0.095", "3.1"), ("3.0", "0.095", "7.9"),
                 ("3.0", "0.095", "41.9"), ("2.2", "0.25", "1.3"), ("7.0", "0.05", "13.0")]
-# (kind, e, normal speed) for the restitution model of physics.md.
+# (kind, e, normal speed) for the restitution model of docs/models.md.
 RESTITUTION_CASES = [("constant", "0.9", "0.3"), ("constant", "0.7", "5.0"),
                      ("velocity_dependent", "0.9", "0.0"),
                      ("velocity_dependent", "0.9", "0.01"),

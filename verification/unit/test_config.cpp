@@ -64,7 +64,7 @@ TEST(Config, DefaultsReproduceThePaperBaseCase) {
   EXPECT_EQ(c.integer("run.sampled_cycles"), 10);  // the paper averages over 10 cycles
 
   const auto p = shaker::CaseParameters::from(c);
-  EXPECT_NEAR(p.shaker.amplitude(), 8.4200, 5e-5);  // physics.md: A = 8.4200
+  EXPECT_NEAR(p.shaker.amplitude(), 8.4200, 5e-5);  // docs/models.md: A = 8.42
   EXPECT_NEAR(p.shaker.period(), 10.526, 5e-4);
   EXPECT_EQ(p.restitution.kind, shaker::Restitution::Kind::constant);
   EXPECT_EQ(p.restitution(0.1), 0.9);

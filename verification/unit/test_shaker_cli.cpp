@@ -150,6 +150,8 @@ TEST(ShakerProgram, ConfigPrintsTheEffectiveConfiguration) {
   EXPECT_NE(r.output.find("e = 0.8\n"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("gamma = 4.5\n"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("particles = 3937\n"), std::string::npos) << r.output;
+  // Dimensional keys carry their units as a TOML comment (the text still loads as a case).
+  EXPECT_NE(r.output.find("frequency = 0.095  # sqrt(g/sigma)\n"), std::string::npos) << r.output;
 }
 
 TEST(ShakerProgram, AnalyzeAndCompareAcceptAValidRunFile) {
