@@ -62,13 +62,8 @@ class Results:
             else None
 
     def analysis(self, case, solver):
-        v = self.view(case, solver)
-        if not v or not v.get("analysis_json") or not os.path.exists(v["analysis_json"]):
-            return None
-        with open(v["analysis_json"]) as f:
-            per_phase = json.load(f)["per_phase"]
-        return {k: np.array([math.nan if x is None else float(x) for x in q["value"]])
-                for k, q in per_phase.items()}
+        table = self.analysis_with_errors(case, solver)
+        return table[0] if table else None
 
     def analysis_with_errors(self, case, solver):
         """Per-phase values and jackknife errors of `shaker analyze --json`."""

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Fails if a tracked file refers to something outside the repository: the ../shared folder
+"""Fails if a tracked file refers to something outside the repository: the specification folder
 beside the project's checkout on the machine it was developed on, or an absolute path of a
 machine (/work/..., /root/..., /home/..., /tmp/..., or this checkout's own absolute path).
 A clone has none of them, so such a reference is a dangling link in a document or a report
@@ -14,17 +14,6 @@ import os
 import re
 import subprocess
 import sys
-
-# Generated files whose generator no longer writes the reference, kept until they are
-# regenerated (never edited by hand). Each entry is the exact stale text; a file is exempt
-# only for lines containing it. An entry that no longer matches is harmless (the generator no
-# longer writes that text) and is named in the output so that it can be deleted.
-STALE_GENERATED = {
-    # make_validation_report.py names reference-data/claims.toml since the docs branch; the
-    # report is rewritten by the full validation study (about an hour), not by hand.
-    "reports/validation.md": "claims from ../shared/spec/paper-claims.md",
-}
-
 
 def patterns(source_dir):
     outside = [r"\.\./shared\b",
@@ -45,7 +34,7 @@ def main():
         return 77
     pattern = patterns(source_dir)
     me = os.path.relpath(os.path.realpath(__file__), os.path.realpath(source_dir))
-    problems, used = [], set()
+    problems = []
     for name in listed.decode().split("\0"):
         path = os.path.join(source_dir, name)
         if not name or name == me or not os.path.isfile(path):
@@ -58,14 +47,8 @@ def main():
             match = pattern.search(line)
             if not match:
                 continue
-            stale = STALE_GENERATED.get(name)
-            if stale and stale in line:
-                used.add(name)
-                continue
             problems.append(f"{name}:{number}: refers to '{match.group(0)}' outside the "
                             f"repository: {line.strip()[:160]}")
-    for name in sorted(STALE_GENERATED.keys() - used):
-        print(f"note: {name} was regenerated; its STALE_GENERATED entry in {me} can be deleted")
     for p in problems:
         print(p)
     if problems:
