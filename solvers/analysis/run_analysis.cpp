@@ -49,25 +49,43 @@ std::optional<FrontFit> fitted_front(const Profile& p, const Shock& shock, const
   return fit;
 }
 
-/// The longest run of consecutive stored phases with a shock (the first on a tie); in a
-/// periodic run the last stored phase is followed by the first.
+/// The phases of the shock's life: the longest run of stored phases with a shock (the first on
+/// a tie), in which one phase without a shock between two with one counts as a missed
+/// detection and does not end the life (the shock rule's thresholds are in standard errors, so
+/// at MD noise a real shock is missed at isolated phases). In a periodic run the last stored
+/// phase is followed by the first. Returns the phases with a shock, in time order.
 std::vector<std::size_t> longest_life(const std::vector<PhaseQuantities>& q, bool periodic) {
   const std::size_t m = q.size();
   const auto has = [&](std::size_t k) { return q[k % m].shock.has_value(); };
+  const auto exists = [&](std::size_t k) { return periodic || k < m; };
+  // Phase k belongs to a life if it has a shock or is a one-phase gap inside one.
+  const auto alive = [&](std::size_t k) {
+    if (!exists(k)) return false;
+    if (has(k)) return true;
+    const bool before = k > 0 ? has(k - 1) : periodic && has(m - 1);
+    return before && exists(k + 1) && has(k + 1);
+  };
   std::vector<std::size_t> life;
   if (std::all_of(q.begin(), q.end(), [](const auto& x) { return x.shock.has_value(); })) {
     for (std::size_t k = 0; k < m; ++k) life.push_back(k);
     return life;
   }
+  // With every phase alive (periodic, one-phase gaps only) a life starts after any gap.
+  bool every_phase_alive = true;
+  for (std::size_t k = 0; k < m; ++k) every_phase_alive = every_phase_alive && alive(k);
   std::size_t best_start = 0, best_length = 0;
   for (std::size_t start = 0; start < m; ++start) {
-    const bool continues = start > 0 ? has(start - 1) : periodic && has(m - 1);
+    const std::size_t previous = start > 0 ? start - 1 : m - 1;
+    const bool continues = every_phase_alive ? has(previous)
+                           : start > 0 ? alive(start - 1) : periodic && alive(m - 1);
     if (!has(start) || continues) continue;
     std::size_t length = 0;
-    while (has(start + length) && (periodic || start + length < m)) ++length;
+    while (length < m && alive(start + length)) ++length;
+    while (length > 0 && !has(start + length - 1)) --length;  // a life ends on a shock
     if (length > best_length) best_start = start, best_length = length;
   }
-  for (std::size_t j = 0; j < best_length; ++j) life.push_back((best_start + j) % m);
+  for (std::size_t j = 0; j < best_length; ++j)
+    if (has(best_start + j)) life.push_back((best_start + j) % m);
   return life;
 }
 
@@ -142,11 +160,16 @@ std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
     height.push_back(q[k].shock->location - q[k].plate_z);
     location.push_back(q[k].shock->location);
   }
-  s.formation_phase = phase.front();
+  // The shock formed between the stored phase before its life (which has none) and the first
+  // with one: the midpoint, unbiased for a formation anywhere in that interval. A life that
+  // starts at the first stored phase of a non-periodic run formed before it: that phase.
+  const std::size_t m = q.size();
+  const double spacing = m > 1 ? 1.0 / static_cast<double>(m) : 1.0;
+  const bool seen_before = o.periodic || life.front() > 0;
+  s.formation_phase = phase.front() - (seen_before ? 0.5 * spacing : 0.0);
   // Exit: where the line through the last two gaps (layer top - shock) reaches zero, between
   // the last phase with a shock and the next stored phase.
-  const std::size_t last = life.back(), m = q.size();
-  const double spacing = m > 1 ? 1.0 / static_cast<double>(m) : 1.0;
+  const std::size_t last = life.back();
   const double next_phase = phase.back() + spacing;
   double exit = next_phase;
   if (life.size() >= 2) {
@@ -197,6 +220,7 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
       r.layer_temperature_peak = q.layer_temperature;
   }
   r.center_of_mass_mean = com / static_cast<double>(r.phases.size());
+  r.bin_height = profiles.front().bin_height;
   r.shock = shock_life(r.phases, options);
   r.width_over_mfp_peak_phase = nan;
   if (r.shock) {
@@ -222,6 +246,15 @@ std::vector<NamedValues> phase_columns(const RunQuantities& r) {
   const auto shock = [](auto get) {
     return [get](const PhaseQuantities& q) { return q.shock ? get(*q.shock) : nan; };
   };
+  const auto bin = [&](NamedValues c) {
+    c.resolution.assign(r.phases.size(), r.bin_height);
+    return c;
+  };
+  const auto bin_over_mfp = [&](NamedValues c) {
+    for (const auto& q : r.phases)
+      c.resolution.push_back(q.shock ? r.bin_height / q.shock->mean_free_path : nan);
+    return c;
+  };
   return {
       column("phase", "1", [](auto& q) { return q.phase; }),
       column("time", "sqrt(sigma/g)", [](auto& q) { return q.time; }),
@@ -239,33 +272,34 @@ std::vector<NamedValues> phase_columns(const RunQuantities& r) {
       column("max_mach", "1", [](auto& q) { return q.max_mach; }),
       column("shock_present", "1", [](auto& q) { return q.shock ? 1.0 : 0.0; }),
       column("shock_location", "sigma", shock([](const Shock& s) { return s.location; })),
-      column("shock_width", "sigma", shock([](const Shock& s) { return s.width; })),
-      column("width_over_mfp", "1", shock([](const Shock& s) { return s.width_over_mfp(); })),
+      bin(column("shock_width", "sigma", shock([](const Shock& s) { return s.width; }))),
+      bin_over_mfp(column("width_over_mfp", "1", shock([](const Shock& s) { return s.width_over_mfp(); }))),
       column("mean_free_path", "sigma", shock([](const Shock& s) { return s.mean_free_path; })),
       column("front_width", "sigma", [](auto& q) { return q.front ? q.front->width : nan; }),
       column("front_width_fit_error", "sigma",
              [](auto& q) { return q.front ? q.front->width_error : nan; }),
       column("front_width_over_mfp", "1",
              [](auto& q) { return q.front ? q.front->width / q.front_mean_free_path : nan; }),
-      column("shock_compressed_top", "sigma", shock([](const Shock& s) { return s.compressed_top; })),
-      column("shock_undisturbed_bottom", "sigma",
-             shock([](const Shock& s) { return s.undisturbed_bottom; })),
+      bin(column("shock_compressed_top", "sigma", shock([](const Shock& s) { return s.compressed_top; }))),
+      bin(column("shock_undisturbed_bottom", "sigma",
+                 shock([](const Shock& s) { return s.undisturbed_bottom; }))),
   };
 }
 
 std::vector<NamedValues> run_values(const RunQuantities& r) {
   const auto life = [&](auto member) { return r.shock ? (*r.shock).*member : nan; };
+  const double spacing = r.phases.empty() ? nan : 1.0 / static_cast<double>(r.phases.size());
   return {
-      {"formation_phase", "1", {life(&ShockLife::formation_phase)}},
+      {"formation_phase", "1", {life(&ShockLife::formation_phase)}, {spacing}},
       {"exit_phase", "1", {life(&ShockLife::exit_phase)}},
-      {"lifetime", "1/f", {life(&ShockLife::lifetime)}},
+      {"lifetime", "1/f", {life(&ShockLife::lifetime)}, {spacing}},
       {"shock_speed", "sqrt(g sigma)", {life(&ShockLife::speed)}},
       {"shock_speed_fit_error", "sqrt(g sigma)", {life(&ShockLife::speed_fit_error)}},
       {"shock_curvature", "g", {life(&ShockLife::curvature)}},
-      {"shock_phases", "1", {r.shock ? static_cast<double>(r.shock->phases.size()) : 0.0}},
+      {"shock_phases", "1", {r.shock ? static_cast<double>(r.shock->phases.size()) : 0.0}, {1.0}},
       {"center_of_mass_mean", "sigma", {r.center_of_mass_mean}},
       {"center_of_mass_apex", "sigma", {r.center_of_mass_apex}},
-      {"width_over_mfp_peak_phase", "1", {r.width_over_mfp_peak_phase}},
+      {"width_over_mfp_peak_phase", "1", {r.width_over_mfp_peak_phase}, {spacing}},
       {"layer_temperature_peak", "g sigma", {r.layer_temperature_peak}},
   };
 }
@@ -336,6 +370,13 @@ double jackknife_error(const std::vector<double>& leave_one_out) {
   double squares = 0.0;
   for (double x : v) squares += (x - mean) * (x - mean);
   return std::sqrt((n - 1.0) / n * squares);
+}
+
+double standard_error(double value, const std::vector<double>& leave_one_out, double resolution) {
+  const double sampling = jackknife_error(leave_one_out);
+  const double rounding = resolution / std::sqrt(12.0);
+  if (!std::isfinite(rounding) || !std::isfinite(value)) return sampling;
+  return std::isfinite(sampling) ? std::hypot(sampling, rounding) : rounding;
 }
 
 }  // namespace shaker::analysis

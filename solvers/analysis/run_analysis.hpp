@@ -50,6 +50,7 @@ struct RunQuantities {
   double center_of_mass_mean = 0.0, center_of_mass_apex = 0.0;
   double width_over_mfp_peak_phase = 0.0;  ///< phase of the largest d/xi in the life (NaN)
   double layer_temperature_peak = 0.0;     ///< largest layer_temperature over the phases
+  double bin_height = 0.0;                 ///< of the profiles (MD bin or continuum cell)
 };
 
 /// Height above the layer's top over which temperature_slope_above is fitted.
@@ -70,6 +71,11 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
 struct NamedValues {
   std::string name, unit;
   std::vector<double> values;
+  /// The grid the value is quantised to (the stored phases' spacing for a phase that is a
+  /// stored phase, the bin height for a distance between bin centres), per entry; empty if
+  /// the value is not quantised. Its uniform rounding error, resolution / sqrt(12), is part
+  /// of the value's uncertainty (docs/analysis.md).
+  std::vector<double> resolution = {};
 };
 /// The per-phase quantities as columns, in a fixed order (the columns of `shaker analyze`).
 std::vector<NamedValues> phase_columns(const RunQuantities& r);
@@ -91,5 +97,11 @@ std::vector<Profile> profiles_without(const RunRecord& run, std::size_t left_out
 /// Jackknife standard error of an estimate from its leave-one-out values (NaN entries are
 /// dropped; NaN if fewer than two remain).
 double jackknife_error(const std::vector<double>& leave_one_out);
+
+/// The standard error of a value: the jackknife error over its leave-one-out values combined
+/// in quadrature with the rounding error of a value quantised to `resolution` (resolution /
+/// sqrt(12), the standard deviation of a uniform rounding error; NaN resolution: none). A
+/// quantised value without replicates has the rounding error alone.
+double standard_error(double value, const std::vector<double>& leave_one_out, double resolution);
 
 }  // namespace shaker::analysis

@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include <cmath>
+#include <numeric>
 
 #include "analysis/run_analysis.hpp"
 #include "app/commands.hpp"
@@ -17,34 +18,48 @@
 namespace shaker {
 namespace {
 
-/// Central values, leave-one-out replicates and jackknife errors of every named quantity.
+/// Central values, leave-one-out replicates and standard errors of every named quantity.
 struct Estimates {
   std::vector<analysis::NamedValues> central;
   std::vector<std::vector<analysis::NamedValues>> replicates;  // [sample][quantity]
   std::vector<std::vector<double>> errors;                     // [quantity][entry]
 };
 
-Estimates estimate(const RunRecord& run, const analysis::AnalysisOptions& options, bool per_phase) {
-  const auto flatten = [&](const std::vector<Profile>& profiles) {
+void add_errors(Estimates& e) {
+  for (std::size_t q = 0; q < e.central.size(); ++q) {
+    std::vector<double> errors;
+    const auto& c = e.central[q];
+    for (std::size_t i = 0; i < c.values.size(); ++i) {
+      std::vector<double> values;
+      for (const auto& r : e.replicates) values.push_back(r[q].values[i]);
+      const double resolution = i < c.resolution.size() ? c.resolution[i] : NAN;
+      errors.push_back(analysis::standard_error(c.values[i], values, resolution));
+    }
+    e.errors.push_back(std::move(errors));
+  }
+}
+
+/// The per-phase and per-run estimates of a run: one analysis of the full sample and one of
+/// each leave-one-out sample.
+std::pair<Estimates, Estimates> estimate(const RunRecord& run, const analysis::AnalysisOptions& options) {
+  Estimates phases, per_run;
+  const auto add = [&](const std::vector<Profile>& profiles, bool central) {
     const auto r = analysis::analyze_profiles(profiles, run.e, options);
-    return per_phase ? analysis::phase_columns(r) : analysis::run_values(r);
+    if (central) {
+      phases.central = analysis::phase_columns(r);
+      per_run.central = analysis::run_values(r);
+    } else {
+      phases.replicates.push_back(analysis::phase_columns(r));
+      per_run.replicates.push_back(analysis::run_values(r));
+    }
   };
-  Estimates out;
-  out.central = flatten(run.profiles);
+  add(run.profiles, true);
   const std::size_t samples = run.samples.empty() ? 0 : run.samples.samples();
   if (samples >= 2)
-    for (std::size_t s = 0; s < samples; ++s)
-      out.replicates.push_back(flatten(analysis::profiles_without(run, s)));
-  for (std::size_t q = 0; q < out.central.size(); ++q) {
-    std::vector<double> errors;
-    for (std::size_t i = 0; i < out.central[q].values.size(); ++i) {
-      std::vector<double> values;
-      for (const auto& r : out.replicates) values.push_back(r[q].values[i]);
-      errors.push_back(analysis::jackknife_error(values));
-    }
-    out.errors.push_back(std::move(errors));
-  }
-  return out;
+    for (std::size_t s = 0; s < samples; ++s) add(analysis::profiles_without(run, s), false);
+  add_errors(phases);
+  add_errors(per_run);
+  return {std::move(phases), std::move(per_run)};
 }
 
 std::string json_number(double x) { return std::isfinite(x) ? fmt::format("{:.17g}", x) : "null"; }
@@ -74,11 +89,16 @@ std::string json_quantities(const Estimates& e, bool scalar) {
     std::vector<std::string> replicates;
     for (const auto& r : e.replicates)
       replicates.push_back(scalar ? json_number(r[q].values[0]) : json_list(r[q].values));
+    const std::string resolution = c.resolution.empty() ? "null"
+                                   : scalar             ? json_number(c.resolution[0])
+                                                        : json_list(c.resolution);
     entries.push_back(fmt::format(
-        "    {}: {{\"unit\": {}, \"value\": {}, \"error\": {}, \"replicates\": [{}]}}",
+        "    {}: {{\"unit\": {}, \"value\": {}, \"error\": {}, \"resolution\": {}, "
+        "\"replicates\": [{}]}}",
         json_string(c.name), json_string(c.unit),
         scalar ? json_number(c.values[0]) : json_list(c.values),
-        scalar ? json_number(e.errors[q][0]) : json_list(e.errors[q]), fmt::join(replicates, ", ")));
+        scalar ? json_number(e.errors[q][0]) : json_list(e.errors[q]), resolution,
+        fmt::join(replicates, ", ")));
   }
   return fmt::format("{{\n{}\n  }}", fmt::join(entries, ",\n"));
 }
@@ -87,25 +107,31 @@ struct Crossings {
   std::string column;
   std::vector<double> per_cycle;
   double mean = NAN, error = NAN;  // between-cycle standard error of the mean
+  /// Leave-one-cycle-out means, when the cycles are the run's samples (then replicate i
+  /// leaves out the same cycle as the other quantities' replicate i); else empty.
+  std::vector<double> replicates;
 };
 
-std::vector<Crossings> crossings(const std::vector<RunRecord>& runs) {
+/// Crossings per cycle of every crossing column: mean over the cycles of all runs, and its
+/// between-cycle standard error (the jackknife error of the leave-one-cycle-out means, which
+/// for a mean is the standard error exactly).
+std::vector<Crossings> crossings(const std::vector<RunRecord>& runs, std::size_t samples) {
   std::vector<Crossings> out;
   for (const auto& name : runs.front().series.names) {
     if (name.rfind("crossings_z", 0) != 0) continue;
-    Crossings c{name, {}, NAN, NAN};
+    Crossings c{name, {}, NAN, NAN, {}};
     for (const auto& run : runs) {
       const auto counts = analysis::crossings_per_cycle(run, name);
       c.per_cycle.insert(c.per_cycle.end(), counts.begin(), counts.end());
     }
     const double m = static_cast<double>(c.per_cycle.size());
-    if (m >= 1) {
-      double sum = 0, squares = 0;
-      for (double x : c.per_cycle) sum += x;
-      c.mean = sum / m;
-      for (double x : c.per_cycle) squares += (x - c.mean) * (x - c.mean);
-      if (m >= 2) c.error = std::sqrt(squares / (m - 1) / m);
-    }
+    const double sum = std::accumulate(c.per_cycle.begin(), c.per_cycle.end(), 0.0);
+    if (m >= 1) c.mean = sum / m;
+    std::vector<double> left_out;
+    if (m >= 2)
+      for (double x : c.per_cycle) left_out.push_back((sum - x) / (m - 1));
+    c.error = analysis::jackknife_error(left_out);
+    if (c.per_cycle.size() == samples) c.replicates = std::move(left_out);
     out.push_back(std::move(c));
   }
   return out;
@@ -119,9 +145,9 @@ std::string analysis_json(const std::vector<std::string>& inputs, const RunRecor
   for (const auto& i : inputs) quoted.push_back(json_string(i));
   for (const auto& c : crossing)
     counts.push_back(fmt::format("    {}: {{\"unit\": \"particles per cycle\", \"value\": {}, "
-                                 "\"error\": {}, \"per_cycle\": {}}}",
+                                 "\"error\": {}, \"per_cycle\": {}, \"replicates\": {}}}",
                                  json_string(c.column), json_number(c.mean), json_number(c.error),
-                                 json_list(c.per_cycle)));
+                                 json_list(c.per_cycle), json_list(c.replicates)));
   return fmt::format(
       "{{\n  \"schema\": \"shaker-analysis\",\n  \"schema_version\": 1,\n"
       "  \"program_version\": {},\n  \"git_commit\": {},\n  \"inputs\": [{}],\n"
@@ -209,10 +235,9 @@ int command_analyze(const AnalyzeOptions& o) {
   options.criteria = o.criteria;
   options.periodic = config.text("run.protocol") == "periodic";
   options.frequency = config.real("shaker.frequency");
-  const Estimates phases = estimate(run, options, true);
-  const Estimates per_run = estimate(run, options, false);
-  const auto crossing = crossings(runs);
+  const auto [phases, per_run] = estimate(run, options);
   const std::size_t samples = run.samples.empty() ? 0 : run.samples.samples();
+  const auto crossing = crossings(runs, samples);
   if (!o.quiet)
     print_table(fmt::format("# {}: solver {}, {}, e = {}, program {} ({}); errors: {}",
                             fmt::join(o.run_files, " + "), run.solver, run.model_variant, run.e,
