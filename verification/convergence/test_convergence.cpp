@@ -272,6 +272,62 @@ TEST(OrderChecks, PassAndFailAgainstTheBand) {
   std::filesystem::remove_all(dir);
 }
 
+// The judge's band rule at its edges. The report generator shows the pass column these write
+// without re-deciding it, so these tests are what pins the order and GCI rules down.
+// Edges are approached by 1e-9: exactly 2 + 0.1 is not representable, and rounds either way.
+namespace {
+constexpr double just = 1e-9;
+
+cv::OrderCheck second_order_check(double fitted, double finest_pair, double next_pair,
+                                  std::size_t fit_points = 3) {
+  cv::OrderCheck check;
+  check.fit_points = fit_points;
+  check.fitted_order = fitted;
+  check.pair_order_finest = finest_pair;
+  check.pair_order_next = next_pair;
+  check.design_order = 2.0;
+  check.tolerance = 0.1;
+  return check;
+}
+}  // namespace
+
+TEST(OrderChecks, EachOrderMustLieWithinTheBand) {
+  const double high_inside = 2.1 - just, low_inside = 1.9 + just;
+  EXPECT_TRUE(second_order_check(high_inside, low_inside, high_inside).pass());
+  EXPECT_TRUE(second_order_check(low_inside, high_inside, low_inside).pass());
+  // Any one of the three orders just outside fails the check on its own.
+  EXPECT_FALSE(second_order_check(2.1 + just, 2.0, 2.0).pass());
+  EXPECT_FALSE(second_order_check(2.0, 1.9 - just, 2.0).pass());
+  EXPECT_FALSE(second_order_check(2.0, 2.0, 2.1 + just).pass());
+  EXPECT_FALSE(second_order_check(1.9 - just, 2.0, 2.0).pass());
+}
+
+TEST(OrderChecks, UndefinedOrdersFailUnlessTheStudyHasTwoLevels) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(second_order_check(2.0, 2.0, nan, 2).pass());  // no next pair to measure
+  EXPECT_FALSE(second_order_check(2.0, 2.0, nan, 3).pass());
+  EXPECT_FALSE(second_order_check(nan, 2.0, 2.0).pass());
+  EXPECT_FALSE(second_order_check(2.0, nan, 2.0).pass());
+  EXPECT_FALSE(second_order_check(2.0, 2.0, std::numeric_limits<double>::infinity()).pass());
+}
+
+namespace {
+cv::GciRow gci_row_with_ratio(double asymptotic_ratio) {
+  cv::GciRow row;
+  row.result.asymptotic_ratio = asymptotic_ratio;
+  row.asymptotic_tolerance = 0.1;
+  return row;
+}
+}  // namespace
+
+TEST(GciRows, AsymptoticRatioMustLieWithinItsToleranceOfOne) {
+  EXPECT_TRUE(gci_row_with_ratio(1.1 - just).pass());
+  EXPECT_TRUE(gci_row_with_ratio(0.9 + just).pass());
+  EXPECT_FALSE(gci_row_with_ratio(1.1 + just).pass());
+  EXPECT_FALSE(gci_row_with_ratio(0.9 - just).pass());
+  EXPECT_FALSE(gci_row_with_ratio(std::numeric_limits<double>::quiet_NaN()).pass());
+}
+
 // The C++ writer and the Python report agree on the schema: a study written by write_study is
 // read by reports/make_convergence_report.py, which marks the passing and failing series.
 TEST(ReportPipeline, StudyWrittenHereIsReadByTheReportGenerator) {
