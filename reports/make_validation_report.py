@@ -396,26 +396,32 @@ def figure7(results, out_dir, link):
 
 # ---- claims and metrics ------------------------------------------------------------------
 
+def _exists(x):
+    return x is not None and not (isinstance(x, float) and math.isnan(x))
+
+
 def value_text(value, error):
     if value is None:
         return "–"
     if isinstance(value, list):
         if error is None or not isinstance(error, list):
             error = [None] * len(value)
-        return "[" + ", ".join(f"{fmt(v)}{pm(e)}" for v, e in zip(value, error)) + "]"
+        return "[" + ", ".join(f"{fmt(v)}{pm(e) if _exists(v) else ''}"
+                               for v, e in zip(value, error)) + "]"
     return f"{fmt(value, 4)}{pm(error)}"
 
 
 def band_text(check):
     c, b = check["comparison"], check["band"]
     return {"range": lambda: f"{b[0]:g} to {b[1]:g}", "all_in_range": lambda:
-            f"all in {b[0]:g} to {b[1]:g}", "less_than": lambda: f"< {b[0]:g}",
+            f"all measured phases in {b[0]:g} to {b[1]:g}", "less_than": lambda: f"< {b[0]:g}",
             "greater_than": lambda: f"> {b[0]:g}", "strictly_increasing":
             lambda: "strictly increasing", "true": lambda: "detected"}[c]()
 
 
 def mark(status):
-    return {"pass": "pass", "fail": "**FAIL**", "inconclusive": "inconclusive"}.get(status, status)
+    return {"pass": "pass", "fail": "**FAIL**", "inconclusive": "inconclusive",
+            "within errors": "within errors"}.get(status, status)
 
 
 def gci_text(results, claim, value):
@@ -454,24 +460,36 @@ def solver_cell(results, claim, solver):
         else:
             bound = " (lower bound)" if ev.get("bound") == "lower" else ""
             grid = gci_text(results, claim, ev["value"]) if solver == "continuum" else ""
+            missed = ev.get("missed_by") or 0.0
+            by = (f", misses the band by {missed:.1f} standard errors"
+                  if ev["status"] == "within errors" else "")
             parts.append(f"{value_text(ev['value'], ev.get('error'))}{grid}{bound} "
-                         f"({mark(ev['status'])})")
+                         f"({mark(ev['status'])}{by})")
     return "; ".join(parts)
 
 
 def claims_section(results):
     gci_source = os.path.relpath(results.gci_path, ROOT) if results.gci_rows else "none found"
     lines = ["## Claims C1 to C20", "",
-             "Bands and claims from reference-data/claims.toml. MD uncertainty: jackknife over "
-             "the pooled single-shock runs, or the spread of a parametric bootstrap of the "
-             "periodic MD profiles over their standard errors (one standard deviation). "
-             "Continuum uncertainty: Roache's grid-convergence index (Fs = 1.25) of the "
-             "1D base-case grid study (verification/mms/test_real_problem.cpp, tables in "
-             f"{gci_source}) at the validation run's cell "
+             "Bands and claims from reference-data/claims.toml. MD uncertainty: one standard "
+             "error, the jackknife over the independent samples (the sampled cycles of a "
+             "periodic run, or the pooled single-shock runs), from `shaker analyze` and "
+             "`shaker compare`; a value quantised to the stored phases or to the bins also "
+             "carries its rounding error, grid step / sqrt(12) (docs/analysis.md). Continuum "
+             "uncertainty: that rounding error where it applies, and Roache's grid-convergence "
+             "index (Fs = 1.25) of the 1D base-case grid study (verification/mms/"
+             f"test_real_problem.cpp, tables in {gci_source}) at the validation run's cell "
              "size, for the claims whose continuum value that study computes (field "
              "continuum_gci of the claim); the study's shortened run (5 transient cycles, "
              "one sampled) estimates the discretisation error only. Other continuum values "
              "carry no uncertainty here.",
+             "",
+             "Verdicts: **pass** when the value meets the band; **within errors** when it "
+             "misses the band by at most 2 standard errors (the data cannot reject the claim; "
+             "a value without an error cannot be within errors); **FAIL** beyond that. A list "
+             "over phases is judged on the phases where it exists (a phase without a shock has "
+             "no width), if they are at least half of them. Why each failing claim fails is "
+             "in the next section.",
              "", "| id | claim | paper | MD | continuum | band | result |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     counts = {}
@@ -491,6 +509,50 @@ def claims_section(results):
                     for n in ev.get("notes", [])})
     lines += [""] + [f"- {n}" for n in notes] + ([""] if notes else [])
     return lines, counts
+
+
+CATEGORY_TEXT = {"a": "(a) the continuum and MD really differ",
+                 "b": "(b) MD does not reproduce the paper's statement",
+                 "c": "(c) a defect of the project still to find or fix"}
+
+
+def measured_text(m):
+    if m.get("status") == "not measured":
+        return f"not measured: {m['reason']}"
+    return value_text(m["value"], m.get("error"))
+
+
+def diagnoses_section(results):
+    """Why each failing claim fails (validation/diagnoses.toml), with its evidence measured
+    on this study's runs."""
+    d = results.data
+    lines = ["## Why the failing claims fail", "",
+             "Each failing claim's reason category and the evidence, measured on this study's "
+             "runs (value ± one standard error); the reasons are the project's findings, kept in "
+             "validation/diagnoses.toml.", ""]
+    for diag in d.get("diagnoses", []):
+        title = diag["claim"] + (f" ({diag['solver']})" if diag.get("solver") else "")
+        status = diag.get("claim_status")
+        lines.append(f"### {title}: {CATEGORY_TEXT[diag['category']]}")
+        lines.append("")
+        if diag.get("stale"):
+            lines += [f"**Stale diagnosis**: the claim is now '{status}', not failing; the "
+                      "reason below was written for a failure.", ""]
+        lines += [" ".join(diag["reason"].split()), ""]
+        solvers = sorted({s for e in diag["evidence"] for s in e["measured"]},
+                         key=["md", "continuum", "md_vs_continuum"].index)
+        if diag["evidence"]:
+            lines += ["| evidence | " + " | ".join(solvers) + " |",
+                      "| --- | " + " | ".join("---" for _ in solvers) + " |"]
+            for e in diag["evidence"]:
+                lines.append(f"| {e['label']} | " + " | ".join(
+                    measured_text(e["measured"][s]) if s in e["measured"] else ""
+                    for s in solvers) + " |")
+            lines.append("")
+    if d.get("undiagnosed"):
+        lines += ["Failing claims without a diagnosis (category (c) until one is found): "
+                  + ", ".join(d["undiagnosed"]), ""]
+    return lines
 
 
 WIDTH_CASES = (("base_bin1", 1.0), ("base_bin0p5", 0.5), ("base_bin0p25", 0.25))
@@ -588,8 +650,8 @@ def main():
     for figure in (figure1, figure2, figure3, figure4, figure5, figure6, figure7):
         body += figure(results, out_dir, link)
     claims, counts = claims_section(results)
-    text = header(results, counts) + body + claims + width_section(results) \
-        + metrics_section(results)
+    text = header(results, counts) + body + claims + diagnoses_section(results) \
+        + width_section(results) + metrics_section(results)
     tmp = args.output + ".partial"
     with open(tmp, "w") as f:
         f.write("\n".join(text) + "\n")

@@ -30,6 +30,27 @@ class Bound:
         self.value, self.kind = value, kind
 
 
+class Quantized:
+    """A value (or list) quantised to a grid: `resolution` is the grid step per value, from
+    `shaker analyze` (its rounding error, resolution / sqrt(12), is part of the uncertainty)."""
+
+    def __init__(self, value, resolution):
+        self.value, self.resolution = value, resolution
+
+
+class Measured:
+    """A value with the standard error `shaker analyze` gives it directly (a count's
+    between-cycle error), used where leave-one-out replicates are not available."""
+
+    def __init__(self, value, error):
+        self.value, self.error = value, error
+
+
+# A value that misses its band by at most this many standard errors is "within errors": the
+# data cannot reject the claim. Beyond it the claim fails.
+REJECTION_ERRORS = 2.0
+
+
 # ---- selecting from one run's analysis table ------------------------------------------------
 
 def _cyclic_distance(a, b):
@@ -75,10 +96,20 @@ class Query:
         return self._compare(self.run(case_a, solver_a), self.run(case_b, solver_b))
 
 
+def _resolutions(view, column, rows):
+    resolution = view.resolution.get(column)
+    return [None if resolution is None or resolution[k] is None else float(resolution[k])
+            for k in rows]
+
+
 # ---- the quantities -----------------------------------------------------------------------
 
+def _per_run(view, name):
+    return Quantized(view.per_run[name], view.per_run_resolution.get(name))
+
+
 def q_shock_formation_phase(q):
-    return q.run(q.cases[0]).per_run["formation_phase"]
+    return _per_run(q.run(q.cases[0]), "formation_phase")
 
 
 def q_shock_exit_phase(q):
@@ -86,20 +117,35 @@ def q_shock_exit_phase(q):
 
 
 def q_width_over_mfp_peak_phase(q):
-    return q.run(q.cases[0]).per_run["width_over_mfp_peak_phase"]
+    return _per_run(q.run(q.cases[0]), "width_over_mfp_peak_phase")
 
 
 def q_width_over_mfp_in_window(q):
+    view = q.run(q.cases[0])
+    idx = _window(view.analysis, q.params["from"], q.params["to"])
+    if not len(idx):
+        raise NotMeasured("no stored phase in the window")
+    return Quantized([float(v) for v in view.analysis["width_over_mfp"][idx]],
+                     _resolutions(view, "width_over_mfp", idx))
+
+
+def q_front_width_over_mfp_in_window(q):
     t = q.table(q.cases[0])
     idx = _window(t, q.params["from"], q.params["to"])
     if not len(idx):
         raise NotMeasured("no stored phase in the window")
-    return [float(v) for v in t["width_over_mfp"][idx]]
+    return [float(v) for v in t["front_width_over_mfp"][idx]]
+
+
+def q_shock_lifetime(q):
+    return _per_run(q.run(q.cases[0]), "lifetime")
 
 
 def q_shock_width_at(q):
-    t = q.table(q.cases[0])
-    return float(t["shock_width"][_row_at(t, q.params["phase"])])
+    view = q.run(q.cases[0])
+    k = _row_at(view.analysis, q.params["phase"])
+    return Quantized(float(view.analysis["shock_width"][k]),
+                     _resolutions(view, "shock_width", [k])[0])
 
 
 def q_max_mach_in_window(q):
@@ -171,7 +217,8 @@ def q_com_mean_excess_of_shallow(q):
 
 
 def q_shock_formation_phase_by_case(q):
-    return [q.run(c).per_run["formation_phase"] for c in q.params["order"]]
+    values = [_per_run(q.run(c), "formation_phase") for c in q.params["order"]]
+    return Quantized([v.value for v in values], [v.resolution for v in values])
 
 
 def q_shock_speed_by_case(q):
@@ -202,8 +249,8 @@ def q_shock_location_fractional_rms(q):
 
 
 def q_particles_per_cycle_above(q):
-    value, _ = q.run(q.cases[0]).particles_per_cycle_above(q.params["height"])
-    return value
+    value, error = q.run(q.cases[0]).particles_per_cycle_above(q.params["height"])
+    return Measured(value, error)
 
 
 def q_collapse_detected(q):
@@ -236,6 +283,8 @@ QUANTITIES = {
     "shock_exit_phase": q_shock_exit_phase,
     "width_over_mfp_peak_phase": q_width_over_mfp_peak_phase,
     "width_over_mfp_in_window": q_width_over_mfp_in_window,
+    "front_width_over_mfp_in_window": q_front_width_over_mfp_in_window,
+    "shock_lifetime": q_shock_lifetime,
     "shock_width_at": q_shock_width_at,
     "max_mach_in_window": q_max_mach_in_window,
     "min_max_mach_in_window": q_min_max_mach_in_window,
@@ -260,6 +309,7 @@ QUANTITIES = {
 # Parameters each quantity needs (checked by validation/check_claims.py).
 REQUIRED_PARAMETERS = {
     "width_over_mfp_in_window": ("from", "to"),
+    "front_width_over_mfp_in_window": ("from", "to"),
     "shock_width_at": ("phase",),
     "max_mach_in_window": ("from", "to"),
     "min_max_mach_in_window": ("from", "to"),
@@ -288,32 +338,74 @@ BAND_LENGTH = {"range": 2, "all_in_range": 2, "less_than": 1, "greater_than": 1,
                "strictly_increasing": 0, "true": 0}
 
 
-def _finite(x):
+def finite(x):
     return x is not None and not (isinstance(x, float) and math.isnan(x))
+
+
+def _measured(values, errors=None):
+    """The (value, error) pairs of a per-phase list where the value exists, if they are at
+    least half of the list (a phase without a shock has no width: not measured there, but a
+    list measured at under half its phases says nothing); else []."""
+    errors = errors or [None] * len(values)
+    pairs = [(v, e) for v, e in zip(values, errors) if finite(v)]
+    return pairs if 2 * len(pairs) >= len(values) else []
 
 
 def check(comparison, band, value):
     """True if the value meets the band."""
     if comparison == "range":
-        return _finite(value) and band[0] <= value <= band[1]
+        return finite(value) and band[0] <= value <= band[1]
     if comparison == "all_in_range":
-        return bool(value) and all(_finite(v) and band[0] <= v <= band[1] for v in value)
+        measured = _measured(value)
+        return bool(measured) and all(band[0] <= v <= band[1] for v, _ in measured)
     if comparison == "less_than":
-        return _finite(value) and value < band[0]
+        return finite(value) and value < band[0]
     if comparison == "greater_than":
-        return _finite(value) and value > band[0]
+        return finite(value) and value > band[0]
     if comparison == "strictly_increasing":
-        return (len(value) >= 2 and all(_finite(v) for v in value)
+        return (len(value) >= 2 and all(finite(v) for v in value)
                 and all(b > a for a, b in zip(value, value[1:])))
     if comparison == "true":
-        return _finite(value) and value == 1.0
+        return finite(value) and value == 1.0
     raise ValueError(f"unknown comparison '{comparison}'")
+
+
+def misses_by(comparison, band, value, error):
+    """By how many standard errors the value misses the band: 0 if it meets it, inf if it
+    misses and has no error. For orderings, the worst adjacent pair (errors combined as
+    independent); for lists in a range, the worst entry."""
+    def sigmas(distance, e):
+        if distance <= 0:
+            return 0.0
+        return distance / e if finite(e) and e > 0 else math.inf
+
+    if comparison == "all_in_range":
+        errors = error if isinstance(error, list) else [None] * len(value)
+        measured = _measured(value, errors)
+        if not measured:
+            return math.inf
+        return max(sigmas(max(band[0] - v, v - band[1]), e) for v, e in measured)
+    if not (finite(value) if not isinstance(value, list) else all(finite(v) for v in value)):
+        return math.inf
+    if comparison == "range":
+        return sigmas(max(band[0] - value, value - band[1]), error)
+    if comparison == "less_than":
+        return sigmas(value - band[0], error)
+    if comparison == "greater_than":
+        return sigmas(band[0] - value, error)
+    errors = error if isinstance(error, list) else [None] * len(value)
+    if comparison == "strictly_increasing":
+        if len(value) < 2:
+            return math.inf
+        return max(sigmas(a - b, math.hypot(ea, eb) if finite(ea) and finite(eb) else None)
+                   for a, b, ea, eb in zip(value, value[1:], errors, errors[1:]))
+    return math.inf
 
 
 def describe_band(comparison, band):
     return {
         "range": lambda: f"{band[0]:g} to {band[1]:g}",
-        "all_in_range": lambda: f"all in {band[0]:g} to {band[1]:g}",
+        "all_in_range": lambda: f"all measured phases in {band[0]:g} to {band[1]:g}",
         "less_than": lambda: f"< {band[0]:g}",
         "greater_than": lambda: f"> {band[0]:g}",
         "strictly_increasing": lambda: "strictly increasing",

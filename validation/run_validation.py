@@ -91,6 +91,7 @@ class RunView:
         self.config = config or {}
         self.analysis, self.errors = None, {}      # per-phase columns and their errors
         self.per_run, self.per_run_errors = {}, {}  # per-run quantities and their errors
+        self.resolution, self.per_run_resolution = {}, {}  # grid steps of quantised values
         self.crossings = {}                       # column -> (per cycle, error)
         self.replicates, self.replicate_kind = [], None
         self.parent, self.replicate_index = None, None
@@ -153,6 +154,10 @@ def fill_view(view, data):
     view.errors = {k: _array(v["error"]) for k, v in data["per_phase"].items()}
     view.per_run = {k: _number(v["value"]) for k, v in data["per_run"].items()}
     view.per_run_errors = {k: _number(v["error"]) for k, v in data["per_run"].items()}
+    view.resolution = {k: v["resolution"] for k, v in data["per_phase"].items()
+                       if v.get("resolution") is not None}
+    view.per_run_resolution = {k: v["resolution"] for k, v in data["per_run"].items()
+                               if v.get("resolution") is not None}
     view.crossings = {k: (_number(v["value"]), _number(v["error"]))
                       for k, v in data["crossings"].items()}
     count = data["samples"] if data["samples"] >= 2 else 0
@@ -163,7 +168,9 @@ def fill_view(view, data):
         rep.parent, rep.replicate_index = view, i
         rep.analysis = {k: _array(v["replicates"][i]) for k, v in data["per_phase"].items()}
         rep.per_run = {k: _number(v["replicates"][i]) for k, v in data["per_run"].items()}
-        rep.crossings = view.crossings
+        rep.resolution, rep.per_run_resolution = view.resolution, view.per_run_resolution
+        rep.crossings = {k: (_number(v["replicates"][i]) if len(v.get("replicates", [])) == count
+                             else math.nan, math.nan) for k, v in data["crossings"].items()}
         view.replicates.append(rep)
 
 
@@ -362,40 +369,56 @@ def _spread(kind, values):
 
 
 def _as_plain(value):
-    if isinstance(value, quantities.Bound):
-        return value.value
+    if isinstance(value, (quantities.Bound, quantities.Quantized, quantities.Measured)):
+        return _as_plain(value.value)
     return value
 
 
-def evaluate(check_spec, claim, solver, views, comparer, partial_cases_ok):
-    """Value, uncertainty, pass/fail (or not measured) of one check of a claim in one solver
-    ('md_vs_continuum' for pair claims)."""
-    fn = quantities.QUANTITIES[check_spec["quantity"]]
-    params = check_spec.get("parameters", {})
+def _with_rounding(error, value, resolution):
+    """The sampling error combined with the rounding error of a quantised value."""
+    def one(e, v, r):
+        rounding = r / math.sqrt(12.0) if r is not None and quantities.finite(v) else None
+        if rounding is None:
+            return e
+        return rounding if e is None else math.hypot(e, rounding)
+    if resolution is None:
+        return error
+    if isinstance(value, list):
+        errors = error if isinstance(error, list) else [None] * len(value)
+        return [one(e, v, r) for e, v, r in zip(errors, value, resolution)]
+    return one(error, value, resolution)
+
+
+
+def measure(quantity, params, cases, solver, views, comparer, partial_cases_ok):
+    """Value and uncertainty of one quantity of the given cases in one solver
+    ('md_vs_continuum' for pair quantities): dict(value, error, bound, resolution, notes), or
+    dict(value=None, status="not measured", reason)."""
+    fn = quantities.QUANTITIES[quantity]
 
     def query(replicate):
         def get_run(case, s):
             view = views.get((case, s))
-            if view is None or view.status != "ok" and check_spec["quantity"] != \
-                    "collapse_detected":
+            if view is None or view.status != "ok" and quantity != "collapse_detected":
                 return None
             if replicate is not None and view.replicates:
                 return view.replicates[replicate]
             return view
-        return quantities.Query(get_run, comparer, solver, claim["cases"], params,
-                                partial_cases_ok)
+        return quantities.Query(get_run, comparer, solver, cases, params, partial_cases_ok)
 
     try:
         value = fn(query(None))
     except quantities.NotMeasured as reason:
-        missing = [f"{s} {c}: {views[(c, s)].status}" for c in claim["cases"]
+        missing = [f"{s} {c}: {views[(c, s)].status}" for c in cases
                    for s in SOLVERS if (c, s) in views and views[(c, s)].status != "ok"]
         return dict(value=None, status="not measured", reason=str(reason)
                     + (f" ({'; '.join(missing)})" if missing else ""))
     bound = value.kind if isinstance(value, quantities.Bound) else None
+    resolution = value.resolution if isinstance(value, quantities.Quantized) else None
+    direct_error = value.error if isinstance(value, quantities.Measured) else None
     value = _as_plain(value)
     # Uncertainty: the same quantity on every replicate of the MD views involved.
-    involved = [v for (c, s), v in views.items() if c in claim["cases"] and v.replicates
+    involved = [v for (c, s), v in views.items() if c in cases and v.replicates
                 and (solver in (s, "md_vs_continuum"))]
     error = None
     if involved and isinstance(value, (float, list)):
@@ -414,15 +437,42 @@ def evaluate(check_spec, claim, solver, views, comparer, partial_cases_ok):
             error = [_spread(kind, [r[i] for r in reps if len(r) == len(value)])
                      for i in range(len(value))]
             error = [None if math.isnan(e) else e for e in error]
+    if error is None and quantities.finite(direct_error):
+        error = direct_error
+    notes = sorted({n for (c, s), v in views.items() if c in cases
+                    and solver in (s, "md_vs_continuum") for n in v.notes})
+    return dict(value=value, error=_with_rounding(error, value, resolution), bound=bound,
+                notes=notes)
+
+
+def evaluate(check_spec, claim, solver, views, comparer, partial_cases_ok):
+    """Value, uncertainty and verdict of one check of a claim in one solver: pass, within
+    errors (misses the band by at most REJECTION_ERRORS standard errors), fail, inconclusive
+    (a bound that cannot decide) or not measured."""
+    m = measure(check_spec["quantity"], check_spec.get("parameters", {}), claim["cases"], solver,
+                views, comparer, partial_cases_ok)
+    if m.get("status") == "not measured":
+        return m
+    value, error, bound = m["value"], m["error"], m["bound"]
     passed = quantities.check(check_spec["comparison"], check_spec["band"], value)
-    status = "pass" if passed else "fail"
+    missed_by = 0.0 if passed else quantities.misses_by(check_spec["comparison"],
+                                                        check_spec["band"], value, error)
+    status = ("pass" if passed else "within errors"
+              if missed_by <= quantities.REJECTION_ERRORS else "fail")
     if bound == "lower" and check_spec["comparison"] == "less_than" and passed:
         status = "inconclusive"
     if bound == "lower" and check_spec["comparison"] == "greater_than" and not passed:
         status = "inconclusive"
-    notes = sorted({n for (c, s), v in views.items() if c in claim["cases"]
-                    and solver in (s, "md_vs_continuum") for n in v.notes})
-    return dict(value=value, error=error, status=status, bound=bound, notes=notes)
+    return dict(m, status=status, missed_by=missed_by)
+
+
+# A claim's status is the worst of its checks' statuses, in this order.
+STATUS_ORDER = ["fail", "not measured", "within errors", "inconclusive", "pass"]
+
+
+def worst_status(statuses):
+    statuses = list(statuses)
+    return next((s for s in STATUS_ORDER if s in statuses), "pass")
 
 
 def evaluate_claims(claims, views, comparer, partial_cases_ok):
@@ -436,15 +486,90 @@ def evaluate_claims(claims, views, comparer, partial_cases_ok):
         for solver in solvers:
             evaluations = [evaluate(c, claim, solver, views, comparer, partial_cases_ok)
                            for c in checks]
-            statuses = [e["status"] for e in evaluations]
-            overall = ("fail" if "fail" in statuses else "not measured" if "not measured" in
-                       statuses else "inconclusive" if "inconclusive" in statuses else "pass")
-            per_solver[solver] = dict(status=overall, checks=evaluations)
-        statuses = [s["status"] for s in per_solver.values()]
-        overall = ("fail" if "fail" in statuses else "not measured" if "not measured" in
-                   statuses else "inconclusive" if "inconclusive" in statuses else "pass")
+            per_solver[solver] = dict(status=worst_status(e["status"] for e in evaluations),
+                                      checks=evaluations)
+        overall = worst_status(s["status"] for s in per_solver.values())
         results.append(dict(claim, checks=checks, per_solver=per_solver, status=overall))
     return results
+
+
+# ---- diagnoses of failing claims ----------------------------------------------------------
+
+CATEGORIES = {"a": "the continuum and MD really differ",
+              "b": "MD does not reproduce the paper's statement",
+              "c": "a defect of the project still to find or fix"}
+
+
+def validate_diagnoses(diagnoses, claims, studies):
+    """Problems of validation/diagnoses.toml: a claim id (or 'Fig. N') the claims file has, a
+    category a/b/c, a reason, and evidence of known quantities with the parameters they need,
+    on cases validation/studies.toml runs with the solvers named."""
+    errors = []
+    ids = {c["id"] for c in claims}
+    runs = {c["name"]: set(c["solvers"]) for c in studies["case"]}
+    for d in diagnoses:
+        where = f"diagnosis of {d.get('claim')}"
+        if d.get("claim") not in ids and not str(d.get("claim", "")).startswith("Fig. "):
+            errors.append(f"{where}: no such claim (allowed: C1 .. C20 or 'Fig. N')")
+        if d.get("category") not in CATEGORIES:
+            errors.append(f"{where}: category must be one of {', '.join(CATEGORIES)}")
+        if not str(d.get("reason", "")).strip():
+            errors.append(f"{where}: no reason")
+        for item in d.get("evidence", []):
+            q = item.get("quantity")
+            if q not in quantities.QUANTITIES:
+                errors.append(f"{where}: unknown quantity {q!r}")
+                continue
+            missing = [n for n in quantities.REQUIRED_PARAMETERS.get(q, ())
+                       if n not in item.get("parameters", {})]
+            if missing:
+                errors.append(f"{where}: quantity {q!r} needs parameter(s) {missing}")
+            solvers = {s for s in item.get("solvers", SOLVERS) if s != "md_vs_continuum"}
+            for case in item.get("cases", []):
+                if case not in runs:
+                    errors.append(f"{where}: case {case!r} is not in validation/studies.toml")
+                elif "solvers" in item and not solvers <= runs[case]:
+                    errors.append(f"{where}: case {case!r} is not run with "
+                                  f"{sorted(solvers - runs[case])}")
+            if not item.get("cases"):
+                errors.append(f"{where}: evidence {item.get('label')!r} names no case")
+    return errors
+
+
+def load_diagnoses(path, claims, studies):
+    """validation/diagnoses.toml; raises ValueError naming every problem."""
+    diagnoses = load_toml(path).get("diagnosis", [])
+    errors = validate_diagnoses(diagnoses, claims, studies)
+    if errors:
+        raise ValueError(f"{path}: " + "; ".join(errors))
+    return diagnoses
+
+
+def evidence_solvers(item, views):
+    if "solvers" in item:
+        return item["solvers"]
+    return [s for s in SOLVERS if any((c, s) in views for c in item["cases"])]
+
+
+def diagnose(diagnoses, results, views, comparer, partial_cases_ok):
+    """Measures the evidence of every diagnosis and ties it to its claim's status: a
+    diagnosis of a claim that no longer fails is marked stale; a failing claim without one is
+    listed as undiagnosed."""
+    status = {c["id"]: c["status"] for c in results}
+    out = []
+    for d in diagnoses:
+        evidence = []
+        for item in d.get("evidence", []):
+            measured = {s: measure(item["quantity"], item.get("parameters", {}), item["cases"], s,
+                                   views, comparer, partial_cases_ok)
+                        for s in evidence_solvers(item, views)}
+            evidence.append(dict(label=item["label"], measured=measured))
+        claim_status = status.get(d["claim"])
+        out.append(dict(d, evidence=evidence, claim_status=claim_status,
+                        stale=claim_status is not None and claim_status != "fail"))
+    diagnosed = {d["claim"] for d in diagnoses}
+    undiagnosed = [c["id"] for c in results if c["status"] == "fail" and c["id"] not in diagnosed]
+    return out, undiagnosed
 
 
 # ---- main ------------------------------------------------------------------------------------
@@ -505,6 +630,7 @@ def main(argv=None):
     parser.add_argument("--gci", help="GCI table of the base-case grid study (continuum "
                                       "uncertainty; default: the report generator's)")
     parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
+    parser.add_argument("--diagnoses", default=os.path.join(HERE, "diagnoses.toml"))
     parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
     parser.add_argument("--require", default="",
                         help="comma-separated claim ids that must pass (else exit status 1); "
@@ -519,6 +645,10 @@ def main(argv=None):
     os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
     studies = load_studies(args.studies)
     claims = load_toml(args.claims)["claim"]
+    try:
+        diagnoses = load_diagnoses(args.diagnoses, claims, studies)
+    except ValueError as error:
+        parser.error(str(error))
     if args.cases:
         names = [c.strip() for c in args.cases.split(",") if c.strip()]
     elif args.quick:
@@ -549,6 +679,7 @@ def main(argv=None):
                 metrics[name] = {"error": str(reason)}
     partial = bool(args.cases) or args.quick
     results = evaluate_claims(claims, views, comparer, partial)
+    diagnosed, undiagnosed = diagnose(diagnoses, results, views, comparer, partial)
 
     runs = [dict(case=r["case"], solver=r["solver"], member=r["member"],
                  status=r["record"]["status"], seconds=r["record"]["seconds"],
@@ -565,7 +696,8 @@ def main(argv=None):
                                       text=True).stdout.strip(),
         wall_seconds=time.monotonic() - started,
         simulated_seconds=sum(r["seconds"] for r in runs if not r["reused"]),
-        runs=runs, metrics=metrics, claims=results,
+        runs=runs, metrics=metrics, claims=results, diagnoses=diagnosed,
+        undiagnosed=undiagnosed,
         views={f"{c}/{s}": dict(case=c, solver=s, status=v.status, path=v.path,
                                 analysis_json=getattr(v, "analysis_json", None),
                                 shock_speed=v.shock_speed,

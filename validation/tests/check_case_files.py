@@ -25,6 +25,8 @@ import run_validation  # noqa: E402
 EXPECTED = {
     "base": {"layer.particles": 3937, "material.e": 0.9, "continuum.ceiling": 80.0,
              "md.box_width": 20.0, "run.protocol": "periodic"},
+    "base_seed2": {"layer.particles": 3937, "material.e": 0.9, "md.box_width": 20.0,
+                   "run.protocol": "periodic", "run.seed": 2, "run.sampled_cycles": 10},
     "depth_h4p5": {"layer.particles": 1969, "continuum.ceiling": 200.0},
     "depth_h13p5": {"layer.particles": 5906, "continuum.ceiling": 80.0},
     "continuum_ceiling200": {"continuum.ceiling": 200.0, "layer.particles": 3937},

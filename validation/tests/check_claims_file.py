@@ -2,7 +2,8 @@
 """ctest validation.claims_file: reference-data/claims.toml holds C1..C20, each once, with
 every field, a quantity the runner knows (validation/quantities.py) and the parameters it
 needs, a known comparison with a band of the right shape, cases that validation/studies.toml
-runs with the solvers the claim needs, and a provenance in the paper.
+runs with the solvers the claim needs, and a provenance in the paper; and that
+validation/diagnoses.toml names known claims, categories, quantities and cases.
 
 It then checks that the checker itself catches broken files (a missing field, an unknown
 quantity, a band of the wrong length, a missing id, a case nobody runs), so that a pass means
@@ -18,6 +19,7 @@ VALIDATION = os.path.dirname(HERE)
 ROOT = os.path.dirname(VALIDATION)
 sys.path.insert(0, VALIDATION)
 import quantities  # noqa: E402
+import run_validation  # noqa: E402
 
 FIELDS = {"id": str, "statement": str, "paper_value": str, "cases": list, "quantity": str,
           "parameters": dict, "comparison": str, "band": list, "solvers": str,
@@ -118,6 +120,41 @@ def broken_copies(claims):
     ]
 
 
+def broken_diagnoses(diagnoses):
+    """(description, broken diagnoses) pairs the diagnoses check must reject."""
+    def edit(fn):
+        d = copy.deepcopy(diagnoses)
+        fn(d)
+        return d
+    return [
+        ("unknown claim", edit(lambda d: d[0].update(claim="C21"))),
+        ("unknown category", edit(lambda d: d[0].update(category="d"))),
+        ("no reason", edit(lambda d: d[0].update(reason=" "))),
+        ("unknown evidence quantity", edit(lambda d: d[0]["evidence"][0].update(quantity="x"))),
+        ("evidence on a case nobody runs",
+         edit(lambda d: d[0]["evidence"][0].update(cases=["no_such_case"]))),
+        ("evidence missing a parameter",
+         edit(lambda d: d[0]["evidence"][1].update(parameters={}))),
+    ]
+
+
+def check_diagnoses(claims, studies):
+    """validation/diagnoses.toml is clean, and its checker catches broken copies."""
+    with open(os.path.join(VALIDATION, "diagnoses.toml"), "rb") as f:
+        diagnoses = tomllib.load(f)["diagnosis"]
+    errors = run_validation.validate_diagnoses(diagnoses, claims, studies)
+    for e in errors:
+        print(f"diagnoses.toml: {e}")
+    print(f"diagnoses.toml: {len(diagnoses)} diagnoses, {len(errors)} problems")
+    failures = len(errors)
+    for description, broken in broken_diagnoses(diagnoses):
+        found = run_validation.validate_diagnoses(broken, claims, studies)
+        print(f"broken diagnoses ({description}): {len(found)} problem(s) found"
+              + (f": {found[0]}" if found else " -- NOT CAUGHT"))
+        failures += 0 if found else 1
+    return failures
+
+
 def main():
     with open(os.path.join(ROOT, "reference-data", "claims.toml"), "rb") as f:
         claims = tomllib.load(f)["claim"]
@@ -134,6 +171,7 @@ def main():
         print(f"broken copy ({description}): {len(found)} problem(s) found"
               + (f": {found[0]}" if found else " -- NOT CAUGHT"))
         failures += 0 if found else 1
+    failures += check_diagnoses(claims, studies)
     return 1 if failures else 0
 
 
