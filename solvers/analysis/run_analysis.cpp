@@ -120,6 +120,36 @@ double temperature_slope_above(const Profile& p, const std::optional<Layer>& lay
   return z.size() >= 3 ? fitted_slope(z, T).first : nan;
 }
 
+double median(std::vector<double> v) {
+  const auto middle = v.begin() + static_cast<long>(v.size() / 2);
+  std::nth_element(v.begin(), middle, v.end());
+  if (v.size() % 2 == 1) return *middle;
+  return 0.5 * (*middle + *std::max_element(v.begin(), middle));
+}
+
+/// The least-squares slope of y(x) and its standard error after dropping outliers: points
+/// farther from the Theil-Sen line (median of the pairwise slopes, which a few outliers do
+/// not move) than 4 robust standard deviations (1.4826 x the median absolute residual) and
+/// `floor`. A shock rule that mistakes noise near the plate for the front at one phase of
+/// the life gives such a point, and one is enough to bias a slope through ten phases by a
+/// tenth.
+std::pair<double, double> robust_slope(const std::vector<double>& x, const std::vector<double>& y,
+                                       double floor) {
+  if (x.size() < 4) return fitted_slope(x, y);
+  std::vector<double> slopes, offsets, magnitude;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (std::size_t j = i + 1; j < x.size(); ++j) slopes.push_back((y[j] - y[i]) / (x[j] - x[i]));
+  const double slope = median(slopes);
+  for (std::size_t k = 0; k < x.size(); ++k) offsets.push_back(y[k] - slope * x[k]);
+  const double offset = median(offsets);
+  for (std::size_t k = 0; k < x.size(); ++k) magnitude.push_back(std::abs(offsets[k] - offset));
+  const double limit = std::max(4.0 * 1.4826 * median(magnitude), floor);
+  std::vector<double> xi, yi;
+  for (std::size_t k = 0; k < x.size(); ++k)
+    if (magnitude[k] <= limit) xi.push_back(x[k]), yi.push_back(y[k]);
+  return fitted_slope(xi.size() >= 3 ? xi : x, xi.size() >= 3 ? yi : y);
+}
+
 /// 2 c of the least-squares parabola a + b x + c x^2.
 double fitted_curvature(const std::vector<double>& x, const std::vector<double>& y) {
   if (x.size() < 4) return nan;
@@ -142,7 +172,7 @@ double fitted_curvature(const std::vector<double>& x, const std::vector<double>&
 }
 
 std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
-                                    const AnalysisOptions& o) {
+                                    const AnalysisOptions& o, double bin_height) {
   const auto life = longest_life(q, o.periodic);
   if (life.empty()) return std::nullopt;
   ShockLife s;
@@ -182,7 +212,13 @@ std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
   s.exit_phase = std::clamp(exit, phase.back(), next_phase);
   if (!o.periodic && last + 1 == m) s.exit_phase = nan;  // the run ended with the shock inside
   s.lifetime = s.exit_phase - s.formation_phase;
-  if (t.size() >= 2) std::tie(s.speed, s.speed_fit_error) = fitted_slope(t, height);
+  // A front within a bin and a half of the plate sits in the lowest bins, whatever its true
+  // height: those phases locate the bin, not the front, and are left out of the speed's fit.
+  std::vector<double> t_resolved, height_resolved;
+  for (std::size_t j = 0; j < t.size(); ++j)
+    if (height[j] >= 1.5 * bin_height) t_resolved.push_back(t[j]), height_resolved.push_back(height[j]);
+  if (t_resolved.size() >= 3) std::tie(s.speed, s.speed_fit_error) = robust_slope(t_resolved, height_resolved, bin_height);
+  else if (t.size() >= 2) std::tie(s.speed, s.speed_fit_error) = robust_slope(t, height, bin_height);
   else s.speed = s.speed_fit_error = nan;
   s.curvature = fitted_curvature(t, location);
   return s;
@@ -221,7 +257,7 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
   }
   r.center_of_mass_mean = com / static_cast<double>(r.phases.size());
   r.bin_height = profiles.front().bin_height;
-  r.shock = shock_life(r.phases, options);
+  r.shock = shock_life(r.phases, options, r.bin_height);
   r.width_over_mfp_peak_phase = nan;
   if (r.shock) {
     double best = -1.0;
