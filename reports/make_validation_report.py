@@ -421,7 +421,7 @@ def band_text(check):
 
 def mark(status):
     return {"pass": "pass", "fail": "**FAIL**", "inconclusive": "inconclusive",
-            "within errors": "within errors"}.get(status, status)
+            "unresolved": "unresolved"}.get(status, status)
 
 
 def gci_text(results, claim, value):
@@ -460,9 +460,11 @@ def solver_cell(results, claim, solver):
         else:
             bound = " (lower bound)" if ev.get("bound") == "lower" else ""
             grid = gci_text(results, claim, ev["value"]) if solver == "continuum" else ""
-            missed = ev.get("missed_by") or 0.0
-            by = (f", misses the band by {missed:.1f} standard errors"
-                  if ev["status"] == "within errors" else "")
+            inside = ev.get("margin")
+            by = ""
+            if ev["status"] == "unresolved" and inside is not None:
+                by = (f", inside the band by {inside:.1f} standard errors" if inside >= 0
+                      else f", outside the band by {-inside:.1f} standard errors")
             parts.append(f"{value_text(ev['value'], ev.get('error'))}{grid}{bound} "
                          f"({mark(ev['status'])}{by})")
     return "; ".join(parts)
@@ -484,9 +486,11 @@ def claims_section(results):
              "one sampled) estimates the discretisation error only. Other continuum values "
              "carry no uncertainty here.",
              "",
-             "Verdicts: **pass** when the value meets the band; **within errors** when it "
-             "misses the band by at most 2 standard errors (the data cannot reject the claim; "
-             "a value without an error cannot be within errors); **FAIL** beyond that. A list "
+             "Verdicts: **pass** when the value lies inside the band by more than 2 standard "
+             "errors; **FAIL** when it lies outside by more than 2; **unresolved** in between "
+             "(the data cannot decide at that level; the margin is given in standard errors). "
+             "A value without an error is judged on its value alone. An ordering is judged on "
+             "its smallest step over the step's error. A list "
              "over phases is judged on the phases where it exists (a phase without a shock has "
              "no width), if they are at least half of them. Why each failing claim fails is "
              "in the next section.",

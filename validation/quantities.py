@@ -46,9 +46,9 @@ class Measured:
         self.value, self.error = value, error
 
 
-# A value that misses its band by at most this many standard errors is "within errors": the
-# data cannot reject the claim. Beyond it the claim fails.
-REJECTION_ERRORS = 2.0
+# A claim passes when its value lies inside the band by more than this many standard errors,
+# fails when it lies outside by more; in between the data cannot decide ("unresolved").
+DECISION_ERRORS = 2.0
 
 
 # ---- selecting from one run's analysis table ------------------------------------------------
@@ -370,36 +370,45 @@ def check(comparison, band, value):
     raise ValueError(f"unknown comparison '{comparison}'")
 
 
-def misses_by(comparison, band, value, error):
-    """By how many standard errors the value misses the band: 0 if it meets it, inf if it
-    misses and has no error. For orderings, the worst adjacent pair (errors combined as
-    independent); for lists in a range, the worst entry."""
+def margin(comparison, band, value, error):
+    """How many standard errors the value lies inside its band (negative: outside): +inf or
+    -inf for a value without an error, -inf for a missing one. For orderings, the smallest
+    step over its error (errors of neighbours combined as independent); for lists in a
+    range, the worst measured entry. `true` comparisons have no error: +-inf."""
     def sigmas(distance, e):
-        if distance <= 0:
-            return 0.0
-        return distance / e if finite(e) and e > 0 else math.inf
+        if finite(e) and e > 0:
+            return distance / e
+        return math.inf if distance > 0 else -math.inf
+
+    def in_range(v, e):
+        return sigmas(min(v - band[0], band[1] - v), e)
 
     if comparison == "all_in_range":
         errors = error if isinstance(error, list) else [None] * len(value)
         measured = _measured(value, errors)
-        if not measured:
-            return math.inf
-        return max(sigmas(max(band[0] - v, v - band[1]), e) for v, e in measured)
+        return min((in_range(v, e) for v, e in measured), default=-math.inf)
     if not (finite(value) if not isinstance(value, list) else all(finite(v) for v in value)):
-        return math.inf
+        return -math.inf
     if comparison == "range":
-        return sigmas(max(band[0] - value, value - band[1]), error)
+        return in_range(value, error)
     if comparison == "less_than":
-        return sigmas(value - band[0], error)
-    if comparison == "greater_than":
         return sigmas(band[0] - value, error)
-    errors = error if isinstance(error, list) else [None] * len(value)
+    if comparison == "greater_than":
+        return sigmas(value - band[0], error)
     if comparison == "strictly_increasing":
+        errors = error if isinstance(error, list) else [None] * len(value)
         if len(value) < 2:
-            return math.inf
-        return max(sigmas(a - b, math.hypot(ea, eb) if finite(ea) and finite(eb) else None)
+            return -math.inf
+        return min(sigmas(b - a, math.hypot(ea, eb) if finite(ea) and finite(eb) else None)
                    for a, b, ea, eb in zip(value, value[1:], errors, errors[1:]))
-    return math.inf
+    return math.inf if check(comparison, band, value) else -math.inf
+
+
+def verdict(inside):
+    """pass, fail or unresolved for a value `inside` standard errors inside its band."""
+    if inside > DECISION_ERRORS:
+        return "pass"
+    return "fail" if inside < -DECISION_ERRORS else "unresolved"
 
 
 def describe_band(comparison, band):

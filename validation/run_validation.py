@@ -446,28 +446,27 @@ def measure(quantity, params, cases, solver, views, comparer, partial_cases_ok):
 
 
 def evaluate(check_spec, claim, solver, views, comparer, partial_cases_ok):
-    """Value, uncertainty and verdict of one check of a claim in one solver: pass, within
-    errors (misses the band by at most REJECTION_ERRORS standard errors), fail, inconclusive
-    (a bound that cannot decide) or not measured."""
+    """Value, uncertainty and verdict of one check of a claim in one solver: pass (inside the
+    band by more than DECISION_ERRORS standard errors), fail (outside by more), unresolved
+    (in between: the data cannot decide), inconclusive (a bound that cannot decide) or not
+    measured."""
     m = measure(check_spec["quantity"], check_spec.get("parameters", {}), claim["cases"], solver,
                 views, comparer, partial_cases_ok)
     if m.get("status") == "not measured":
         return m
     value, error, bound = m["value"], m["error"], m["bound"]
     passed = quantities.check(check_spec["comparison"], check_spec["band"], value)
-    missed_by = 0.0 if passed else quantities.misses_by(check_spec["comparison"],
-                                                        check_spec["band"], value, error)
-    status = ("pass" if passed else "within errors"
-              if missed_by <= quantities.REJECTION_ERRORS else "fail")
+    inside = quantities.margin(check_spec["comparison"], check_spec["band"], value, error)
+    status = quantities.verdict(inside)
     if bound == "lower" and check_spec["comparison"] == "less_than" and passed:
         status = "inconclusive"
     if bound == "lower" and check_spec["comparison"] == "greater_than" and not passed:
         status = "inconclusive"
-    return dict(m, status=status, missed_by=missed_by)
+    return dict(m, status=status, margin=inside)
 
 
 # A claim's status is the worst of its checks' statuses, in this order.
-STATUS_ORDER = ["fail", "not measured", "within errors", "inconclusive", "pass"]
+STATUS_ORDER = ["fail", "not measured", "unresolved", "inconclusive", "pass"]
 
 
 def worst_status(statuses):

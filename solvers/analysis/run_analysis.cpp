@@ -212,13 +212,13 @@ std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
   s.exit_phase = std::clamp(exit, phase.back(), next_phase);
   if (!o.periodic && last + 1 == m) s.exit_phase = nan;  // the run ended with the shock inside
   s.lifetime = s.exit_phase - s.formation_phase;
-  // A front within a bin and a half of the plate sits in the lowest bins, whatever its true
+  // A front within two bins of the plate sits in the lowest bins, whatever its true
   // height: those phases locate the bin, not the front, and are left out of the speed's fit.
   std::vector<double> t_resolved, height_resolved;
   for (std::size_t j = 0; j < t.size(); ++j)
-    if (height[j] >= 1.5 * bin_height) t_resolved.push_back(t[j]), height_resolved.push_back(height[j]);
-  if (t_resolved.size() >= 3) std::tie(s.speed, s.speed_fit_error) = robust_slope(t_resolved, height_resolved, bin_height);
-  else if (t.size() >= 2) std::tie(s.speed, s.speed_fit_error) = robust_slope(t, height, bin_height);
+    if (height[j] >= 2.0 * bin_height) t_resolved.push_back(t[j]), height_resolved.push_back(height[j]);
+  if (t_resolved.size() >= 3) std::tie(s.speed, s.speed_fit_error) = robust_slope(t_resolved, height_resolved, 2.0 * bin_height);
+  else if (t.size() >= 2) std::tie(s.speed, s.speed_fit_error) = robust_slope(t, height, 2.0 * bin_height);
   else s.speed = s.speed_fit_error = nan;
   s.curvature = fitted_curvature(t, location);
   return s;
