@@ -181,29 +181,6 @@ PhaseSummary summarize(const Profile& p, double e) {
   return s;
 }
 
-std::optional<double> shock_speed(const std::vector<Profile>& profiles, const ShockCriteria& c) {
-  std::vector<double> t, h;
-  for (const auto& p : profiles) {
-    const auto shock = find_shock(p, c);
-    if (shock) {
-      t.push_back(p.time);
-      h.push_back(shock->location - p.plate_z);
-    } else if (!t.empty()) {
-      break;
-    }
-  }
-  if (t.size() < 2) return std::nullopt;
-  const double n = static_cast<double>(t.size());
-  const double tm = std::accumulate(t.begin(), t.end(), 0.0) / n;
-  const double hm = std::accumulate(h.begin(), h.end(), 0.0) / n;
-  double sth = 0.0, stt = 0.0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    sth += (t[k] - tm) * (h[k] - hm);
-    stt += (t[k] - tm) * (t[k] - tm);
-  }
-  return sth / stt;
-}
-
 SeriesDifference series_difference(const std::vector<double>& a, const std::vector<double>& b) {
   if (a.size() != b.size()) throw std::invalid_argument("series_difference: lengths differ");
   SeriesDifference d;

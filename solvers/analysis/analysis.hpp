@@ -63,11 +63,6 @@ struct PhaseSummary {
 };
 PhaseSummary summarize(const Profile& p, double e);
 
-/// Average shock speed in the plate frame from the phases where a shock exists: the slope
-/// of a least-squares line through (t, location - plate_z) over the first contiguous run of
-/// phases with a shock. Nothing if fewer than two phases have one.
-std::optional<double> shock_speed(const std::vector<Profile>& profiles,
-                                  const ShockCriteria& criteria = {});
 
 // ---- Agreement metrics ------------------------------------------------------------------
 
