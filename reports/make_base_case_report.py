@@ -10,6 +10,7 @@ import datetime
 import os
 import platform
 import sys
+import tomllib
 
 import h5py
 import matplotlib
@@ -27,6 +28,16 @@ def read_run(path):
         attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
         profiles = {k: np.array(f["profiles"][k]) for k in f["profiles"]}
     return attrs, profiles
+
+
+def resolution(attrs):
+    """The run's spatial resolution as its configuration records it: the continuum's cell
+    size, or the MD's sampling bin height (ci/base-case.sh runs the continuum at a coarser cell
+    than the case file's, for speed)."""
+    config = tomllib.loads(attrs.get("configuration", ""))
+    if attrs.get("solver") == "continuum":
+        return f"cell {config['continuum']['cell_size']:g} sigma"
+    return f"bins {config['md']['bin_height']:g} sigma"
 
 
 def read_analysis(path):
@@ -103,12 +114,14 @@ def main():
     lines += [f"- date: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M UTC}",
               f"- machine: {platform.node()} ({platform.machine()}, {os.cpu_count()} cores)",
               f"- commit: {commit}", ""]
-    lines += ["| solver | status | wall time (s) | model variant |", "| --- | --- | --- | --- |"]
+    lines += ["| solver | status | wall time (s) | model variant | resolution |",
+              "| --- | --- | --- | --- | --- |"]
     for solver in SOLVERS:
         state, _, ms = status.get(solver, "not run:0").partition(":")
         variant = runs[solver][0].get("model_variant", "") if solver in runs else ""
         shown = {"ok": "ran", "unavailable": "not implemented yet"}.get(state, state)
-        lines.append(f"| {solver} | {shown} | {int(ms) / 1000:.1f} | {variant} |")
+        lines.append(f"| {solver} | {shown} | {int(ms) / 1000:.1f} | {variant} | "
+                     f"{resolution(runs[solver][0]) if solver in runs else ''} |")
     lines.append("")
     for solver in SOLVERS:
         log = os.path.join(args.runs, f"{solver}.log")

@@ -233,6 +233,9 @@ def pm(error):
     return f" ± {fmt(error, 2)}" if error is not None else ""
 
 
+MACH_PLOT_MIN_NU = 1e-3  # Fig. 3 draws Ma(z) only where nu exceeds this
+
+
 def figure3(results, out_dir, link):
     needs = [("base", "md"), ("base", "continuum")]
     text = ["## Fig. 3: Mach number and 10 nu against height at f t = 0.22 (base case)", ""]
@@ -248,7 +251,10 @@ def figure3(results, out_dir, link):
         ax.plot(10 * prof["nu"][k], prof["z"][k], label=f"{solver} 10 nu", **STYLE[solver])
         if "mach" in prof:
             has_profile = True
-            ax.plot(prof["mach"][k], prof["z"][k], label=f"{solver} Ma",
+            # Ma of a nearly empty bin (a few particles in the dilute gas) is meaningless and
+            # can reach 1e8: drawn only where there is material.
+            dense = prof["nu"][k] > MACH_PLOT_MIN_NU
+            ax.plot(prof["mach"][k][dense], prof["z"][k][dense], label=f"{solver} Ma",
                     **(dict(ls="none", marker="^", ms=4) if solver == "md" else dict(ls="--")))
         if not math.isnan(table["shock_location"][k]):
             ax.plot([table["max_mach"][k]], [table["shock_location"][k]], "r^" if solver == "md"
@@ -265,6 +271,7 @@ def figure3(results, out_dir, link):
     note = ("" if has_profile else " The Mach-number profile Ma(z) is not drawn: `shaker analyze` "
             "prints only the maximum Ma in the layer, which the paper locates at the leading "
             "edge of the shock; it is drawn there.")
+    note += f" Ma is drawn where nu > {MACH_PLOT_MIN_NU:g}."
     return text + ["Lines continuum, markers MD." + note, "", f"![Fig. 3]({link}/{name})", ""] \
         + rows + [""]
 
