@@ -129,6 +129,19 @@ def q_width_over_mfp_in_window(q):
                      _resolutions(view, "width_over_mfp", idx))
 
 
+def _at(q, column):
+    t = q.table(q.cases[0])
+    return float(t[column][_row_at(t, q.params["phase"])])
+
+
+def q_shock_location_at(q):
+    return _at(q, "shock_location")
+
+
+def q_center_of_mass_at(q):
+    return _at(q, "center_of_mass")
+
+
 def q_front_width_over_mfp_in_window(q):
     t = q.table(q.cases[0])
     idx = _window(t, q.params["from"], q.params["to"])
@@ -180,13 +193,11 @@ def q_temperature_slope_above_layer_at(q):
 
 
 def q_layer_gap_at(q):
-    t = q.table(q.cases[0])
-    return float(t["layer_gap"][_row_at(t, q.params["phase"])])
+    return _at(q, "layer_gap")
 
 
 def q_mass_gap_at(q):
-    t = q.table(q.cases[0])
-    return float(t["mass_gap"][_row_at(t, q.params["phase"])])
+    return _at(q, "mass_gap")
 
 
 def q_com_fractional_rms_md_vs_continuum(q):
@@ -286,6 +297,8 @@ QUANTITIES = {
     "front_width_over_mfp_in_window": q_front_width_over_mfp_in_window,
     "shock_lifetime": q_shock_lifetime,
     "shock_width_at": q_shock_width_at,
+    "shock_location_at": q_shock_location_at,
+    "center_of_mass_at": q_center_of_mass_at,
     "max_mach_in_window": q_max_mach_in_window,
     "min_max_mach_in_window": q_min_max_mach_in_window,
     "layer_temperature_fraction_at": q_layer_temperature_fraction_at,
@@ -311,6 +324,8 @@ REQUIRED_PARAMETERS = {
     "width_over_mfp_in_window": ("from", "to"),
     "front_width_over_mfp_in_window": ("from", "to"),
     "shock_width_at": ("phase",),
+    "shock_location_at": ("phase",),
+    "center_of_mass_at": ("phase",),
     "max_mach_in_window": ("from", "to"),
     "min_max_mach_in_window": ("from", "to"),
     "layer_temperature_fraction_at": ("phase",),
