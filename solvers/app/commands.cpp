@@ -35,11 +35,25 @@ CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::
   return sub;
 }
 
+CLI::App* add_solver_subcommand(CLI::App& app, const std::string& name, const std::string& help,
+                                RunOptions& options) {
+  auto* sub = add_run_subcommand(app, name, help, options);
+  sub->add_flag("--quiet", options.progress.quiet, "no progress on stderr");
+  sub->add_option("--progress-interval", options.progress.interval_seconds,
+                  fmt::format("seconds between progress lines when stderr is not a terminal "
+                              "(a terminal gets one live line); allowed: {}",
+                              progress_interval_range.describe()))
+      ->capture_default_str();
+  return sub;
+}
+
 int command_md(const RunOptions& options) {
-  return md::run(load(options), {{"configuration file", options.config_file}});
+  options.progress.validate();
+  return md::run(load(options), {{"configuration file", options.config_file}}, options.progress);
 }
 int command_continuum(const RunOptions& options) {
-  return continuum::run(load(options), {{"configuration file", options.config_file}});
+  options.progress.validate();
+  return continuum::run(load(options), {{"configuration file", options.config_file}}, options.progress);
 }
 
 int command_config(const RunOptions& options) {

@@ -5,17 +5,22 @@
 #include <vector>
 
 #include "analysis/analysis.hpp"
+#include "common/progress.hpp"
 
 namespace shaker {
 
 struct RunOptions {
   std::string config_file;
   std::vector<std::string> overrides;
+  ProgressSettings progress;  ///< solvers only
 };
 
 /// A subcommand taking CONFIG and any number of --set key=value.
 CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::string& help,
                              RunOptions& options);
+/// The same with a solver's --quiet and --progress-interval.
+CLI::App* add_solver_subcommand(CLI::App& app, const std::string& name, const std::string& help,
+                                RunOptions& options);
 
 int command_md(const RunOptions& options);
 int command_continuum(const RunOptions& options);

@@ -19,8 +19,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   RunOptions run_md, run_continuum, show_config;
-  add_run_subcommand(app, "md", "Run the event-driven MD solver on a case file", run_md);
-  add_run_subcommand(app, "continuum", "Run the continuum solver on a case file", run_continuum);
+  add_solver_subcommand(app, "md", "Run the event-driven MD solver on a case file", run_md);
+  add_solver_subcommand(app, "continuum", "Run the continuum solver on a case file", run_continuum);
   auto* config = add_run_subcommand(
       app, "config", "Print the effective configuration (defaults, file, --set overrides)",
       show_config);

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 #include <sstream>
 
@@ -173,6 +174,11 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
 }  // namespace
 
 void write_run_file(const std::filesystem::path& path, const RunRecord& record) {
+  for (const char* name : required_series_columns)
+    if (!record.series.has(name))
+      throw std::invalid_argument(fmt::format(
+          "run file '{}': the time series has no column '{}'; every run file has the columns {} "
+          "(docs/output-schema.md)", path.string(), name, fmt::join(required_series_columns, ", ")));
   write_hdf5_atomically(path, [&](hid_t file) {
     h5::write_attribute(file, "schema_version", std::int64_t{output_schema_version});
     h5::write_attribute(file, "program_version", std::string(program_version()));

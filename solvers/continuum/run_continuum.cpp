@@ -1,13 +1,11 @@
-// `shaker continuum CASE.toml`: the run protocols of the MD solver on the continuum model.
-//  periodic:     transient cycles, then sampled cycles; profiles at phases k / K averaged over
-//                the sampled cycles; the periodicity check compares each phase's centre of
-//                mass with the same phase one cycle earlier.
-//  single_shock: transient cycles, e switched at run.switch_phase before the recorded cycle,
-//                then one recorded cycle.
-// The time series carries, besides centre of mass, mass and energies, the container-frame
-// energy budget (frame_energy, accumulated body work, collisional loss and floor energy, and
-// the residual of E - E0 - W + L - F), the periodicity measure of the last two cycles (also
-// printed in the summary) and the restitution in effect at each row.
+// `shaker continuum CASE.toml`: the run loop of common/run_loop.hpp (the MD's protocols)
+// drives the continuum solver; its observers average the profiles at phases k / K over the
+// sampled cycles, record the time series, take the 3D field snapshots and report progress.
+// The time series carries, besides the common columns (t, phase, plate_z, com_z), mass and
+// energies, the container-frame energy budget (frame_energy, accumulated body work,
+// collisional loss and floor energy, and the residual of E - E0 - W + L - F), the periodicity
+// measure of the last two cycles (each phase's centre of mass against the same phase one cycle
+// earlier; also printed in the summary) and the restitution in effect at each row.
 #include "continuum/run_continuum.hpp"
 
 #include <fmt/format.h>
@@ -16,7 +14,9 @@
 #include <limits>
 
 #include "common/errors.hpp"
+#include "common/progress.hpp"
 #include "common/run_file.hpp"
+#include "common/run_loop.hpp"
 #include "continuum/checkpoint.hpp"
 #include "continuum/output.hpp"
 #include "continuum/setup.hpp"
@@ -25,15 +25,23 @@ namespace shaker::continuum {
 
 namespace {
 
-struct Recorder {
-  std::vector<double> time, phase, com, mass, kinetic, thermal, potential, loss_rate, com_change,
+/// The rows of the time series, one at every stored phase.
+struct Recorder final : RunObserver {
+  std::vector<double> time, phase, plate_z, com, mass, kinetic, thermal, potential, loss_rate, com_change,
       floor_uses, steps, frame_energy, body_work, collisional_loss, floor_energy, budget_residual,
       periodicity_column, restitution;
   double initial_energy = 0, initial_body_work = 0, initial_loss = 0, initial_floor = 0;
-  void add(const TimeIntegrator& solver, const ShakerKinematics& shaker, std::size_t phases) {
+  const TimeIntegrator& solver;
+  const ShakerKinematics& shaker;
+  std::size_t phases;
+
+  Recorder(const TimeIntegrator& s, const ShakerKinematics& k, std::size_t K) : solver(s), shaker(k), phases(K) {}
+  void at_phase(const PhaseInstant&) override { add(); }
+  void add() {
     const Diagnostics d = diagnostics(solver, shaker);
     time.push_back(solver.time());
     phase.push_back(shaker.phase(solver.time()));
+    plate_z.push_back(shaker.position(solver.time()));
     com.push_back(d.center_of_mass);
     mass.push_back(d.mass);
     kinetic.push_back(d.kinetic);
@@ -59,20 +67,21 @@ struct Recorder {
     floor_energy.push_back(b.floor_energy);
     budget_residual.push_back((energy - initial_energy) - (b.body_work - initial_body_work) +
                               (b.collisional_loss - initial_loss) - (b.floor_energy - initial_floor));
-    periodicity_column.push_back(periodicity(phases));
+    periodicity_column.push_back(periodicity());
     restitution.push_back(solver.op().settings().e);
   }
   TimeSeries series() const {
     TimeSeries s;
-    s.add("time", time);
+    s.add("t", time);
     s.add("phase", phase);
-    s.add("center_of_mass", com);
+    s.add("plate_z", plate_z);
+    s.add("com_z", com);
     s.add("total_mass", mass);
     s.add("kinetic_energy", kinetic);
     s.add("thermal_energy", thermal);
     s.add("potential_energy", potential);
     s.add("collisional_loss_rate", loss_rate);
-    s.add("center_of_mass_change_from_previous_cycle", com_change);
+    s.add("com_z_change_from_previous_cycle", com_change);
     s.add("temperature_floor_uses", floor_uses);
     s.add("steps", steps);
     s.add("frame_energy", frame_energy);
@@ -86,7 +95,7 @@ struct Recorder {
   }
   /// RMS over the last cycle's phases of the change from the previous cycle, / RMS height
   /// (NaN until two whole cycles are recorded).
-  double periodicity(std::size_t phases) const {
+  double periodicity() const {
     if (com.size() < 2 * phases) return std::numeric_limits<double>::quiet_NaN();
     double d2 = 0, h2 = 0;
     for (std::size_t i = com.size() - phases; i < com.size(); ++i) {
@@ -97,27 +106,87 @@ struct Recorder {
   }
 };
 
-void accumulate(Profile& sum, const Profile& p, bool first) {
-  if (first) {
-    sum = p;
-    return;
+/// The profiles of the run file: horizontally averaged at each stored phase and averaged over
+/// the sampled cycles.
+class ProfileAverage final : public RunObserver {
+ public:
+  ProfileAverage(const TimeIntegrator& solver, const ShakerKinematics& shaker, std::size_t phases)
+      : solver_(solver), shaker_(shaker), sums_(phases), cycles_(phases, 0) {}
+  void at_phase(const PhaseInstant& instant) override {
+    if (!instant.sampled) return;
+    const auto k = static_cast<std::size_t>(instant.phase);
+    add(sums_[k], horizontal_profile(solver_, shaker_), cycles_[k]++ == 0);
   }
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    sum.n[i] += p.n[i];
-    sum.nu[i] += p.nu[i];
-    sum.uz[i] += p.uz[i];
-    sum.T[i] += p.T[i];
+  std::vector<Profile> averages() const {
+    std::vector<Profile> out = sums_;
+    for (std::size_t k = 0; k < out.size(); ++k) divide(out[k], static_cast<double>(cycles_[k]));
+    return out;
   }
-}
 
-void finish_average(Profile& p, double count) {
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    p.n[i] /= count;
-    p.nu[i] /= count;
-    p.uz[i] /= count;
-    p.T[i] /= count;
+ private:
+  static void add(Profile& sum, const Profile& p, bool first) {
+    if (first) {
+      sum = p;
+      return;
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      sum.n[i] += p.n[i];
+      sum.nu[i] += p.nu[i];
+      sum.uz[i] += p.uz[i];
+      sum.T[i] += p.T[i];
+    }
   }
-}
+  static void divide(Profile& p, double count) {
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      p.n[i] /= count;
+      p.nu[i] /= count;
+      p.uz[i] /= count;
+      p.T[i] /= count;
+    }
+  }
+
+  const TimeIntegrator& solver_;
+  const ShakerKinematics& shaker_;
+  std::vector<Profile> sums_;
+  std::vector<int> cycles_;
+};
+
+/// 3D fields at the stored phases nearest to continuum.field_phases, in the last cycle.
+class FieldSnapshots final : public RunObserver {
+ public:
+  FieldSnapshots(const TimeIntegrator& solver, const ShakerKinematics& shaker, std::vector<double> phases)
+      : solver_(solver), shaker_(shaker), field_phases_(std::move(phases)) {}
+  void at_phase(const PhaseInstant& instant) override {
+    if (!instant.last_cycle()) return;
+    const auto K = static_cast<std::size_t>(instant.phases);
+    for (double phase : field_phases_)
+      if (static_cast<std::size_t>(std::lround(phase * static_cast<double>(K))) % K ==
+          static_cast<std::size_t>(instant.phase))
+        snapshots.push_back(snapshot(solver_, shaker_));
+  }
+  std::vector<FieldSnapshot> snapshots;
+
+ private:
+  const TimeIntegrator& solver_;
+  const ShakerKinematics& shaker_;
+  std::vector<double> field_phases_;
+};
+
+/// The solver as the run loop drives it.
+class DrivenIntegrator final : public DrivenSolver {
+ public:
+  explicit DrivenIntegrator(TimeIntegrator& solver) : solver_(solver) {}
+  double time() const override { return solver_.time(); }
+  void advance_to(double t) override { solver_.advance_to(t); }
+  void switch_restitution(const Restitution& after) override {
+    solver_.op().settings().e = after.e;
+    switched = true;
+  }
+  bool switched = false;
+
+ private:
+  TimeIntegrator& solver_;
+};
 
 /// Where a step failure leaves the last good state: OUTPUT.last_good.h5.
 std::filesystem::path last_good_path(std::filesystem::path output) {
@@ -138,7 +207,9 @@ void check_outputs(const ContinuumCase& c, std::vector<NamedPath> inputs) {
   check_output_paths(outputs, inputs);
 }
 
-int execute(const config::Config& config, const std::vector<NamedPath>& inputs) {
+int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
+            const ProgressSettings& progress_settings) {
+  const Stopwatch wall;
   const ContinuumCase c = continuum_case(config);
   check_outputs(c, inputs);
   if (!c.restart.empty())
@@ -150,41 +221,21 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs) 
   TimeIntegrator solver = make_solver(c);
   if (!c.restart.empty()) read_checkpoint(c.restart, solver);
   const std::filesystem::path output = run.output;
-  const double period = shaker.period();
-  const std::size_t K = static_cast<std::size_t>(run.phases_per_cycle);
-  const bool single = run.kind == RunProtocol::Kind::single_shock;
-  const std::int64_t sampled = single ? 1 : run.sampled_cycles;
-  const std::int64_t cycles = run.transient_cycles + sampled;
-  const double start = solver.time();
-  const double switch_time = start + (static_cast<double>(run.transient_cycles) + run.switch_phase) * period;
-  bool switched = false;
+  const PhaseSchedule schedule = PhaseSchedule::from_start(run, shaker, solver.time());
+  const auto K = static_cast<std::size_t>(schedule.phases());
 
-  Recorder recorder;
-  std::vector<Profile> profiles(K);
-  std::vector<FieldSnapshot> fields;
+  Recorder recorder(solver, shaker, K);
+  ProfileAverage profiles(solver, shaker, K);
+  FieldSnapshots fields(solver, shaker, c.field_phases);
+  const double cells = static_cast<double>(c.grid.interior_cells());
+  ProgressReport progress("shaker continuum", "cell updates/s",
+                          [&] { return cells * static_cast<double>(solver.counters().steps); },
+                          progress_settings);
+  std::vector<RunObserver*> observers{&recorder, &profiles, &progress};
+  if (c.grid.dimension == 3) observers.push_back(&fields);
+  DrivenIntegrator driven(solver);
   try {
-    for (std::int64_t cycle = 0; cycle < cycles; ++cycle) {
-      const bool sampling = cycle >= run.transient_cycles;
-      for (std::size_t k = 0; k < K; ++k) {
-        // Absolute cycle counts, so that a restarted run meets the same target times.
-        const double target = (start / period + static_cast<double>(cycle) +
-                               static_cast<double>(k) / static_cast<double>(K)) * period;
-        if (single && !switched && target >= switch_time) {
-          solver.advance_to(switch_time);
-          solver.op().settings().e = run.after_switch.e;
-          switched = true;
-        }
-        solver.advance_to(target);
-        recorder.add(solver, shaker, K);
-        if (!sampling) continue;
-        accumulate(profiles[k], horizontal_profile(solver, shaker), cycle == run.transient_cycles);
-        if (c.grid.dimension == 3 && cycle == cycles - 1)
-          for (double phase : c.field_phases)
-            if (static_cast<std::size_t>(std::lround(phase * static_cast<double>(K))) % K == k)
-              fields.push_back(snapshot(solver, shaker));
-      }
-    }
-    solver.advance_to((start / period + static_cast<double>(cycles)) * period);
+    schedule.run(driven, observers);
   } catch (const StepFailure& failure) {
     const std::filesystem::path last_good = last_good_path(output);
     write_checkpoint(last_good, solver, config.to_toml());
@@ -192,40 +243,40 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs) 
                last_good.string());
     return 1;
   }
-  for (auto& p : profiles) finish_average(p, static_cast<double>(sampled));
 
   RunRecord record;
   record.solver = "continuum";
   record.model_variant = fmt::format("{} transport, {}D", model::to_string(c.physics.transport),
                                      c.grid.dimension);
   record.configuration = config.to_toml();
-  record.e = switched ? run.after_switch.e : c.parameters.restitution.e;  // e of the recorded cycle
-  record.profiles = std::move(profiles);
+  record.e = driven.switched ? run.after_switch.e : c.parameters.restitution.e;  // e of the recorded cycle
+  record.profiles = profiles.averages();
   record.series = recorder.series();
-  if (!fields.empty()) {
+  if (!fields.snapshots.empty()) {
     std::filesystem::path fields_path = output;
     fields_path.replace_extension(".fields.h5");
-    write_fields(fields_path, c.grid, fields);
+    write_fields(fields_path, c.grid, fields.snapshots);
   }
   if (!c.checkpoint.empty()) write_checkpoint(c.checkpoint, solver, config.to_toml());
   write_run_file(output, record);
   const Counters& counters = solver.counters();
-  fmt::print("shaker continuum: {} cycles to t = {:.6g}, {} steps ({} rejected), temperature floor "
-             "used {} times; mass drift {:.3e}; periodicity (centre of mass, last two cycles) {:.3e}"
-             " (series column periodicity_last_two_cycles); energy budget residual {:.3e} of the "
-             "accumulated loss {:.6g}\nwrote {}\n",
-             cycles, solver.time(), counters.steps, counters.rejected_steps,
-             counters.temperature_floor_uses,
+  fmt::print("shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
+             "temperature floor used {} times; mass drift {:.3e}; periodicity (centre of mass, last "
+             "two cycles) {:.3e} (series column periodicity_last_two_cycles); energy budget residual "
+             "{:.3e} of the accumulated loss {:.6g}\nwrote {}\n",
+             schedule.cycles(), solver.time(), duration_text(wall.seconds()), counters.steps,
+             counters.rejected_steps, counters.temperature_floor_uses,
              (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
-             recorder.periodicity(K), recorder.budget_residual.back(),
+             recorder.periodicity(), recorder.budget_residual.back(),
              recorder.collisional_loss.back() - recorder.initial_loss, output.string());
   return 0;
 }
 
 }  // namespace
 
-int run(const config::Config& config, const std::vector<NamedPath>& inputs) {
-  return execute(config, inputs);
+int run(const config::Config& config, const std::vector<NamedPath>& inputs,
+        const ProgressSettings& progress) {
+  return execute(config, inputs, progress);
 }
 
 }  // namespace shaker::continuum

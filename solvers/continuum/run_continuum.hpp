@@ -3,10 +3,13 @@
 
 #include "common/config.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/progress.hpp"
 
 namespace shaker::continuum {
 /// Runs `shaker continuum` on a validated configuration; returns the process exit code.
 /// Runs the case. `inputs` are files read besides those the configuration names (the case
 /// file): no output may overwrite one of them. Bad input throws InputError before any work.
-int run(const config::Config& config, const std::vector<NamedPath>& inputs = {});
+/// Progress goes to stderr as `progress` says.
+int run(const config::Config& config, const std::vector<NamedPath>& inputs = {},
+        const ProgressSettings& progress = {});
 }  // namespace shaker::continuum

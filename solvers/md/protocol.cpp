@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -62,96 +63,96 @@ struct SeriesRows {
   }
 };
 
-}  // namespace
-
-RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
-                        const MdSettings& settings, const Progress& progress) {
-  const ShakerKinematics& shaker = parameters.shaker;
-  const RunProtocol& protocol = parameters.run;
-  const bool single_shock = protocol.kind == RunProtocol::Kind::single_shock;
-  const long phases = static_cast<long>(protocol.phases_per_cycle);
-  const long transient = static_cast<long>(protocol.transient_cycles);
-  const long sampled = single_shock ? 1 : static_cast<long>(protocol.sampled_cycles);
-  const long cycles = transient + sampled;
-  const double f = shaker.f;
-  const double first_cycle = std::ceil(sim.time() * f - 1e-9);
-  const double switch_time = (first_cycle + static_cast<double>(transient) + protocol.switch_phase) / f;
-  bool switched = !single_shock;
-
-  const auto n = static_cast<double>(sim.size());
-  const double energy0 = sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time());
-  const Tally tally0 = sim.tally();
-  RunOutcome out;
-  auto budget_now = [&](double energy) {
-    const Tally& tally = sim.tally();
+/// The energy and running totals at the start of the run, from which its budget counts.
+struct BudgetOrigin {
+  double energy;
+  Tally tally;
+  EnergyBudget at(const Tally& now, double energy_now) const {
     EnergyBudget b;
-    b.plate_work = tally.plate_work - tally0.plate_work;
-    b.collisional_loss = tally.pair_loss + tally.wall_loss - tally0.pair_loss - tally0.wall_loss;
-    b.energy_change = energy - energy0;
-    const double scale = std::max({std::fabs(b.plate_work), std::fabs(b.collisional_loss), std::fabs(energy), 1e-300});
+    b.plate_work = now.plate_work - tally.plate_work;
+    b.collisional_loss = now.pair_loss + now.wall_loss - tally.pair_loss - tally.wall_loss;
+    b.energy_change = energy_now - energy;
+    const double scale = std::max({std::fabs(b.plate_work), std::fabs(b.collisional_loss), std::fabs(energy_now), 1e-300});
     b.relative_closure = std::fabs(b.energy_change + b.collisional_loss - b.plate_work) / scale;
     return b;
-  };
+  }
+};
 
-  PhaseSampler sampler(static_cast<int>(phases), settings.bin_height, settings.ceiling,
-                       sim.geometry().width);
-  SeriesRows rows(settings.crossing_heights);
-  sim.count_crossings(settings.crossing_heights);
-  std::vector<Vec3> r, v;
-  auto record = [&](double t) {
-    sim.positions_at(t, r, v);
+/// The rows of RunOutcome::series: one at every stored phase and one at the end of the run.
+class SeriesObserver final : public RunObserver {
+ public:
+  SeriesObserver(Simulation& sim, const ShakerKinematics& shaker, const MdSettings& settings,
+                 const BudgetOrigin& origin, PhaseSnapshot& snapshot)
+      : sim_(sim), shaker_(shaker), origin_(origin), snapshot_(snapshot), rows_(settings.crossing_heights) {
+    sim.count_crossings(settings.crossing_heights);
+  }
+  void at_phase(const PhaseInstant& instant) override { record(instant.t); }
+  void at_run_end(double t) override { record(t); }
+  TimeSeries finish() { return rows_.finish(); }
+
+ private:
+  void record(double t) {
+    snapshot_.take(t);
+    const std::vector<Vec3>& r = snapshot_.r();
+    const std::vector<Vec3>& v = snapshot_.v();
     double com = 0.0, near_plate = 0.0, kinetic = 0.0;
-    const double plate_z = shaker.position(t);
+    const double plate_z = shaker_.position(t);
     for (std::size_t i = 0; i < r.size(); ++i) {
       com += r[i].z;
       kinetic += 0.5 * dot(v[i], v[i]);
       near_plate += r[i].z - 0.5 - plate_z < 0.5 ? 1.0 : 0.0;  // within half a diameter
     }
-    const double potential = sim.geometry().gravity * com;
-    const EnergyBudget b = budget_now(kinetic + potential);
-    const Tally& tally = sim.tally();
-    rows.add({t, shaker.phase(t), plate_z, com / n, kinetic, potential, b.plate_work, b.collisional_loss, b.relative_closure,
-              static_cast<double>(tally.pair), static_cast<double>(tally.plate),
-              static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
-              static_cast<double>(tally.guard_activations),
-              static_cast<double>(sim.count_overlaps(r, 1e-9)), near_plate,
-              static_cast<double>(tally.pair - tally0.pair)},
-             sim.crossings_at(t));
-  };
+    const double potential = sim_.geometry().gravity * com;
+    const EnergyBudget b = origin_.at(sim_.tally(), kinetic + potential);
+    const Tally& tally = sim_.tally();
+    rows_.add({t, shaker_.phase(t), plate_z, com / static_cast<double>(sim_.size()), kinetic, potential,
+               b.plate_work, b.collisional_loss, b.relative_closure,
+               static_cast<double>(tally.pair), static_cast<double>(tally.plate),
+               static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
+               static_cast<double>(tally.guard_activations),
+               static_cast<double>(sim_.count_overlaps(r, 1e-9)), near_plate,
+               static_cast<double>(tally.pair - origin_.tally.pair)},
+              sim_.crossings_at(t));
+  }
+
+  const Simulation& sim_;
+  const ShakerKinematics& shaker_;
+  const BudgetOrigin& origin_;
+  PhaseSnapshot& snapshot_;
+  SeriesRows rows_;
+};
+
+}  // namespace
+
+RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters, const MdSettings& settings,
+                        const std::vector<RunObserver*>& also) {
+  const PhaseSchedule schedule = PhaseSchedule::whole_cycles(parameters.run, parameters.shaker, sim.time());
+  const BudgetOrigin origin{sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time()), sim.tally()};
+  PhaseSampler sampler(static_cast<int>(schedule.phases()), settings.bin_height, settings.ceiling,
+                       sim.geometry().width);
+  PhaseSnapshot snapshot(sim);
+  SeriesObserver series(sim, parameters.shaker, settings, origin, snapshot);
+  SamplingObserver sampling(sampler, snapshot);
+  std::vector<RunObserver*> observers{&series, &sampling};
+  observers.insert(observers.end(), also.begin(), also.end());
 
   const auto start = std::chrono::steady_clock::now();
-  for (long m = 0; m < cycles; ++m) {
-    for (long k = 0; k < phases; ++k) {
-      const double t = (first_cycle + static_cast<double>(m) + static_cast<double>(k) / static_cast<double>(phases)) / f;
-      if (!switched && switch_time <= t) {
-        sim.advance_to(switch_time);
-        sim.set_restitution(protocol.after_switch);
-        switched = true;
-      }
-      sim.advance_to(t);
-      record(t);
-      if (m >= transient) sampler.add(static_cast<int>(k), t, r, v);
-    }
-    if (progress) {
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      progress(m + 1, cycles, static_cast<double>(sim.tally().collisions() - tally0.collisions()) / seconds);
-    }
-  }
-  const double end = (first_cycle + static_cast<double>(cycles)) / f;
-  sim.advance_to(end);
-  record(end);
+  DrivenSimulation driven(sim);
+  schedule.run(driven, observers);
+  RunOutcome out;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  out.profiles = sampler.profiles(shaker);
+  const double end = schedule.end();
+  out.profiles = sampler.profiles(parameters.shaker);
   out.samples = sampler.samples();
-  out.series = rows.finish();
-  out.budget = budget_now(sim.kinetic_energy(end) + sim.potential_energy(end));
+  out.series = series.finish();
+  out.budget = origin.at(sim.tally(), sim.kinetic_energy(end) + sim.potential_energy(end));
   out.overlaps = sim.count_overlaps(end, 1e-9);
   out.queue_consistent = sim.queue_consistent();
   const Tally& tally = sim.tally();
-  out.collisions = tally.collisions() - tally0.collisions();
-  out.events = out.collisions + (tally.cell - tally0.cell) + (tally.stale - tally0.stale) +
-               (tally.grazes - tally0.grazes);
+  out.collisions = tally.collisions() - origin.tally.collisions();
+  out.events = out.collisions + (tally.cell - origin.tally.cell) + (tally.stale - origin.tally.stale) +
+               (tally.grazes - origin.tally.grazes);
   return out;
 }
 

@@ -1,15 +1,15 @@
 #pragma once
-// The run protocols of the configuration: transient cycles then sampled cycles (periodic), or
-// the paper's single shock (periodic state, then a change of restitution at a given phase and
-// one recorded cycle). Sampling never changes the trajectory: it reads particle states at the
-// sampling instants without touching the particles.
-#include <functional>
+// An MD run: the run loop of common/run_loop.hpp (transient then sampled cycles, or the
+// paper's single shock) drives the simulation, and the MD's observers record the profiles
+// (PhaseSampler) and the time series. Recording never changes the trajectory: it reads
+// particle states at the sampling instants without touching the particles.
 #include <string>
 #include <vector>
 
 #include "common/case_parameters.hpp"
 #include "common/config.hpp"
 #include "common/profile.hpp"
+#include "common/run_loop.hpp"
 #include "md/simulation.hpp"
 
 namespace shaker::md {
@@ -57,10 +57,21 @@ struct RunOutcome {
   std::uint64_t collisions = 0, events = 0;
 };
 
-/// Called once per cycle with (cycle done, cycles total, collisions per second).
-using Progress = std::function<void(long, long, double)>;
+/// The simulation as the run loop drives it.
+class DrivenSimulation final : public DrivenSolver {
+ public:
+  explicit DrivenSimulation(Simulation& simulation) : simulation_(simulation) {}
+  double time() const override { return simulation_.time(); }
+  void advance_to(double t) override { simulation_.advance_to(t); }
+  void switch_restitution(const Restitution& after) override { simulation_.set_restitution(after); }
 
+ private:
+  Simulation& simulation_;
+};
+
+/// Runs the case's protocol from the simulation's state; `also` observe the run besides the
+/// MD's own recorders (progress).
 RunOutcome run_protocol(Simulation& simulation, const CaseParameters& parameters,
-                        const MdSettings& settings, const Progress& progress = {});
+                        const MdSettings& settings, const std::vector<RunObserver*>& also = {});
 
 }  // namespace shaker::md

@@ -2,7 +2,6 @@
 #include "md/run_md.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +11,7 @@
 #include "common/case_parameters.hpp"
 #include "common/errors.hpp"
 #include "common/memory.hpp"
+#include "common/progress.hpp"
 #include "common/run_file.hpp"
 #include "md/checkpoint.hpp"
 #include "md/initial_states.hpp"
@@ -87,7 +87,9 @@ void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometr
 
 }  // namespace
 
-int run(const config::Config& config, const std::vector<NamedPath>& inputs) {
+int run(const config::Config& config, const std::vector<NamedPath>& inputs,
+        const ProgressSettings& progress_settings) {
+  const Stopwatch wall;
   const CaseParameters parameters = CaseParameters::from(config);
   const MdSettings settings = MdSettings::from(config);
   const Geometry geometry = geometry_of(parameters, settings);
@@ -105,17 +107,10 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs) {
   rules.tc = settings.tc;
   Simulation simulation = make_simulation(config, parameters, settings, geometry, rules);
 
-  const bool terminal = ::isatty(::fileno(stderr)) != 0;
-  Progress progress;
-  if (terminal)
-    progress = [start = std::chrono::steady_clock::now()](long done, long total, double rate) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const double left = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
-      fmt::print(stderr, "\rshaker md: cycle {}/{}, {:.3g} collisions/s, about {:.0f} s left   ",
-                 done, total, rate, left);
-      if (done == total) fmt::print(stderr, "\n");
-    };
-  const RunOutcome outcome = run_protocol(simulation, parameters, settings, progress);
+  ProgressReport progress("shaker md", "collisions/s",
+                          [&] { return static_cast<double>(simulation.tally().collisions()); },
+                          progress_settings);
+  const RunOutcome outcome = run_protocol(simulation, parameters, settings, {&progress});
 
   RunRecord record;
   record.solver = "md";
@@ -135,9 +130,9 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs) {
     write_checkpoint(settings.checkpoint_output, simulation.save(), geometry, config.to_toml());
 
   const Tally& tally = simulation.tally();
-  fmt::print("shaker md: {} particles, {} cycles, t = {:.6g}\n", simulation.size(),
+  fmt::print("shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", simulation.size(),
              parameters.run.transient_cycles + (switched ? 1 : parameters.run.sampled_cycles),
-             simulation.time());
+             simulation.time(), duration_text(wall.seconds()));
   fmt::print("  collisions: {} (pair {}, plate {}, ceiling {}), {:.4g} collisions/s, {:.4g} events/s\n",
              outcome.collisions, tally.pair, tally.plate, tally.ceiling,
              static_cast<double>(outcome.collisions) / outcome.seconds,

@@ -59,4 +59,16 @@ CycleSamples PhaseSampler::samples() const {
   return CycleSamples::from_arrays(bins_, samples_.bin_volume(), std::move(cycles), std::move(sums));
 }
 
+void PhaseSnapshot::take(double t) {
+  if (t == t_) return;
+  simulation_.positions_at(t, r_, v_);
+  t_ = t;
+}
+
+void SamplingObserver::at_phase(const PhaseInstant& instant) {
+  if (!instant.sampled) return;
+  snapshot_.take(instant.t);
+  sampler_.add(static_cast<int>(instant.phase), instant.t, snapshot_.r(), snapshot_.v());
+}
+
 }  // namespace shaker::md

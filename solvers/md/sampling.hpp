@@ -3,12 +3,15 @@
 // n, u and T pooled over all particles found in a bin at that phase in all sampled cycles.
 // The sums of each cycle are kept (common/cycle_samples.hpp) for standard errors and for the
 // analysis's jackknife.
+#include <limits>
 #include <vector>
 
 #include "common/cycle_samples.hpp"
 #include "common/profile.hpp"
+#include "common/run_loop.hpp"
 #include "common/shaker_kinematics.hpp"
 #include "md/particles.hpp"
+#include "md/simulation.hpp"
 
 namespace shaker::md {
 
@@ -33,6 +36,33 @@ class PhaseSampler {
   std::vector<double> first_time_;   // per phase
   std::vector<int> cycles_;          // snapshots per phase
   std::vector<BinSums> scratch_;     // one snapshot
+};
+
+/// Positions and velocities of every particle at one time, computed once for all the
+/// observers that read them (the run loop's times increase strictly, so a time names a state).
+class PhaseSnapshot {
+ public:
+  explicit PhaseSnapshot(const Simulation& simulation) : simulation_(simulation) {}
+  /// Takes the snapshot at t >= the simulation's time, unless it is already at t.
+  void take(double t);
+  const std::vector<Vec3>& r() const { return r_; }
+  const std::vector<Vec3>& v() const { return v_; }
+
+ private:
+  const Simulation& simulation_;
+  double t_ = std::numeric_limits<double>::quiet_NaN();  ///< NaN: none taken
+  std::vector<Vec3> r_, v_;
+};
+
+/// A PhaseSampler fed by the run loop: every stored phase of every sampled cycle.
+class SamplingObserver final : public RunObserver {
+ public:
+  SamplingObserver(PhaseSampler& sampler, PhaseSnapshot& snapshot) : sampler_(sampler), snapshot_(snapshot) {}
+  void at_phase(const PhaseInstant& instant) override;
+
+ private:
+  PhaseSampler& sampler_;
+  PhaseSnapshot& snapshot_;
 };
 
 }  // namespace shaker::md

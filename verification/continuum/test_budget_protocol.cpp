@@ -84,7 +84,7 @@ TEST(SingleShock, SwitchesEAtThePhaseAndKeepsItInTheCheckpoint) {
   const double switch_time = (1.0 + cc.parameters.run.switch_phase) * period;
   const RunRecord r = read_run_file(dir / "run.h5");
   EXPECT_EQ(r.e, after);
-  const auto& time = r.series.column("time");
+  const auto& time = r.series.column("t");
   const auto& e = r.series.column("restitution");
   // The last row before the switch and the first after it lie one stored phase apart.
   double last_before = -1, first_after = 1e300;

@@ -142,8 +142,8 @@ TEST(BaseCase, PeriodicStateAndShock) {
   c.set("run.sampled_cycles=2");
   ASSERT_EQ(run(c), 0);
   const RunRecord r = read_run_file(dir / "run.h5");
-  const auto& change = r.series.column("center_of_mass_change_from_previous_cycle");
-  const auto& com = r.series.column("center_of_mass");
+  const auto& change = r.series.column("com_z_change_from_previous_cycle");
+  const auto& com = r.series.column("com_z");
   const std::size_t K = r.profiles.size();
   double d2 = 0, h2 = 0;
   for (std::size_t i = com.size() - K; i < com.size(); ++i) {

@@ -12,6 +12,7 @@
 #include "analysis/analysis.hpp"
 #include "common/case_parameters.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/run_loop.hpp"
 #include "common/units.hpp"
 #include "md/initial_states.hpp"
 #include "md/protocol.hpp"
@@ -229,6 +230,80 @@ double shock_location(const Profile& p) {
   return shock ? shock->location : nan;
 }
 
+/// The study's samplers, fed the particles at every stored phase of the sampled cycles; each
+/// cycle's quantities and each block's standard errors taken at the cycle's end.
+class StudySampling final : public RunObserver {
+ public:
+  StudySampling(const CaseParameters& c, const md::MdSettings& s, const md::Simulation& sim,
+                std::span<const std::size_t> block_sizes, double fine_bin_height, SamplingTrajectory& out)
+      : c_(c), bin_(s.bin_height), fine_bin_(fine_bin_height), top_(s.ceiling), block_sizes_(block_sizes),
+        snapshot_(sim), out_(out), pooled_(sampler(bin_)), pooled_fine_(sampler(fine_bin_)),
+        cycle_(sampler(bin_)), cycle_fine_(sampler(fine_bin_)) {
+    for (std::size_t b = 0; b < block_sizes.size(); ++b) blocks_.push_back(sampler(bin_));
+  }
+
+  void at_phase(const PhaseInstant& instant) override {
+    if (!instant.sampled) return;
+    snapshot_.take(instant.t);
+    const auto k = static_cast<int>(instant.phase);
+    for (auto* one : {pooled_.get(), pooled_fine_.get(), cycle_.get(), cycle_fine_.get()})
+      one->add(k, instant.t, snapshot_.r(), snapshot_.v());
+    for (auto& block : blocks_) block->add(k, instant.t, snapshot_.r(), snapshot_.v());
+  }
+
+  void at_cycle_end(const CycleEnd& end) override {
+    if (!end.sampled) return;
+    record_quantities();
+    const auto done = static_cast<std::size_t>(end.cycle + 1 - c_.run.transient_cycles);
+    for (std::size_t b = 0; b < block_sizes_.size(); ++b)
+      if (done % block_sizes_[b] == 0) close_block(b, done);
+    cycle_ = sampler(bin_);
+    cycle_fine_ = sampler(fine_bin_);
+  }
+
+  void finish() {
+    out_.pooled = pooled_->profiles(c_.shaker);
+    out_.pooled_fine = pooled_fine_->profiles(c_.shaker);
+  }
+
+ private:
+  std::unique_ptr<md::PhaseSampler> sampler(double bin) const {
+    return std::make_unique<md::PhaseSampler>(static_cast<int>(c_.run.phases_per_cycle), bin, top_,
+                                              c_.md_box_width);
+  }
+
+  void record_quantities() {
+    const std::vector<Profile> profiles = cycle_->profiles(c_.shaker);
+    for (std::size_t q = 0; q < out_.quantity_names.size(); ++q) {
+      const Profile p = without_standard_errors(convergence::at_phase(profiles, out_.quantity_phases[q]));
+      out_.per_cycle[q].push_back(out_.quantity_names[q] == "shock_location" ? shock_location(p)
+                                                                            : analysis::center_of_mass(p));
+    }
+    out_.per_cycle_shock_fine.push_back(
+        shock_location(without_standard_errors(convergence::at_phase(cycle_fine_->profiles(c_.shaker), 0.22))));
+  }
+
+  void close_block(std::size_t b, std::size_t done) {
+    const std::vector<Profile> block = blocks_[b]->profiles(c_.shaker);
+    if (b == 0 && done == block_sizes_[0]) out_.first_block = block;
+    auto& n_se = out_.n_se[b].emplace_back();
+    auto& T_se = out_.T_se[b].emplace_back();
+    for (const Profile& p : block) {
+      n_se.push_back(p.n_se);
+      T_se.push_back(p.T_se);
+    }
+    blocks_[b] = sampler(bin_);
+  }
+
+  const CaseParameters& c_;
+  double bin_, fine_bin_, top_;
+  std::span<const std::size_t> block_sizes_;
+  md::PhaseSnapshot snapshot_;
+  SamplingTrajectory& out_;
+  std::unique_ptr<md::PhaseSampler> pooled_, pooled_fine_, cycle_, cycle_fine_;
+  std::vector<std::unique_ptr<md::PhaseSampler>> blocks_;
+};
+
 }  // namespace
 
 SamplingTrajectory run_sampling_trajectory(const config::Config& config,
@@ -242,9 +317,6 @@ SamplingTrajectory run_sampling_trajectory(const config::Config& config,
   for (std::size_t K : block_sizes)
     if (K < 2 || cycles % K != 0)
       throw std::invalid_argument(fmt::format("block size {} does not divide {} cycles", K, cycles));
-  const int phases = static_cast<int>(c.run.phases_per_cycle);
-  const double width = c.md_box_width, top = s.ceiling;
-  auto sampler = [&](double bin) { return std::make_unique<md::PhaseSampler>(phases, bin, top, width); };
 
   SamplingTrajectory out;
   out.cycles = cycles;
@@ -256,51 +328,12 @@ SamplingTrajectory run_sampling_trajectory(const config::Config& config,
   out.T_se.resize(block_sizes.size());
 
   md::Simulation sim = make_simulation(c, s);
-  auto pooled = sampler(s.bin_height), pooled_fine = sampler(fine_bin_height);
-  std::vector<std::unique_ptr<md::PhaseSampler>> blocks;
-  for (std::size_t b = 0; b < block_sizes.size(); ++b) blocks.push_back(sampler(s.bin_height));
-  std::vector<md::Vec3> r, v;
+  StudySampling sampling(c, s, sim, block_sizes, fine_bin_height, out);
   const auto start = std::chrono::steady_clock::now();
-  const auto transient = static_cast<std::size_t>(c.run.transient_cycles);
-  for (std::size_t m = 0; m < transient + cycles; ++m) {
-    const bool sampled = m >= transient;
-    auto cycle = sampler(s.bin_height), cycle_fine = sampler(fine_bin_height);
-    for (int k = 0; k < phases; ++k) {
-      // The same instants as run_protocol: (cycle + k / phases) / f from t = 0.
-      const double t = (static_cast<double>(m) + static_cast<double>(k) / phases) / c.shaker.f;
-      sim.advance_to(t);
-      if (!sampled) continue;
-      sim.positions_at(t, r, v);
-      for (auto* one : {pooled.get(), pooled_fine.get(), cycle.get(), cycle_fine.get()}) one->add(k, t, r, v);
-      for (auto& block : blocks) block->add(k, t, r, v);
-    }
-    if (!sampled) continue;
-    const std::vector<Profile> profiles = cycle->profiles(c.shaker);
-    for (std::size_t q = 0; q < out.quantity_names.size(); ++q) {
-      const Profile p = without_standard_errors(at_phase(profiles, out.quantity_phases[q]));
-      out.per_cycle[q].push_back(out.quantity_names[q] == "shock_location"
-                                     ? shock_location(p)
-                                     : analysis::center_of_mass(p));
-    }
-    out.per_cycle_shock_fine.push_back(
-        shock_location(without_standard_errors(at_phase(cycle_fine->profiles(c.shaker), 0.22))));
-    const std::size_t done = m + 1 - transient;
-    for (std::size_t b = 0; b < block_sizes.size(); ++b) {
-      if (done % block_sizes[b] != 0) continue;
-      const std::vector<Profile> block = blocks[b]->profiles(c.shaker);
-      if (b == 0 && done == block_sizes[0]) out.first_block = block;
-      auto& n_se = out.n_se[b].emplace_back();
-      auto& T_se = out.T_se[b].emplace_back();
-      for (const Profile& p : block) {
-        n_se.push_back(p.n_se);
-        T_se.push_back(p.T_se);
-      }
-      blocks[b] = sampler(s.bin_height);
-    }
-  }
+  md::DrivenSimulation driven(sim);
+  PhaseSchedule::whole_cycles(c.run, c.shaker, sim.time()).run(driven, {&sampling});
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  out.pooled = pooled->profiles(c.shaker);
-  out.pooled_fine = pooled_fine->profiles(c.shaker);
+  sampling.finish();
   return out;
 }
 

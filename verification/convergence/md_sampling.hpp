@@ -119,8 +119,8 @@ struct BinSizeCheck {
 
 // ---- the MD study -----------------------------------------------------------------------
 
-/// One trajectory of the MD solver, driven exactly as run_protocol drives it (flat-layer start
-/// at t = 0, the transient, then the sampled cycles at run.phases_per_cycle phases), sampled by
+/// One trajectory of the MD solver, driven by the run loop as `shaker md` drives it (flat-layer
+/// start at t = 0, the transient, then the sampled cycles at run.phases_per_cycle phases), sampled by
 /// the solver's own PhaseSampler: blocks of each K at md.bin_height, one sampler per cycle at
 /// md.bin_height and at fine_bin_height, and both pooled over all cycles.
 struct SamplingTrajectory {

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "common/config.hpp"
@@ -86,8 +87,7 @@ TEST(RunFile, RoundTripWithStandardErrorsIsExact) {
   const TemporaryDirectory dir;
   const RunRecord written = awkward_record(true);
   RunRecord with_nan = written;
-  with_nan.series = {};
-  with_nan.series.add("shock_z", {1.0, std::numeric_limits<double>::quiet_NaN(), 3.5});
+  with_nan.series.add("shock_z", {1.0, std::numeric_limits<double>::quiet_NaN(), 3.5, 4.0});
   for (const RunRecord& record : {written, with_nan}) {
     shaker::write_run_file(dir / "run.h5", record);
     expect_same_record(record, shaker::read_run_file(dir / "run.h5"));
@@ -133,6 +133,25 @@ TEST(RunFile, RunWithoutProfilesRoundTrips) {
   record.profiles.clear();
   shaker::write_run_file(dir / "series-only.h5", record);
   expect_same_record(record, shaker::read_run_file(dir / "series-only.h5"));
+}
+
+TEST(RunFile, RefusesASeriesWithoutARequiredColumn) {
+  const TemporaryDirectory dir;
+  for (const char* missing : shaker::required_series_columns) {
+    RunRecord record = make_sample_record(true);
+    shaker::TimeSeries kept;
+    for (std::size_t i = 0; i < record.series.names.size(); ++i)
+      if (record.series.names[i] != missing) kept.add(record.series.names[i], record.series.columns[i]);
+    record.series = kept;
+    try {
+      shaker::write_run_file(dir / "run.h5", record);
+      ADD_FAILURE() << "a series without " << missing << " was written";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find(std::string("'") + missing + "'"), std::string::npos)
+          << error.what();
+    }
+    EXPECT_TRUE(files_in(dir.path()).empty()) << "left behind: " << files_in(dir.path()).front();
+  }
 }
 
 TEST(RunFile, FailedWriteLeavesNothingUnderTheFinalNameAndNoTemporaryFile) {

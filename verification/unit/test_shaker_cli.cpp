@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -163,6 +164,66 @@ TEST(ShakerProgram, AnalyzeAndCompareAcceptAValidRunFile) {
   const Result compare =
       run_shaker({"compare", (dir / "sample.h5").string(), (dir / "sample.h5").string()});
   EXPECT_EQ(compare.exit_code, 0) << compare.output;
+}
+
+/// The cycle counts k of the progress lines "LABEL: cycle k of n, ..." (n must be `cycles`).
+std::vector<int> progress_cycles(const std::string& output, const std::string& label, int cycles) {
+  std::vector<int> found;
+  const std::regex progress(label + R"(: cycle (\d+) of (\d+), t = [^,]+, [^,]+/s, .+ left)");
+  for (std::sregex_iterator it(output.begin(), output.end(), progress), end; it != end; ++it) {
+    EXPECT_EQ(std::stoi((*it)[2]), cycles) << it->str();
+    found.push_back(std::stoi((*it)[1]));
+  }
+  return found;
+}
+
+// Progress on stderr when it is not a terminal (here a pipe): with --progress-interval 0 a
+// line at every stored phase, cycle counts rising to the total; --quiet prints none; the
+// summary states the wall time.
+TEST(ShakerProgram, ProgressLinesOnAPipeAndNoneWhenQuiet) {
+  const shaker::testing::TemporaryDirectory dir;
+  write_file(dir / "tiny.toml",
+             "[run]\ntransient_cycles = 1\nsampled_cycles = 2\nphases_per_cycle = 4\n"
+             "[layer]\nparticles = 40\n[md]\nbox_width = 4.0\n[continuum]\ncell_size = 0.5\n");
+  for (const std::string solver : {"md", "continuum"}) {
+    SCOPED_TRACE(solver);
+    const std::string label = "shaker " + solver, output = (dir / (solver + ".h5")).string();
+    const std::vector<std::string> run = {solver, (dir / "tiny.toml").string(), "--set", "run.output=" + output};
+    std::vector<std::string> args = run;
+    args.insert(args.end(), {"--progress-interval", "0"});
+    const Result every_phase = run_shaker(args);
+    ASSERT_EQ(every_phase.exit_code, 0) << every_phase.output;
+    const std::vector<int> cycles = progress_cycles(every_phase.output, label, 3);
+    // Every stored phase but the first (nothing done yet), and the end of the run.
+    ASSERT_EQ(cycles.size(), 3u * 4u) << every_phase.output;
+    EXPECT_EQ(cycles.front(), 1);
+    EXPECT_EQ(cycles.back(), 3);
+    for (std::size_t i = 1; i < cycles.size(); ++i) EXPECT_GE(cycles[i], cycles[i - 1]) << every_phase.output;
+    EXPECT_NE(every_phase.output.find("wall time "), std::string::npos) << every_phase.output;
+
+    args = run;
+    args.insert(args.end(), {"--progress-interval", "0", "--quiet"});
+    const Result quiet = run_shaker(args);
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+    EXPECT_TRUE(progress_cycles(quiet.output, label, 3).empty()) << quiet.output;
+    EXPECT_EQ(quiet.output.find(": cycle "), std::string::npos) << quiet.output;
+
+    // An interval longer than the run: no line.
+    args = run;
+    args.insert(args.end(), {"--progress-interval", "3600"});
+    const Result hourly = run_shaker(args);
+    ASSERT_EQ(hourly.exit_code, 0) << hourly.output;
+    EXPECT_EQ(hourly.output.find(": cycle "), std::string::npos) << hourly.output;
+
+    std::filesystem::remove(output);
+    args = run;
+    args.insert(args.end(), {"--progress-interval", "-1"});
+    const Result bad = run_shaker(args);
+    EXPECT_EQ(bad.exit_code, 2) << bad.output;
+    EXPECT_NE(bad.output.find("--progress-interval = -1"), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find("0 <= value <= 86400"), std::string::npos) << bad.output;
+    EXPECT_FALSE(std::filesystem::exists(output));
+  }
 }
 
 }  // namespace

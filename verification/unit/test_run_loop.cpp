@@ -1,0 +1,215 @@
+// The run loop of common/run_loop.hpp with a stand-in solver: the target times of both
+// clocks to the bit, the order of advances, switch and observer calls, and the progress
+// observer's lines (plain, live and quiet).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "common/progress.hpp"
+#include "common/run_loop.hpp"
+
+namespace {
+
+using shaker::CycleEnd;
+using shaker::PhaseInstant;
+using shaker::PhaseSchedule;
+using shaker::RunProtocol;
+using shaker::ShakerKinematics;
+
+const ShakerKinematics shaker_base{3.0, 0.095};
+
+RunProtocol protocol(std::int64_t transient, std::int64_t sampled, std::int64_t phases) {
+  RunProtocol run;
+  run.transient_cycles = transient;
+  run.sampled_cycles = sampled;
+  run.phases_per_cycle = phases;
+  return run;
+}
+
+/// Writes down everything the loop asks of it, in order.
+class LoggingSolver final : public shaker::DrivenSolver {
+ public:
+  explicit LoggingSolver(double t0) : t_(t0) {}
+  double time() const override { return t_; }
+  void advance_to(double t) override {
+    EXPECT_GE(t, t_) << "the loop went back in time";
+    t_ = t;
+    log.push_back("advance " + std::to_string(t));
+  }
+  void switch_restitution(const shaker::Restitution& after) override {
+    log.push_back("switch " + std::to_string(after.e));
+  }
+  std::vector<std::string> log;
+
+ private:
+  double t_;
+};
+
+class LoggingObserver final : public shaker::RunObserver {
+ public:
+  explicit LoggingObserver(std::vector<std::string>& log) : log_(log) {}
+  void at_phase(const PhaseInstant& p) override {
+    log_.push_back("phase " + std::to_string(p.cycle) + "/" + std::to_string(p.cycles) + " " +
+                   std::to_string(p.phase) + "/" + std::to_string(p.phases) + (p.sampled ? " sampled" : ""));
+    instants.push_back(p);
+  }
+  void at_cycle_end(const CycleEnd& e) override {
+    log_.push_back("cycle end " + std::to_string(e.cycle) + (e.sampled ? " sampled" : ""));
+  }
+  void at_run_end(double t) override { log_.push_back("run end " + std::to_string(t)); }
+  std::vector<PhaseInstant> instants;
+
+ private:
+  std::vector<std::string>& log_;
+};
+
+TEST(PhaseSchedule, WholeCyclesKeepTheMdArithmetic) {
+  const RunProtocol run = protocol(2, 3, 7);
+  const double f = shaker_base.f;
+  const PhaseSchedule fresh = PhaseSchedule::whole_cycles(run, shaker_base, 0.0);
+  ASSERT_EQ(fresh.cycles(), 5);
+  for (std::int64_t m = 0; m < 5; ++m)
+    for (std::int64_t k = 0; k < 7; ++k)
+      EXPECT_EQ(fresh.target(m, k), (static_cast<double>(m) + static_cast<double>(k) / 7.0) / f);
+  EXPECT_EQ(fresh.end(), 5.0 / f);
+  // A run continued from mid-cycle starts at the next whole cycle; from a whole cycle (up to
+  // round-off), at that cycle.
+  EXPECT_EQ(PhaseSchedule::whole_cycles(run, shaker_base, 2.5 / f).target(0, 0), 3.0 / f);
+  EXPECT_EQ(PhaseSchedule::whole_cycles(run, shaker_base, 4.0 / f).target(0, 0), 4.0 / f);
+}
+
+TEST(PhaseSchedule, FromStartKeepsTheContinuumArithmetic) {
+  const RunProtocol run = protocol(1, 2, 5);
+  const double period = shaker_base.period(), t0 = 1.2345;
+  const PhaseSchedule s = PhaseSchedule::from_start(run, shaker_base, t0);
+  for (std::int64_t m = 0; m < 3; ++m)
+    for (std::int64_t k = 0; k < 5; ++k)
+      EXPECT_EQ(s.target(m, k),
+                (t0 / period + static_cast<double>(m) + static_cast<double>(k) / 5.0) * period);
+  EXPECT_EQ(s.end(), (t0 / period + 3.0) * period);
+}
+
+TEST(PhaseSchedule, CallsObserversInOrderAtEveryPhaseCycleEndAndTheEnd) {
+  const PhaseSchedule s = PhaseSchedule::whole_cycles(protocol(1, 1, 2), shaker_base, 0.0);
+  LoggingSolver solver(0.0);
+  std::vector<std::string> log;
+  LoggingObserver first(log), second(log);
+  s.run(solver, {&first, &second});
+  const std::vector<std::string> expected = {
+      "phase 0/2 0/2", "phase 0/2 0/2", "phase 0/2 1/2", "phase 0/2 1/2", "cycle end 0",
+      "cycle end 0", "phase 1/2 0/2 sampled", "phase 1/2 0/2 sampled", "phase 1/2 1/2 sampled",
+      "phase 1/2 1/2 sampled", "cycle end 1 sampled", "cycle end 1 sampled",
+      "run end " + std::to_string(s.end()), "run end " + std::to_string(s.end())};
+  EXPECT_EQ(log, expected);
+  std::vector<std::string> advances;
+  for (std::int64_t m = 0; m < 2; ++m)
+    for (std::int64_t k = 0; k < 2; ++k) advances.push_back("advance " + std::to_string(s.target(m, k)));
+  advances.push_back("advance " + std::to_string(s.end()));
+  EXPECT_EQ(solver.log, advances);
+  ASSERT_EQ(first.instants.size(), 4u);
+  EXPECT_EQ(first.instants[3].t, s.target(1, 1));
+  EXPECT_TRUE(first.instants[3].last_cycle());
+  EXPECT_FALSE(first.instants[1].last_cycle());
+  EXPECT_EQ(first.instants[3].cycles_done(), 1.5);
+}
+
+TEST(PhaseSchedule, SingleShockSwitchesOnceBeforeTheFirstPhaseAfterTheSwitch) {
+  RunProtocol run = protocol(2, 10, 4);  // a single shock records one cycle whatever sampled_cycles says
+  run.kind = RunProtocol::Kind::single_shock;
+  run.switch_phase = -0.3;
+  run.after_switch.e = 0.5;
+  for (const bool whole : {true, false}) {
+    const PhaseSchedule s = whole ? PhaseSchedule::whole_cycles(run, shaker_base, 0.0)
+                                  : PhaseSchedule::from_start(run, shaker_base, 0.0);
+    ASSERT_EQ(s.cycles(), 3);
+    LoggingSolver solver(0.0);
+    s.run(solver, {});
+    const double switch_time = whole ? (0.0 + 2.0 - 0.3) / shaker_base.f : 0.0 + (2.0 - 0.3) * shaker_base.period();
+    // f t = 1.5 comes before the switch at f t = 1.7, and 1.75 after it.
+    const std::vector<std::string> around = {"advance " + std::to_string(s.target(1, 2)),
+                                             "advance " + std::to_string(switch_time),
+                                             "switch " + std::to_string(0.5),
+                                             "advance " + std::to_string(s.target(1, 3))};
+    ASSERT_EQ(solver.log.size(), 3u * 4u + 1u + 2u);
+    EXPECT_EQ(std::vector<std::string>(solver.log.begin() + 6, solver.log.begin() + 10), around);
+  }
+}
+
+/// What a ProgressReport writes for a run of `cycles` cycles of `phases` phases.
+std::string progress_text(const shaker::ProgressSettings& settings, bool live, std::int64_t cycles,
+                          std::int64_t phases) {
+  char* buffer = nullptr;
+  std::size_t size = 0;
+  std::FILE* stream = open_memstream(&buffer, &size);
+  double work = 0.0;
+  {
+    shaker::ProgressReport report("shaker test", "widgets/s", [&] { return work; }, settings, stream, live);
+    const PhaseSchedule s = PhaseSchedule::whole_cycles(protocol(1, cycles - 1, phases), shaker_base, 0.0);
+    LoggingSolver solver(0.0);
+    struct Work final : shaker::RunObserver {
+      double& work;
+      explicit Work(double& w) : work(w) {}
+      void at_phase(const PhaseInstant&) override { work += 10.0; }
+    } counter(work);
+    s.run(solver, {&counter, &report});
+  }
+  std::fclose(stream);
+  std::string text(buffer, size);
+  std::free(buffer);
+  return text;
+}
+
+TEST(ProgressReport, PlainLinesAtEveryPhaseWithIntervalZero) {
+  const std::string text = progress_text({false, 0.0}, false, 3, 2);
+  // Phase (0, 0) has nothing done; then (0, 1), (1, 0), (1, 1), (2, 0), (2, 1) and the end.
+  const std::vector<std::string> cycles = {"1", "2", "2", "3", "3", "3"};
+  std::size_t at = 0;
+  for (const std::string& cycle : cycles) {
+    const std::string line = "shaker test: cycle " + cycle + " of 3, t = ";
+    const std::size_t found = text.find(line, at);
+    ASSERT_NE(found, std::string::npos) << "no '" << line << "' after offset " << at << " in\n" << text;
+    EXPECT_NE(text.find(" widgets/s, ", found), std::string::npos);
+    at = found + line.size();
+  }
+  EXPECT_EQ(text.find("shaker test:", at), std::string::npos) << text;
+  EXPECT_EQ(text.find('\r'), std::string::npos);
+  EXPECT_EQ(text.back(), '\n');
+}
+
+TEST(ProgressReport, QuietWritesNothingAndALongIntervalOnlyTheLiveLine) {
+  EXPECT_EQ(progress_text({true, 0.0}, false, 3, 2), "");
+  EXPECT_EQ(progress_text({true, 0.0}, true, 3, 2), "");
+  EXPECT_EQ(progress_text({false, 3600.0}, false, 3, 2), "");
+  // A terminal gets the live line at the end of the run, and a newline after it.
+  const std::string live = progress_text({false, 3600.0}, true, 3, 2);
+  EXPECT_EQ(live.rfind("\rshaker test: cycle 3 of 3, t = ", 0), 0u) << live;
+  EXPECT_EQ(live.back(), '\n');
+}
+
+TEST(ProgressReport, IntervalOutsideItsRangeIsInputError) {
+  EXPECT_NO_THROW((shaker::ProgressSettings{false, 0.0}.validate()));
+  EXPECT_NO_THROW((shaker::ProgressSettings{false, 86400.0}.validate()));
+  for (const double bad : {-1.0, 1e9, std::nan("")}) {
+    try {
+      shaker::ProgressSettings{false, bad}.validate();
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const shaker::InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("--progress-interval"), std::string::npos);
+      EXPECT_NE(std::string(error.what()).find("0 <= value <= 86400"), std::string::npos) << error.what();
+    }
+  }
+}
+
+TEST(ProgressReport, DurationsReadAsPeopleSayThem) {
+  EXPECT_EQ(shaker::duration_text(0.42), "0.42 s");
+  EXPECT_EQ(shaker::duration_text(42.0), "42 s");
+  EXPECT_EQ(shaker::duration_text(750.0), "12.5 min");
+  EXPECT_EQ(shaker::duration_text(3.2 * 3600.0), "3.2 h");
+}
+
+}  // namespace
