@@ -12,6 +12,7 @@
 namespace shaker::md {
 
 std::string crossing_column(double height) { return fmt::format("crossings_z{:g}", height); }
+std::string distinct_particles_column(double height) { return fmt::format("particles_z{:g}", height); }
 
 MdSettings MdSettings::from(const config::Config& c) {
   MdSettings s;
@@ -48,12 +49,15 @@ struct SeriesRows {
   std::vector<std::vector<double>> columns;
   explicit SeriesRows(const std::vector<double>& crossing_heights) {
     for (double h : crossing_heights) names.push_back(crossing_column(h));
+    for (double h : crossing_heights) names.push_back(distinct_particles_column(h));
     columns.resize(names.size());
   }
-  void add(std::initializer_list<double> row, const std::vector<std::uint64_t>& crossings) {
+  void add(std::initializer_list<double> row, const std::vector<std::uint64_t>& crossings,
+           const std::vector<std::uint64_t>& distinct_particles) {
     std::size_t k = 0;
     for (double x : row) columns[k++].push_back(x);
     for (std::uint64_t c : crossings) columns[k++].push_back(static_cast<double>(c));
+    for (std::uint64_t c : distinct_particles) columns[k++].push_back(static_cast<double>(c));
   }
   TimeSeries finish() {
     TimeSeries s;
@@ -96,7 +100,7 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
   PhaseSampler sampler(static_cast<int>(phases), settings.bin_height, settings.ceiling,
                        sim.geometry().width);
   SeriesRows rows(settings.crossing_heights);
-  sim.count_crossings(settings.crossing_heights);
+  sim.start_height_counts(settings.crossing_heights, f);
   std::vector<Vec3> r, v;
   auto record = [&](double t) {
     sim.positions_at(t, r, v);
@@ -116,7 +120,7 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
               static_cast<double>(tally.guard_activations),
               static_cast<double>(sim.count_overlaps(r, 1e-9)), near_plate,
               static_cast<double>(tally.pair - tally0.pair)},
-             sim.crossings_at(t));
+             sim.crossings_at(t), sim.distinct_particles_at(t));
   };
 
   const auto start = std::chrono::steady_clock::now();
