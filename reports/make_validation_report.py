@@ -519,7 +519,28 @@ def claims_section(results):
                     for r in claim["per_solver"].values() for ev in r["checks"]
                     for n in ev.get("notes", [])})
     lines += [""] + [f"- {n}" for n in notes] + ([""] if notes else [])
+    unresolved = unresolved_lines(results)
+    if unresolved:
+        lines += ["What would decide the unresolved checks: the error shrinks as one over the "
+                  "square root of the number of independent samples (cycles or single-shock "
+                  "runs), so a check at margin m standard errors needs about (2 / |m|)^2 "
+                  "times its samples to reach 2 either way.", ""] + unresolved + [""]
     return lines, counts
+
+
+def unresolved_lines(results):
+    out = []
+    for claim in results.data["claims"]:
+        for solver, r in claim["per_solver"].items():
+            for check, ev in zip(claim["checks"], r["checks"]):
+                if ev.get("status") != "unresolved" or ev.get("margin") is None:
+                    continue
+                m = abs(ev["margin"])
+                need = (f"about {(2.0 / m) ** 2:.0f} times the samples" if m > 0.05 else
+                        "the value sits on the band's edge: more samples decide only if it moves")
+                out.append(f"- {claim['id']} {solver} ({check['quantity']}): margin "
+                           f"{ev['margin']:+.1f}; {need}")
+    return out
 
 
 CATEGORY_TEXT = {"a": "(a) the continuum and MD really differ",

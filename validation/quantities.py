@@ -259,8 +259,13 @@ def q_shock_location_fractional_rms(q):
     return float(m["shock_location_fractional_rms"])
 
 
-def q_particles_per_cycle_above(q):
-    value, error = q.run(q.cases[0]).particles_per_cycle_above(q.params["height"])
+def q_crossings_per_cycle_above(q):
+    value, error = q.run(q.cases[0]).per_cycle_count(f"crossings_z{q.params['height']:g}")
+    return Measured(value, error)
+
+
+def q_distinct_particles_per_cycle_above(q):
+    value, error = q.run(q.cases[0]).per_cycle_count(f"particles_z{q.params['height']:g}")
     return Measured(value, error)
 
 
@@ -313,7 +318,8 @@ QUANTITIES = {
     "shock_speed_trend_deviation_at_last": q_shock_speed_trend_deviation_at_last,
     "shock_speed_relative_change": q_shock_speed_relative_change,
     "shock_location_fractional_rms": q_shock_location_fractional_rms,
-    "particles_per_cycle_above": q_particles_per_cycle_above,
+    "crossings_per_cycle_above": q_crossings_per_cycle_above,
+    "distinct_particles_per_cycle_above": q_distinct_particles_per_cycle_above,
     "collapse_detected": q_collapse_detected,
     "com_apex_difference": q_com_apex_difference,
     "shock_curvature_difference": q_shock_curvature_difference,
@@ -339,7 +345,8 @@ REQUIRED_PARAMETERS = {
     "shock_speed_trend_deviation_at_last": ("order",),
     "shock_speed_relative_change": ("run", "reference"),
     "shock_location_fractional_rms": ("run", "reference"),
-    "particles_per_cycle_above": ("height",),
+    "crossings_per_cycle_above": ("height",),
+    "distinct_particles_per_cycle_above": ("height",),
     "com_apex_difference": ("high", "low"),
     "shock_curvature_difference": ("high", "low"),
 }

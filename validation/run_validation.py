@@ -113,10 +113,10 @@ class RunView:
                 self._profiles = {k: np.array(f["profiles"][k]) for k in f["profiles"]}
         return self._profiles
 
-    def particles_per_cycle_above(self, height):
-        """Upward crossings of z = height per cycle, counted by the solver (time-series column
-        crossings_z<height>) and averaged over cycles by `shaker analyze`."""
-        column = f"crossings_z{height:g}"
+    def per_cycle_count(self, column):
+        """A count per cycle that the solver records (time-series column crossings_z<h>:
+        upward crossings of z = h; particles_z<h>: distinct particles at or above h), averaged
+        over the cycles by `shaker analyze`: (mean, between-cycle standard error)."""
         if column not in self.crossings:
             raise quantities.NotMeasured(f"the run has no time-series column {column}")
         return self.crossings[column]

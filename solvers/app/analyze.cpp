@@ -118,7 +118,7 @@ struct Crossings {
 std::vector<Crossings> crossings(const std::vector<RunRecord>& runs, std::size_t samples) {
   std::vector<Crossings> out;
   for (const auto& name : runs.front().series.names) {
-    if (name.rfind("crossings_z", 0) != 0) continue;
+    if (name.rfind("crossings_z", 0) != 0 && name.rfind("particles_z", 0) != 0) continue;
     Crossings c{name, {}, NAN, NAN, {}};
     for (const auto& run : runs) {
       const auto counts = analysis::crossings_per_cycle(run, name);

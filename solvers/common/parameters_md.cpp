@@ -30,7 +30,8 @@ std::vector<ParameterSpec> md_parameters() {
            "same trajectory bit for bit").in("-"),
       real_list("md.crossing_heights", {80.0}, positive(),
                 "lab-frame heights h > 0 whose upward crossings by any particle are counted in "
-                "the time-series columns crossings_z<h> (cumulative since the start of the run)").in("sigma"),
+                "the time-series columns crossings_z<h>, and the distinct particles at or above h "
+                "in each cycle in particles_z<h> (both cumulative since the start of the run)").in("sigma"),
   };
 }
 

@@ -44,14 +44,25 @@ inline void advance(Particle& p, double t, double g) {
   p.t = t;
 }
 
-/// Whether the free flight of p from its local time to t rises through the lab-frame height h:
-/// it starts below h and reaches h, either at t or at its apex inside the interval. A free
-/// flight is one parabola, so it rises through h at most once.
-inline bool rises_through(const Particle& p, double t, double g, double h) {
-  if (!(p.r.z < h)) return false;
+/// Height of p at time t >= p.t in its free flight.
+inline double height_at(const Particle& p, double t, double g) {
   const double dt = t - p.t;
-  if (p.v.z - g * dt >= 0.0) return p.r.z + (p.v.z - 0.5 * g * dt) * dt >= h;  // still rising at t
-  return p.v.z > 0.0 && p.r.z + p.v.z * p.v.z / (2.0 * g) >= h;             // apex inside
+  return p.r.z + (p.v.z - 0.5 * g * dt) * dt;
+}
+
+/// Highest point of the free flight of p over [from, to] (p.t <= from <= to): the start if it
+/// is already falling there, the end if it is still rising there, else the apex.
+inline double flight_peak(const Particle& p, double from, double to, double g) {
+  if (p.v.z - g * (from - p.t) <= 0.0) return height_at(p, from, g);
+  if (p.v.z - g * (to - p.t) >= 0.0) return height_at(p, to, g);
+  return p.r.z + p.v.z * p.v.z / (2.0 * g);
+}
+
+/// Whether the free flight of p from its local time to t rises through the lab-frame height h:
+/// it starts below h and reaches h. A free flight is one parabola, so it rises through h at
+/// most once.
+inline bool rises_through(const Particle& p, double t, double g, double h) {
+  return p.r.z < h && flight_peak(p, p.t, t, g) >= h;
 }
 
 /// Everything needed to start or continue a run: positions, velocities and local times.

@@ -13,6 +13,7 @@
 namespace shaker::md {
 
 std::string crossing_column(double height) { return fmt::format("crossings_z{:g}", height); }
+std::string distinct_particles_column(double height) { return fmt::format("particles_z{:g}", height); }
 
 MdSettings MdSettings::from(const config::Config& c) {
   MdSettings s;
@@ -49,12 +50,15 @@ struct SeriesRows {
   std::vector<std::vector<double>> columns;
   explicit SeriesRows(const std::vector<double>& crossing_heights) {
     for (double h : crossing_heights) names.push_back(crossing_column(h));
+    for (double h : crossing_heights) names.push_back(distinct_particles_column(h));
     columns.resize(names.size());
   }
-  void add(std::initializer_list<double> row, const std::vector<std::uint64_t>& crossings) {
+  void add(std::initializer_list<double> row, const std::vector<std::uint64_t>& crossings,
+           const std::vector<std::uint64_t>& distinct_particles) {
     std::size_t k = 0;
     for (double x : row) columns[k++].push_back(x);
     for (std::uint64_t c : crossings) columns[k++].push_back(static_cast<double>(c));
+    for (std::uint64_t c : distinct_particles) columns[k++].push_back(static_cast<double>(c));
   }
   TimeSeries finish() {
     TimeSeries s;
@@ -84,7 +88,7 @@ class SeriesObserver final : public RunObserver {
   SeriesObserver(Simulation& sim, const ShakerKinematics& shaker, const MdSettings& settings,
                  const BudgetOrigin& origin, PhaseSnapshot& snapshot)
       : sim_(sim), shaker_(shaker), origin_(origin), snapshot_(snapshot), rows_(settings.crossing_heights) {
-    sim.count_crossings(settings.crossing_heights);
+    sim.start_height_counts(settings.crossing_heights, shaker.f);
   }
   void at_phase(const PhaseInstant& instant) override { record(instant.t); }
   void at_run_end(double t) override { record(t); }
@@ -112,7 +116,7 @@ class SeriesObserver final : public RunObserver {
                static_cast<double>(tally.guard_activations),
                static_cast<double>(sim_.count_overlaps(r, 1e-9)), near_plate,
                static_cast<double>(tally.pair - origin_.tally.pair)},
-              sim_.crossings_at(t));
+              sim_.crossings_at(t), sim_.distinct_particles_at(t));
   }
 
   const Simulation& sim_;

@@ -30,6 +30,9 @@ struct MdSettings {
 
 /// Name of the time-series column counting upward crossings of `height`: crossings_z80.
 std::string crossing_column(double height);
+/// Name of the time-series column counting distinct particles per cycle at or above `height`:
+/// particles_z80.
+std::string distinct_particles_column(double height);
 
 struct EnergyBudget {
   double plate_work = 0.0, collisional_loss = 0.0, energy_change = 0.0;
@@ -48,7 +51,10 @@ struct RunOutcome {
   /// less than half a diameter above the plate), collisions (pair collisions since the start
   /// of this run), crossings_z<h> for each h of md.crossing_heights (upward crossings of the
   /// lab-frame height h by any particle since the start of this run, exact: each free flight
-  /// is checked at the particle's updates, flights under way up to the row's time).
+  /// is checked at the particle's updates, flights under way up to the row's time), and
+  /// particles_z<h> for each h (summed over the cycles since the start of this run: the
+  /// distinct particles at or above h at some instant of the cycle, exact in the same way; the
+  /// difference between the rows at two consecutive cycle boundaries is that cycle's count).
   TimeSeries series;
   EnergyBudget budget;
   std::size_t overlaps = 0;  ///< at the end of the run

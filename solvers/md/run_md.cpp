@@ -71,9 +71,11 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
 void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometry& g) {
   const double n = static_cast<double>(c.particles);
   // Per particle: its state, event, last collision, cell links, queue node, sampled r and v,
-  // and the flat layer's site list; per cell a list head; per sampling bin and phase the
-  // pooled sums (13 doubles) and the profile's fields written out (2 x 9 doubles).
-  const double per_particle = sizeof(Particle) + sizeof(Event) + 8.0 + 16.0 + 64.0 + 2.0 * sizeof(Vec3) + 16.0;
+  // the flat layer's site list, and the last cycle counted at each crossing height; per cell a
+  // list head; per sampling bin and phase the pooled sums (13 doubles) and the profile's
+  // fields written out (2 x 9 doubles).
+  const double per_particle = sizeof(Particle) + sizeof(Event) + 8.0 + 16.0 + 64.0 + 2.0 * sizeof(Vec3) + 16.0 +
+                              4.0 * static_cast<double>(s.crossing_heights.size());
   const double rows = std::min(std::floor(g.height), g.plate_top() + 8.0 * n / (g.width * g.width) + 3.0);
   const double cells = std::floor(g.width) * std::floor(g.width) * std::max(rows, 3.0);
   const double bins = std::ceil(s.ceiling / s.bin_height);

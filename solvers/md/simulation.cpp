@@ -273,6 +273,7 @@ void Simulation::sort_by_cell() {
   permute(data_.particles);
   permute(data_.events);
   permute(data_.last_collision);
+  height_counts_.renumber(old_of_new);
   for (Event& e : data_.events)
     if (e.partner >= 0) e.partner = new_of_old[static_cast<std::size_t>(e.partner)];
   std::vector<std::int32_t> cell_of(n);
@@ -287,27 +288,8 @@ void Simulation::sort_by_cell() {
 
 void Simulation::update(std::int32_t i, double now) {
   Particle& p = data_.particles[i];
-  for (std::size_t k = 0; k < crossing_heights_.size(); ++k)
-    crossings_[k] += rises_through(p, now, geometry_.gravity, crossing_heights_[k]) ? 1 : 0;
+  height_counts_.count_flight(i, p, now);
   advance(p, now, geometry_.gravity);
-}
-
-// A particle's next update counts its whole flight since its local time, so the crossings
-// of flights under way that happened before now are subtracted here (a flight crosses at most
-// once, so what it did before now it still has done at its update).
-void Simulation::count_crossings(std::vector<double> heights) {
-  crossing_heights_ = std::move(heights);
-  crossings_.assign(crossing_heights_.size(), 0);
-  const std::vector<std::uint64_t> before = crossings_at(data_.time);
-  for (std::size_t k = 0; k < crossings_.size(); ++k) crossings_[k] = -static_cast<std::int64_t>(before[k]);
-}
-
-std::vector<std::uint64_t> Simulation::crossings_at(double t) const {
-  std::vector<std::int64_t> counts = crossings_;
-  for (const Particle& p : data_.particles)
-    for (std::size_t k = 0; k < crossing_heights_.size(); ++k)
-      counts[k] += rises_through(p, t, geometry_.gravity, crossing_heights_[k]) ? 1 : 0;
-  return std::vector<std::uint64_t>(counts.begin(), counts.end());
 }
 
 void Simulation::note_collision(std::int32_t i, std::int32_t partner, double before) {
@@ -596,7 +578,7 @@ std::size_t Simulation::bytes_per_particle() const {
   // Grids: cell heads, and the calendar's buckets (at most two per particle).
   const std::size_t grids = cells_.head_.size() * sizeof(std::int32_t) +
                             (use_calendar_ ? 2 * n * sizeof(std::int32_t) : 0);
-  return per_particle + grids / n;
+  return per_particle + height_counts_.bytes_per_particle() + grids / n;
 }
 
 }  // namespace shaker::md

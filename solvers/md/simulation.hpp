@@ -13,6 +13,7 @@
 #include "md/calendar_queue.hpp"
 #include "md/event_queue.hpp"
 #include "md/geometry.hpp"
+#include "md/height_counts.hpp"
 #include "md/particles.hpp"
 
 namespace shaker::md {
@@ -102,12 +103,20 @@ class Simulation {
   std::size_t count_overlaps(double t, double tolerance) const;
   /// The same for positions already computed by positions_at(time(), ...).
   std::size_t count_overlaps(const std::vector<Vec3>& r, double tolerance) const;
-  /// Starts counting upward crossings of these lab-frame heights at time() (counts start at
-  /// zero; crossings earlier in flights under way are not counted).
-  void count_crossings(std::vector<double> heights);
-  /// Upward crossings of each height since count_crossings, up to t >= time(): flights still
-  /// under way are counted up to t without changing any particle.
-  std::vector<std::uint64_t> crossings_at(double t) const;
+  /// Starts counting, for each of these lab-frame heights, upward crossings and distinct
+  /// particles per shaker cycle at time() (counts start at zero; what flights under way did
+  /// before is not counted). Cycle c is [c / cycle_frequency, (c + 1) / cycle_frequency).
+  void start_height_counts(std::vector<double> heights, double cycle_frequency) {
+    height_counts_.start(std::move(heights), cycle_frequency, geometry_.gravity, data_.time, data_.particles);
+  }
+  /// Upward crossings of each height since start_height_counts, up to t >= time(): flights
+  /// still under way are counted up to t without changing any particle.
+  std::vector<std::uint64_t> crossings_at(double t) const { return height_counts_.crossings_at(data_.particles, t); }
+  /// For each height, the sum over the cycles since start_height_counts of the distinct
+  /// particles at or above it at some instant of the cycle, up to t >= time().
+  std::vector<std::uint64_t> distinct_particles_at(double t) const {
+    return height_counts_.distinct_particles_at(data_.particles, t);
+  }
   /// Heap property, index, and every pending event in the future of time().
   bool queue_consistent() const;
   std::size_t bytes_per_particle() const;
@@ -146,7 +155,7 @@ class Simulation {
   /// sort_interval * N pair collisions.
   void sort_by_cell();
   static constexpr std::uint64_t sort_interval = 2;
-  /// Brings particle i to now, counting the crossings of its free flight on the way.
+  /// Brings particle i to now, counting what its free flight reached on the way.
   void update(std::int32_t i, double now);
 
   /// Software pipelining across events (large N, where every event waits for memory): while
@@ -184,9 +193,7 @@ class Simulation {
   IndexedHeap heap_;
   CalendarQueue calendar_;
   PlateContactFinder plate_finder_;
-  std::vector<double> crossing_heights_;
-  /// Crossings counted at particle updates, less those before count_crossings was called.
-  std::vector<std::int64_t> crossings_;
+  HeightCounts height_counts_;
 };
 
 }  // namespace shaker::md

@@ -148,13 +148,14 @@ def write_run(path, config_text, solver, seed):
         if solver == "md":
             per_cycle = 0.3 if config["layer"]["particles"] > 3000 else 5.0
             data["crossings_z80"] = per_cycle * (times - times[0]) * f
+            data["particles_z80"] = 0.8 * per_cycle * (times - times[0]) * f
             data["collisions"] = 240000.0 * (times - times[0]) * f
             # Running totals as a continued run has them (not starting at 0): SYNTHETIC_COLLISIONS
             # collisions in the run, pair + plate.
             data["pair_collisions"] = np.linspace(5000.0, 5000.0 + SYNTHETIC_COLLISIONS - 20000.0, len(times))
             data["plate_collisions"] = np.linspace(700.0, 700.0 + 20000.0, len(times))
             data["ceiling_collisions"] = np.full(len(times), 3.0)
-            columns += ["crossings_z80", "collisions", "pair_collisions", "plate_collisions",
+            columns += ["crossings_z80", "particles_z80", "collisions", "pair_collisions", "plate_collisions",
                         "ceiling_collisions"]
         s.attrs["columns"] = ",".join(columns)
         for name in columns:

@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <vector>
 
 #include "common/config.hpp"
 #include "common/case_parameters.hpp"
@@ -55,8 +56,11 @@ Simulation base_case(Restitution restitution, int transient, QueueKind queue) {
   return sim;
 }
 
-void BaseCaseCycle(benchmark::State& state, Restitution restitution, QueueKind queue) {
+/// crossing_heights: counted as `shaker md` counts md.crossing_heights (none: not counted).
+void BaseCaseCycle(benchmark::State& state, Restitution restitution, QueueKind queue,
+                   std::vector<double> crossing_heights) {
   Simulation sim = base_case(restitution, 10, queue);
+  if (!crossing_heights.empty()) sim.start_height_counts(crossing_heights, 0.095);
   const double period = 1.0 / 0.095;
   const std::uint64_t start = sim.tally().collisions();
   for (auto _ : state) sim.advance_to(sim.time() + period);
@@ -66,14 +70,19 @@ void BaseCaseCycle(benchmark::State& state, Restitution restitution, QueueKind q
       static_cast<double>(sim.tally().collisions() - start), benchmark::Counter::kAvgIterations);
   state.counters["bytes_per_particle"] = static_cast<double>(sim.bytes_per_particle());
 }
-// The default queue (calendar), and the heap for comparison.
-BENCHMARK_CAPTURE(BaseCaseCycle, constant_e, Restitution{Restitution::Kind::constant, 0.9}, QueueKind::calendar)
+// The default queue (calendar), and the heap for comparison; the default crossing height
+// counted (what a run pays for it).
+BENCHMARK_CAPTURE(BaseCaseCycle, constant_e, Restitution{Restitution::Kind::constant, 0.9}, QueueKind::calendar,
+                  std::vector<double>{})
+    ->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK_CAPTURE(BaseCaseCycle, constant_e_crossings_z80, Restitution{Restitution::Kind::constant, 0.9},
+                  QueueKind::calendar, std::vector<double>{80.0})
     ->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK_CAPTURE(BaseCaseCycle, velocity_dependent_e, Restitution{Restitution::Kind::velocity_dependent, 0.9},
-                  QueueKind::calendar)
+                  QueueKind::calendar, std::vector<double>{})
     ->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK_CAPTURE(BaseCaseCycle, constant_e_heap, Restitution{Restitution::Kind::constant, 0.9},
-                  QueueKind::heap)
+                  QueueKind::heap, std::vector<double>{})
     ->Unit(benchmark::kMillisecond)->Iterations(5);
 
 /// The whole base-case run as `shaker md` does it: 10 transient + 10 sampled cycles with

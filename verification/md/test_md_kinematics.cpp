@@ -162,7 +162,7 @@ TEST(MdKinematics, UpwardCrossingsOfABallThrownUpFromAFixedPlate) {
   s.particles[0].r = {2.5, 2.5, 0.5 + 1e-12};
   s.particles[0].v = {0.0, 0.0, v0};
   Simulation sim(plate_box(0.0, 1.0), constant_e(e), s);
-  sim.count_crossings(heights);
+  sim.start_height_counts(heights, 1.0);
   std::vector<std::uint64_t> expected(heights.size(), 0);
   std::vector<std::uint64_t> previous(heights.size(), 0);
   bool monotone = true;
@@ -196,7 +196,7 @@ TEST(MdKinematics, CrossingsCountOnlyFlightsAfterCountingStarts) {
   s.particles[0].v = {0.0, 0.0, 4.0};  // apex 8.5, first landing at t = 8
   Simulation sim(plate_box(0.0, 1.0), constant_e(1.0), s);
   sim.advance_to(2.0);  // at z = 6.5: h = 3 already crossed in this flight
-  sim.count_crossings({3.0});
+  sim.start_height_counts({3.0}, 1.0);
   EXPECT_EQ(sim.crossings_at(2.0)[0], 0u);
   sim.advance_to(7.9);
   EXPECT_EQ(sim.crossings_at(7.9)[0], 0u);
@@ -204,6 +204,90 @@ TEST(MdKinematics, CrossingsCountOnlyFlightsAfterCountingStarts) {
   EXPECT_EQ(sim.crossings_at(9.0)[0], 1u);
   sim.advance_to(17.0);
   EXPECT_EQ(sim.crossings_at(17.0)[0], 2u);
+}
+
+/// A ball of plate_box at (x, y, z) moving straight up or down at vz (it never meets a ball at
+/// another (x, y) at least one diameter away).
+Particle vertical_ball(double x, double y, double z, double vz) {
+  Particle p;
+  p.r = {x, y, z};
+  p.v = {0.0, 0.0, vz};
+  return p;
+}
+
+/// The per-cycle counts from running counts read at consecutive cycle boundaries.
+std::vector<std::uint64_t> per_cycle(const std::vector<std::vector<std::uint64_t>>& readings, std::size_t k) {
+  std::vector<std::uint64_t> counts;
+  for (std::size_t c = 1; c < readings.size(); ++c) counts.push_back(readings[c][k] - readings[c - 1][k]);
+  return counts;
+}
+
+TEST(MdKinematics, DistinctParticlesPerCycleOfElasticBallsOnAFixedPlate) {
+  // Five balls bounce elastically straight up and down on the fixed plate (contact at z = 1/2),
+  // in cycles of length 8 (f = 1/8). A starts at rest at its apex 6.5; B, C, E, F leave the
+  // plate at speeds 2.4, 1, 3.2 and 7 (apexes 3.38, 1, 5.62, 25; bounce periods 4.8, 2, 6.4,
+  // 14; A's is 2 sqrt(12)). A ball is at or above h within (apex time) +- sqrt(2 (apex - h)):
+  //   h = 2.5: A in [0, 2.83], [4.10, 9.76], [11.03, 16.68], [17.96, 23.61], [24.88, 30.54],
+  //            [31.81, ...]; B in [1.07, 3.73] + 4.8 k; E in [0.70, 5.70] + 6.4 k;
+  //            F in [0.29, 13.71] + 14 k; C never.
+  //   h = 4.5: A in [0, 2], [4.93, 8.93], [11.86, 15.86], [18.79, 22.79], [25.71, 29.71];
+  //            E in [1.70, 4.70] + 6.4 k; F in [0.60, 13.40] + 14 k; B and C never.
+  //   h = 22:  F only, in [4.55, 9.45] and [18.55, 23.45]: not in the last cycle.
+  // A is above every h but 22 when counting starts. Flights across t = 8 or 16 (A, B, E, F at
+  // 2.5; A and F at t = 8, E and F at t = 16 at 4.5; F at t = 8 at 22) count in both cycles,
+  // once per ball, while B rises through 2.5 twice in cycles 0, 1 and 3 and E through 4.5
+  // twice in cycle 1.
+  const double f = 0.125;
+  const std::vector<double> heights = {2.5, 4.5, 22.0};
+  State s;
+  s.particles = {vertical_ball(1.0, 1.0, 6.5, 0.0), vertical_ball(1.0, 3.5, 0.5 + 1e-12, 2.4),
+                 vertical_ball(3.5, 1.0, 0.5 + 1e-12, 1.0), vertical_ball(3.5, 3.5, 0.5 + 1e-12, 3.2),
+                 vertical_ball(2.25, 2.25, 0.5 + 1e-12, 7.0)};
+  Simulation sim(plate_box(0.0, 1.0), constant_e(1.0), s);
+  sim.start_height_counts(heights, f);
+  std::vector<std::vector<std::uint64_t>> distinct{sim.distinct_particles_at(0.0)}, crossings{sim.crossings_at(0.0)};
+  bool monotone = true;
+  for (int cycle = 0; cycle < 4; ++cycle) {
+    std::vector<std::uint64_t> previous = distinct.back();
+    for (int step = 1; step <= 40; ++step) {  // readings between events too
+      const double t = (cycle + step / 40.0) / f;
+      sim.advance_to(t);
+      const std::vector<std::uint64_t> now = sim.distinct_particles_at(t);
+      for (std::size_t k = 0; k < heights.size(); ++k)
+        monotone = monotone && now[k] >= previous[k] && now[k] <= distinct.back()[k] + s.particles.size();
+      previous = now;
+    }
+    distinct.push_back(sim.distinct_particles_at(sim.time()));
+    crossings.push_back(sim.crossings_at(sim.time()));
+  }
+  using Counts = std::vector<std::uint64_t>;
+  EXPECT_EQ(distinct.front(), Counts(3, 0));
+  EXPECT_EQ(per_cycle(distinct, 0), Counts({4, 4, 4, 4}));
+  EXPECT_EQ(per_cycle(crossings, 0), Counts({6, 5, 3, 6}));
+  EXPECT_EQ(per_cycle(distinct, 1), Counts({3, 3, 3, 3}));
+  EXPECT_EQ(per_cycle(crossings, 1), Counts({3, 4, 2, 3}));
+  EXPECT_EQ(per_cycle(distinct, 2), Counts({1, 1, 1, 0}));
+  EXPECT_EQ(per_cycle(crossings, 2), Counts({1, 0, 1, 0}));
+  EXPECT_TRUE(monotone);
+  EXPECT_EQ(sim.tally().pair, 0u);
+}
+
+TEST(MdKinematics, DistinctParticlesCountOnlyFromWhenCountingStarts) {
+  // Thrown up at 4 from the plate: at or above h = 7.9 in [2.90, 5.10] and, after the bounce
+  // at t = 8, in [10.90, 13.10]. Counting starts at t = 5.5 in cycle 0 = [0, 8): the flight
+  // under way (no cell crossing above z = 3 updates it) reached h before, so cycle 0 counts
+  // nothing and cycle 1 one particle.
+  State s;
+  s.particles = {vertical_ball(2.5, 2.5, 0.5 + 1e-12, 4.0)};
+  Simulation sim(plate_box(0.0, 1.0), constant_e(1.0), s);
+  sim.advance_to(5.5);
+  sim.start_height_counts({7.9}, 0.125);
+  EXPECT_EQ(sim.distinct_particles_at(5.5)[0], 0u);
+  sim.advance_to(8.0);
+  EXPECT_EQ(sim.distinct_particles_at(8.0)[0], 0u);
+  sim.advance_to(16.0);
+  EXPECT_EQ(sim.distinct_particles_at(16.0)[0], 1u);
+  EXPECT_EQ(sim.crossings_at(16.0)[0], 1u);
 }
 
 /// Independent reference for the oscillating plate: dense scan + long double bisection.

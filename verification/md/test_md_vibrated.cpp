@@ -1,9 +1,11 @@
-// The vibrated layer: the base-case smoke test, energy budget, checkpoint restart, the collapse
-// detector and guard, the single-shock protocol, and the hydrostatic elastic gas.
+// The vibrated layer: the base-case smoke test, energy budget, heights reached per cycle,
+// checkpoint restart, the collapse detector and guard, the single-shock protocol, and the
+// hydrostatic elastic gas.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <numeric>
 
 #include "analysis/analysis.hpp"
 #include "common/config.hpp"
@@ -93,20 +95,233 @@ TEST(MdVibrated, CrossingAndCollisionColumnsAreCumulative) {
   const RunRecord record = read_run_file(dir / "crossings.h5");
   const auto& low = record.series.column("crossings_z12.5");
   const auto& high = record.series.column("crossings_z80");
+  const auto& low_particles = record.series.column("particles_z12.5");
+  const auto& high_particles = record.series.column("particles_z80");
   const auto& collisions = record.series.column("collisions");
   const auto& pair = record.series.column("pair_collisions");
   bool monotone = true;
   for (std::size_t k = 1; k < low.size(); ++k)
     monotone = monotone && low[k] >= low[k - 1] && high[k] >= high[k - 1] &&
+               low_particles[k] >= low_particles[k - 1] && high_particles[k] >= high_particles[k - 1] &&
                collisions[k] >= collisions[k - 1];
-  std::printf("measured: %g crossings of z = 12.5, %g of z = 80, %g pair collisions\n",
-              low.back(), high.back(), collisions.back());
+  std::printf("measured: %g crossings of z = 12.5, %g of z = 80, %g pair collisions; %g and %g "
+              "distinct particles per cycle summed\n", low.back(), high.back(), collisions.back(),
+              low_particles.back(), high_particles.back());
   EXPECT_TRUE(monotone);
   EXPECT_GT(low.back(), 1000.0);  // the layer is thrown above 12.5 every cycle
   EXPECT_LE(high.back(), low.back());
+  EXPECT_EQ(low_particles.front(), 0.0);
+  EXPECT_GT(low_particles.back(), 1000.0);
+  EXPECT_LE(low_particles.back(), 2.0 * 3937);  // at most every particle in each of 2 cycles
+  EXPECT_LE(high_particles.back(), low_particles.back());
   EXPECT_EQ(collisions.back() - collisions.front(), pair.back() - pair.front());
   EXPECT_EQ(collisions.front(), 0.0);  // the first row is the start of the run
   EXPECT_GT(collisions.back(), 1e5);
+}
+
+constexpr double base_frequency = 0.095;  // the base case's shaker.frequency
+
+/// A plate of the base case's frequency shaken at peak acceleration gamma g, width x width.
+Geometry shaken_plate(double gamma, double width) {
+  Geometry g;
+  g.width = width;
+  g.plate = PlateMotion::from(ShakerKinematics{gamma, base_frequency});
+  return g;
+}
+
+CollisionRules constant_restitution(double e) {
+  CollisionRules rules;
+  rules.restitution = Restitution{Restitution::Kind::constant, e};
+  return rules;
+}
+
+/// Per height and cycle: upward crossings, distinct particles, and particles at or above the
+/// height at the cycle's start.
+struct CycleCounts {
+  std::vector<std::vector<std::uint64_t>> crossings, distinct, above_at_start;
+};
+
+/// Counts `cycles` cycles of the shaker frequency f from sim's time (a cycle boundary): the
+/// running counts read at consecutive boundaries, and the positions at each.
+CycleCounts count_cycles(Simulation& sim, const std::vector<double>& heights, double f, int cycles) {
+  const double first = std::round(sim.time() * f);
+  sim.start_height_counts(heights, f);
+  CycleCounts out;
+  out.crossings.resize(heights.size());
+  out.distinct.resize(heights.size());
+  out.above_at_start.resize(heights.size());
+  std::vector<std::uint64_t> crossings = sim.crossings_at(sim.time()), distinct = sim.distinct_particles_at(sim.time());
+  std::vector<Vec3> r, v;
+  for (int c = 0; c < cycles; ++c) {
+    sim.positions_at(sim.time(), r, v);
+    for (std::size_t k = 0; k < heights.size(); ++k)
+      out.above_at_start[k].push_back(static_cast<std::uint64_t>(
+          std::count_if(r.begin(), r.end(), [&](const Vec3& x) { return x.z >= heights[k]; })));
+    sim.advance_to((first + c + 1) / f);
+    const std::vector<std::uint64_t> x = sim.crossings_at(sim.time()), d = sim.distinct_particles_at(sim.time());
+    for (std::size_t k = 0; k < heights.size(); ++k) {
+      out.crossings[k].push_back(x[k] - crossings[k]);
+      out.distinct[k].push_back(d[k] - distinct[k]);  // wraps around (fails below) if it fell
+    }
+    crossings = x;
+    distinct = d;
+  }
+  return out;
+}
+
+TEST(MdVibrated, DistinctParticlesPerCycleAreBoundedByCrossingsAndParticlesAbove) {
+  // A small vibrated layer with pair collisions (the base case's plate and depth on a 6 x 6
+  // plate). A particle counted in a cycle was at or above h at its start or rose through h in
+  // it, and every particle above h at the start counts.
+  const Geometry g = shaken_plate(3.0, 6.0);
+  const std::size_t n = 354;  // the base case's 3937 per 20 x 20
+  Simulation sim(g, constant_restitution(0.9), flat_layer(g, n, 17));
+  sim.advance_to(2.0 / base_frequency);
+  const std::vector<double> heights = {12.5, 20.5, 30.5, 45.5};
+  const CycleCounts counts = count_cycles(sim, heights, base_frequency, 4);
+  bool bounded = true;
+  int differ = 0;  // cycles with fewer distinct particles than crossings plus particles above
+  for (std::size_t k = 0; k < heights.size(); ++k) {
+    for (std::size_t c = 0; c < counts.distinct[k].size(); ++c) {
+      const std::uint64_t d = counts.distinct[k][c], x = counts.crossings[k][c], a = counts.above_at_start[k][c];
+      bounded = bounded && a <= d && d <= x + a && d <= n;
+      differ += d < x + a ? 1 : 0;
+      std::printf("measured: h = %g, cycle %zu: %llu distinct, %llu crossings, %llu above at the start\n",
+                  heights[k], c, static_cast<unsigned long long>(d), static_cast<unsigned long long>(x),
+                  static_cast<unsigned long long>(a));
+    }
+  }
+  EXPECT_TRUE(bounded);
+  EXPECT_GT(differ, 0);  // particles crossing twice in a cycle, or above at its start and crossing
+  const std::vector<std::uint64_t>& highest = counts.distinct.back();
+  EXPECT_GT(std::accumulate(highest.begin(), highest.end(), std::uint64_t{0}), 0u);
+  EXPECT_GT(sim.tally().pair, 10000u);
+}
+
+/// Per particle and cycle, from the particles' free flights one by one (independently of the
+/// solver's counting): upward crossings of h, at the rising root of z(t) = h, and whether the
+/// particle is at or above h at the cycle's start. It reaches h in a cycle exactly if it is
+/// above at the start or crosses during it.
+class FlightReference {
+ public:
+  FlightReference(double h, double f, double first_cycle, int cycles, std::size_t n)
+      : h_(h), f_(f), first_(first_cycle), cycles_(cycles),
+        crossings_(n, std::vector<int>(static_cast<std::size_t>(cycles), 0)),
+        above_(n, std::vector<bool>(static_cast<std::size_t>(cycles), false)) {}
+
+  /// The free flight of particle i (state p) over [p.t, end] (gravity 1).
+  void add(std::size_t i, const Particle& p, double end) {
+    if (p.r.z < h_ && p.v.z > 0.0) {
+      const double discriminant = p.v.z * p.v.z - 2.0 * (h_ - p.r.z);
+      if (discriminant >= 0.0) {
+        const double at = p.t + 2.0 * (h_ - p.r.z) / (p.v.z + std::sqrt(discriminant));
+        const double c = std::floor(at * f_) - first_;
+        if (at <= end && c >= 0 && c < cycles_) ++crossings_[i][static_cast<std::size_t>(c)];
+      }
+    }
+    for (int c = 0; c < cycles_; ++c) {
+      const double start = (first_ + c) / f_, dt = start - p.t;
+      if (dt >= 0.0 && start < end && p.r.z + p.v.z * dt - 0.5 * dt * dt >= h_) above_[i][static_cast<std::size_t>(c)] = true;
+    }
+  }
+  std::uint64_t crossings(int c) const {
+    std::uint64_t sum = 0;
+    for (const auto& particle : crossings_) sum += static_cast<std::uint64_t>(particle[static_cast<std::size_t>(c)]);
+    return sum;
+  }
+  std::uint64_t distinct(int c) const {
+    std::uint64_t sum = 0;
+    for (std::size_t i = 0; i < crossings_.size(); ++i)
+      sum += crossings_[i][static_cast<std::size_t>(c)] > 0 || above_[i][static_cast<std::size_t>(c)] ? 1 : 0;
+    return sum;
+  }
+  /// Particles crossing more than once in a cycle, and particles above h at a cycle's start.
+  int repeats() const { return tally([](int crossed, bool) { return crossed > 1; }); }
+  int above_at_starts() const { return tally([](int, bool above) { return above; }); }
+
+ private:
+  template <class Test> int tally(Test test) const {
+    int count = 0;
+    for (std::size_t i = 0; i < crossings_.size(); ++i)
+      for (std::size_t c = 0; c < crossings_[i].size(); ++c) count += test(crossings_[i][c], above_[i][c]) ? 1 : 0;
+    return count;
+  }
+  double h_, f_, first_;
+  int cycles_;
+  std::vector<std::vector<int>> crossings_;
+  std::vector<std::vector<bool>> above_;
+};
+
+bool same_state(const Particle& p, const Particle& q) {
+  const double x[] = {p.r.x, p.r.y, p.r.z, p.v.x, p.v.y, p.v.z, p.t};
+  const double y[] = {q.r.x, q.r.y, q.r.z, q.v.x, q.v.y, q.v.z, q.t};
+  return std::memcmp(x, y, sizeof x) == 0;
+}
+
+TEST(MdVibrated, DistinctParticlesEqualCrossingsWhenEachBallCrossesAtMostOnce) {
+  // Nine balls on a plate shaken at Gamma = 1.5, inelastic (e = 0.5), straight up and down,
+  // too far apart to meet. A twin of the run is stepped event by event to follow every free
+  // flight of every ball (FlightReference). Just above the plate's lowest contact height balls
+  // chatter, crossing several times in a cycle, and start cycles above it; the two upper
+  // heights each ball crosses at most once per cycle and never starts a cycle above them, so
+  // there the distinct particles of a cycle are its crossings. The heights are off the cell
+  // boundaries (integers), where a flight is cut exactly at h and the reference's root is a
+  // rounding away from the cut.
+  const Geometry g = shaken_plate(1.5, 18.0);
+  const CollisionRules rules = constant_restitution(0.5);
+  Random random(23);
+  State s;
+  for (int k = 0; k < 9; ++k) {
+    Particle p;
+    p.r = {3.0 + 6.0 * (k % 3), 3.0 + 6.0 * (k / 3), random.uniform(1.5, 6.0)};
+    s.particles.push_back(p);
+  }
+  const std::vector<double> heights = {0.95, 5.3, 9.8};
+  const double f = base_frequency;
+  const int transient = 2, cycles = 10;
+  Simulation counted(g, rules, s), stepped(g, rules, s);
+  counted.advance_to(transient / f);
+  const CycleCounts counts = count_cycles(counted, heights, f, cycles);
+
+  const double end = (transient + cycles) / f;
+  std::vector<FlightReference> reference;
+  for (double h : heights) reference.emplace_back(h, f, transient, cycles, s.particles.size());
+  std::vector<Particle> last = stepped.particles();
+  auto follow = [&](std::size_t i, double until) {
+    for (FlightReference& r : reference) r.add(i, last[i], until);
+  };
+  while (stepped.time() < end) {
+    stepped.step();
+    for (std::size_t i = 0; i < last.size(); ++i)
+      if (!same_state(stepped.particles()[i], last[i])) {
+        follow(i, stepped.particles()[i].t);
+        last[i] = stepped.particles()[i];
+      }
+  }
+  for (std::size_t i = 0; i < last.size(); ++i) follow(i, end);  // flights under way
+
+  for (std::size_t k = 0; k < reference.size(); ++k)
+    for (int c = 0; c < cycles; ++c) {
+      const auto at = static_cast<std::size_t>(c);
+      EXPECT_EQ(counts.crossings[k][at], reference[k].crossings(c)) << "height " << k << ", cycle " << c;
+      EXPECT_EQ(counts.distinct[k][at], reference[k].distinct(c)) << "height " << k << ", cycle " << c;
+    }
+  std::printf("measured: h = %g: %d repeated crossings, %d cycle starts above\n", heights[0],
+              reference[0].repeats(), reference[0].above_at_starts());
+  EXPECT_GT(reference[0].repeats(), 0);
+  EXPECT_GT(reference[0].above_at_starts(), 0);
+  for (std::size_t k = 1; k < heights.size(); ++k) {
+    EXPECT_EQ(reference[k].repeats(), 0) << heights[k];  // the construction
+    EXPECT_EQ(reference[k].above_at_starts(), 0) << heights[k];
+    std::uint64_t crossed = 0;
+    for (std::size_t c = 0; c < counts.crossings[k].size(); ++c) {
+      EXPECT_EQ(counts.distinct[k][c], counts.crossings[k][c]) << "h = " << heights[k] << ", cycle " << c;
+      crossed += counts.crossings[k][c];
+    }
+    std::printf("measured: h = %g: %llu crossings\n", heights[k], static_cast<unsigned long long>(crossed));
+    EXPECT_GT(crossed, 0u) << heights[k];
+  }
+  EXPECT_EQ(counted.tally().pair, 0u);
 }
 
 bool same_bits(const SimulationData& a, const SimulationData& b) {
@@ -147,11 +362,13 @@ TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
   // shaker md with md.checkpoint_output, then md.initial_state = checkpoint, against one run.
   const auto dir = testing::test_directory();
   config::Config first = base_case(dir / "a.h5");
+  first.set("md.crossing_heights=[12.5]");
   first.set("run.transient_cycles=1");
   first.set("run.sampled_cycles=1");
   first.set("md.checkpoint_output=" + (dir / "a-end.h5").string());
   ASSERT_EQ(run(first), 0);
   config::Config second = base_case(dir / "b.h5");
+  second.set("md.crossing_heights=[12.5]");
   second.set("run.transient_cycles=0");
   second.set("run.sampled_cycles=1");
   second.set("md.initial_state=checkpoint");
@@ -159,6 +376,7 @@ TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
   second.set("md.checkpoint_output=" + (dir / "b-end.h5").string());
   ASSERT_EQ(run(second), 0);
   config::Config straight = base_case(dir / "c.h5");
+  straight.set("md.crossing_heights=[12.5]");
   straight.set("run.transient_cycles=1");
   straight.set("run.sampled_cycles=2");
   straight.set("md.checkpoint_output=" + (dir / "c-end.h5").string());
@@ -166,6 +384,19 @@ TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
   const Checkpoint b = read_checkpoint(dir / "b-end.h5"), c = read_checkpoint(dir / "c-end.h5");
   EXPECT_NEAR(b.data.time, 3.0 / 0.095, 1e-12);
   EXPECT_TRUE(same_bits(b.data, c.data));
+  // The counts restart with the run (they are not in checkpoints); the restarted run's last
+  // cycle has the straight run's counts.
+  const RunRecord restarted = read_run_file(dir / "b.h5"), whole = read_run_file(dir / "c.h5");
+  const auto& t = whole.series.column("t");
+  const auto cycle_start = static_cast<std::size_t>(std::find(t.begin(), t.end(), 2.0 / 0.095) - t.begin());
+  ASSERT_LT(cycle_start, t.size());
+  for (const char* name : {"crossings_z12.5", "particles_z12.5"}) {
+    const auto& part = restarted.series.column(name);
+    const auto& all = whole.series.column(name);
+    EXPECT_EQ(part.front(), 0.0) << name;
+    EXPECT_EQ(part.back(), all.back() - all[cycle_start]) << name;
+    EXPECT_GT(part.back(), 0.0) << name;
+  }
 }
 
 TEST(MdVibrated, CollapseIsDetectedAndReportedForLowE) {
