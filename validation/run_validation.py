@@ -31,7 +31,6 @@ import hashlib
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 import time
@@ -284,7 +283,7 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None):
     if rc == 0 and os.path.exists(output):
         status = "ok"
     elif rc is None:
-        status = "hang"
+        status = f"timed out after {run['timeout']:.0f} s"
     elif rc == SOLVER_UNAVAILABLE:
         status = "unavailable"
     elif rc == 1 and "collapse" in stderr.lower():
