@@ -263,7 +263,7 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None):
             record["reused"] = True
             return record
     if reuse_only:
-        status = "ok" if os.path.exists(output) else "unavailable"
+        status = "ok" if os.path.exists(output) else "not run"
         return dict(status=status, path=output if status == "ok" else None, seconds=0.0,
                     key=key, config=text, reused=status == "ok", returncode=None,
                     stderr="--reuse-only: no finished run", command="")
