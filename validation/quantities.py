@@ -277,10 +277,11 @@ def q_collapse_detected(q):
         return 1.0
     if view.status in ("unavailable", "not run"):
         raise NotMeasured(f"the run is {view.status}")
-    view.notes.add({"ok": "the run finished without reporting collapse",
-                    "hang": "the run did not finish within its time limit (a hang, not a "
-                            "detection)"}.get(view.status, f"the run failed without naming "
-                                                           f"collapse: {view.stderr_tail}"))
+    if view.status.startswith("timed out"):
+        view.notes.add("the run did not finish within its time limit (a hang, not a detection)")
+    else:
+        view.notes.add("the run finished without reporting collapse" if view.status == "ok"
+                       else f"the run failed without naming collapse: {view.stderr_tail}")
     return 0.0
 
 

@@ -31,7 +31,6 @@ import hashlib
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 import time
@@ -264,7 +263,7 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None):
             record["reused"] = True
             return record
     if reuse_only:
-        status = "ok" if os.path.exists(output) else "unavailable"
+        status = "ok" if os.path.exists(output) else "not run"
         return dict(status=status, path=output if status == "ok" else None, seconds=0.0,
                     key=key, config=text, reused=status == "ok", returncode=None,
                     stderr="--reuse-only: no finished run", command="")
@@ -284,7 +283,7 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None):
     if rc == 0 and os.path.exists(output):
         status = "ok"
     elif rc is None:
-        status = "hang"
+        status = f"timed out after {run['timeout']:.0f} s"
     elif rc == SOLVER_UNAVAILABLE:
         status = "unavailable"
     elif rc == 1 and "collapse" in stderr.lower():
@@ -634,6 +633,9 @@ def main(argv=None):
     parser.add_argument("--require", default="",
                         help="comma-separated claim ids that must pass (else exit status 1); "
                         "ID:SOLVER requires only that solver's check (e.g. C1:md)")
+    parser.add_argument("--require-not-failing", default="",
+                        help="like --require, but 'unresolved' (within 2 standard errors of "
+                        "the band) is accepted too: what a study with few samples can show")
     parser.add_argument("--rerun", action="store_true", help="ignore finished runs")
     parser.add_argument("--reuse-only", action="store_true",
                         help="never start a solver; use finished runs in --workdir only")
@@ -721,7 +723,8 @@ def main(argv=None):
     if report.returncode != 0:
         log("the report generator failed")
         return 1
-    failing = required_not_passing(results, args.require)
+    failing = required_not_passing(results, args.require, {"pass"})
+    failing += required_not_passing(results, args.require_not_failing, {"pass", "unresolved"})
     for c in results:
         log(f"{c['id']}: {c['status']}  " + "; ".join(
             f"{s}: {r['status']} {_format_value(r['checks'][0].get('value'))}"
@@ -732,9 +735,10 @@ def main(argv=None):
     return 0
 
 
-def required_not_passing(results, require):
-    """The entries of --require (ID, or ID:SOLVER for one solver's check of a claim, e.g.
-    C1:md) that do not pass, as 'ID (status)' strings; an unknown entry counts as failing."""
+def required_not_passing(results, require, accepted):
+    """The entries of a requirement list (ID, or ID:SOLVER for one solver's check of a claim,
+    e.g. C1:md) whose status is not among `accepted`, as 'ID (status)' strings; an unknown
+    entry counts as failing."""
     failing = []
     for entry in (e.strip() for e in require.split(",") if e.strip()):
         claim_id, _, solver = entry.partition(":")
@@ -742,11 +746,11 @@ def required_not_passing(results, require):
         if claim is None:
             failing.append(f"{entry} (no such claim)")
         elif not solver:
-            if claim["status"] != "pass":
+            if claim["status"] not in accepted:
                 failing.append(f"{entry} ({claim['status']})")
         elif solver not in claim["per_solver"]:
             failing.append(f"{entry} (not checked for {solver})")
-        elif claim["per_solver"][solver]["status"] != "pass":
+        elif claim["per_solver"][solver]["status"] not in accepted:
             failing.append(f"{entry} ({claim['per_solver'][solver]['status']})")
     return failing
 
