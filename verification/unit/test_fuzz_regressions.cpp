@@ -3,11 +3,16 @@
 // build. The contract: InputError naming what is wrong, quickly.
 #include <gtest/gtest.h>
 
+#include <hdf5.h>
+
 #include <string>
 #include <vector>
 
 #include "common/config.hpp"
 #include "common/errors.hpp"
+#include "common/hdf5_file.hpp"
+#include "common/run_file.hpp"
+#include "sample_run.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -71,6 +76,39 @@ TEST(FuzzRegressionConfig, OrdinaryDocumentsPassTheNestingCheck) {
       "case.toml");
   EXPECT_EQ(c.real("material.e"), 0.5);
   EXPECT_EQ(c.real_list("md.crossing_heights").size(), 3u);
+}
+
+// A run file whose profiles have 30,000 bins and whose cycle_samples/cycles matrix claims
+// 30,000 samples per phase (a few MB in all) made the reader allocate the per-sample sums,
+// 3 x 30,000 x 30,000 bins (108 GB), before it checked the sums' shapes: std::bad_alloc, exit 1.
+// The shapes are now checked first.
+TEST(FuzzRegressionRunFile, SampleShapesAreCheckedBeforeTheSumsAreAllocated) {
+  const shaker::testing::TemporaryDirectory dir;
+  const auto path = dir / "huge-samples.h5";
+  shaker::write_run_file(path, shaker::testing::make_sample_record(false));
+  {
+    namespace h5 = shaker::h5;
+    h5::Handle file(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    ASSERT_GE(file.id(), 0);
+    const std::size_t phases = shaker::testing::sample_phases, bins = 30000;
+    const std::vector<double> ones(phases * bins, 1.0);
+    {
+      h5::Handle profiles = h5::open_group(file.id(), "profiles");
+      for (const char* field : {"z", "n", "nu", "uz", "T"}) {
+        H5Ldelete(profiles.id(), field, H5P_DEFAULT);
+        h5::write(profiles.id(), field, ones, phases, bins);
+      }
+      for (const char* optional : {"samples", "n_se", "uz_se", "T_se"})
+        if (h5::exists(profiles.id(), optional)) H5Ldelete(profiles.id(), optional, H5P_DEFAULT);
+    }
+    h5::Handle samples = h5::create_group(file.id(), "cycle_samples");
+    h5::write_attribute(samples.id(), "bin_volume", 1.0);
+    h5::write(samples.id(), "cycles", ones, phases, bins);  // 30,000 samples of one cycle each
+    for (const char* sum : {"count", "vx", "vy", "vz", "v2"})
+      h5::write(samples.id(), sum, std::vector<double>{1.0}, 1, 1);
+  }
+  expect_input_error([&] { shaker::read_run_file(path); },
+                     {"huge-samples.h5", "cycle_samples/count is not a [90000 x 30000] matrix"}, 10.0);
 }
 
 }  // namespace
