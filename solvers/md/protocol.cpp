@@ -44,7 +44,7 @@ struct SeriesRows {
       "t", "phase", "plate_z", "com_z", "kinetic", "potential", "plate_work",
       "collisional_loss", "energy_closure", "pair_collisions", "plate_collisions",
       "ceiling_collisions", "cell_crossings", "guard_activations", "overlaps", "near_plate",
-      "collisions"};
+      "collisions", "queue_consistent"};
   std::vector<std::vector<double>> columns;
   explicit SeriesRows(const std::vector<double>& crossing_heights) {
     for (double h : crossing_heights) names.push_back(crossing_column(h));
@@ -115,7 +115,8 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters,
               static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
               static_cast<double>(tally.guard_activations),
               static_cast<double>(sim.count_overlaps(r, 1e-9)), near_plate,
-              static_cast<double>(tally.pair - tally0.pair)},
+              static_cast<double>(tally.pair - tally0.pair),
+              sim.queue_consistent() ? 1.0 : 0.0},
              sim.crossings_at(t));
   };
 
