@@ -246,7 +246,40 @@ int toml_nesting(const std::string& text) {
   return deepest;
 }
 
-void check_nesting(const std::string& text, const std::string& origin) {
+/// Offset of the first byte that does not begin a valid UTF-8 sequence (overlong forms,
+/// surrogates and code points above U+10FFFF are invalid), or npos.
+std::size_t invalid_utf8_at(const std::string& text) {
+  const auto byte = [&](std::size_t i) { return static_cast<std::uint32_t>(static_cast<unsigned char>(text[i])); };
+  for (std::size_t i = 0; i < text.size();) {
+    const std::uint32_t lead = byte(i);
+    std::size_t length = 1;
+    std::uint32_t code = lead, smallest = 0;
+    if (lead >= 0x80) {
+      if ((lead & 0xE0) == 0xC0) length = 2, code = lead & 0x1F, smallest = 0x80;
+      else if ((lead & 0xF0) == 0xE0) length = 3, code = lead & 0x0F, smallest = 0x800;
+      else if ((lead & 0xF8) == 0xF0) length = 4, code = lead & 0x07, smallest = 0x10000;
+      else return i;
+      if (i + length > text.size()) return i;
+      for (std::size_t k = 1; k < length; ++k) {
+        if ((byte(i + k) & 0xC0) != 0x80) return i;
+        code = (code << 6) | (byte(i + k) & 0x3F);
+      }
+      if (code < smallest || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return i;
+    }
+    i += length;
+  }
+  return std::string::npos;
+}
+
+/// The checks made before toml11 sees a text: UTF-8 (TOML requires it, and toml11's report of
+/// an invalid sequence in a literal string reads past the end of its buffer: it rewinds a copy
+/// of the location to an iterator of the original), then the nesting depth.
+void check_before_parsing(const std::string& text, const std::string& origin) {
+  if (const std::size_t at = invalid_utf8_at(text); at != std::string::npos)
+    throw InputError(fmt::format("{}: not valid UTF-8 at byte {} (line {}, byte 0x{:02x}); allowed: "
+                                 "UTF-8 text, as TOML requires", origin, at,
+                                 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'),
+                                 static_cast<unsigned char>(text[at])));
   const int depth = toml_nesting(text);
   if (depth > max_toml_nesting)
     throw InputError(fmt::format("{}: arrays, tables or dotted-key parts nested {} deep; allowed: at most {}",
@@ -265,7 +298,7 @@ std::optional<toml::value> toml_value(const std::string& raw) {
 }
 
 Value parse_override(const ParameterSpec& spec, const std::string& raw) {
-  check_nesting(raw, fmt::format("--set {}", spec.key));
+  check_before_parsing(raw, fmt::format("--set {}", spec.key));
   // A TOML value ("foo" with its quotes, 1e-6, [10, 20.5], true) is read as TOML; a bare word
   // is a string for text keys, and numbers and lists keep the plain forms below (80,90).
   if (const auto v = toml_value(raw)) {
@@ -341,7 +374,7 @@ Config parse_document(std::istream& in, const std::string& origin) {
   toml::value document;
   try {
     const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    check_nesting(text, origin);
+    check_before_parsing(text, origin);
     std::istringstream copy(text);
     document = toml::parse(copy, origin);
   } catch (const InputError&) {
