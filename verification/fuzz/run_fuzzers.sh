@@ -61,8 +61,10 @@ for target in $targets; do
   [[ $target = fuzz_config && -f $seeds/config.dict ]] && options+=(-dict="$seeds/config.dict")
   echo "-- $target, $seconds s"
   # The seeds as a second corpus directory: read, never written.
+  started=$(date +%s)
   timeout $(( seconds + 300 )) "$program" "${options[@]}" "$corpus/$target" "$seeds/$target" > "$log" 2>&1
   status=$?
+  ran=$(( $(date +%s) - started ))
   executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   rss=$(sed -n 's/^stat::peak_rss_mb: *//p' "$log" | tail -1)
@@ -76,15 +78,16 @@ for target in $targets; do
     failed+=("$target")
     tail -60 "$log" >&2
   fi
-  rows+=("| $target | $seconds | ${executions:-?} | ${rate:-?} | ${cov:-?} | ${ft:-?} | ${rss:-?} | $outcome |")
+  rows+=("| $target | $ran | ${executions:-?} | ${rate:-?} | ${cov:-?} | ${ft:-?} | ${rss:-?} | $outcome |")
 done
 
 {
   echo "# Fuzzing summary"
   echo
   echo "Commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown), $(date -u +%Y-%m-%dT%H:%M:%SZ)."
-  echo "Each target ran alone for the time given, from the corpus kept in $corpus and the seeds"
-  echo "of make_corpus.sh (cov: coverage points of the instrumented code reached; ft: features)."
+  echo "Each target ran alone for $seconds s (less if it found something; seconds: wall time, start-up"
+  echo "and the seed corpus included), from the corpus kept in $corpus and the seeds of"
+  echo "make_corpus.sh (cov: coverage points of the instrumented code reached; ft: features)."
   echo
   echo "| target | seconds | executions | exec/s | cov | ft | peak RSS (MB) | outcome |"
   echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |"
