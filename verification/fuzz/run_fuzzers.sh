@@ -43,6 +43,10 @@ corpus=${corpus:-$build_dir/corpus}
 artifacts=${artifacts:-$build_dir/artifacts}
 report=${report:-$build_dir/fuzz-summary.md}
 mkdir -p "$(dirname "$report")"
+# The targets' per-process input files: in the build tree, so that a target stopped by a
+# finding (no exit handlers run) leaves nothing in /tmp.
+export TMPDIR=$(realpath -m "$build_dir/tmp")
+rm -rf "$TMPDIR" && mkdir -p "$TMPDIR"
 
 rows=()
 failed=()
@@ -80,6 +84,8 @@ for target in $targets; do
   fi
   rows+=("| $target | $ran | ${executions:-?} | ${rate:-?} | ${cov:-?} | ${ft:-?} | ${rss:-?} | $outcome |")
 done
+
+rm -rf "$TMPDIR"
 
 {
   echo "# Fuzzing summary"
