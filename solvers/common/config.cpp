@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -196,36 +197,92 @@ template <class T> bool parse_number(const std::string& s, T& out) {
   return ec == std::errc() && ptr == end;
 }
 
-/// Deepest nesting of arrays and inline tables in a TOML text (brackets in strings and
-/// comments not counted). toml11 parses nesting by recursion: a hostile depth overflows the
-/// stack, so texts deeper than max_toml_nesting are refused before parsing.
+/// Deepest nesting in a TOML text: arrays and inline tables, plus the components of a dotted
+/// key or table header (a.b.c is a table in a table), with strings and comments skipped as
+/// TOML delimits them (basic "...", literal '...', multi-line """...""" and '''...''').
+/// toml11 parses nesting by recursion (a hostile depth overflows the stack) and slows down
+/// quadratically with a key's components (8,000 took 2.4 s and 120 MB), so texts deeper than
+/// max_toml_nesting are refused before parsing.
 constexpr int max_toml_nesting = 32;
 int toml_nesting(const std::string& text) {
-  int depth = 0, deepest = 0;
-  char quote = 0;  // inside a string: its quote character
-  for (std::size_t i = 0; i < text.size(); ++i) {
+  int depth = 0, deepest = 0, key_dots = 0;
+  const std::size_t size = text.size();
+  for (std::size_t i = 0; i < size; ++i) {
     const char c = text[i];
-    if (quote) {
-      if (c == '\\' && quote == '"') ++i;
-      else if (c == quote) quote = 0;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '#') {
+    if (c == '"' || c == '\'') {
+      const std::string quotes(3, c);
+      const bool multi_line = text.compare(i, 3, quotes) == 0;
+      for (i += multi_line ? 3 : 1; i < size; ++i) {
+        if (c == '"' && text[i] == '\\') {
+          ++i;  // an escape: the next character is content
+        } else if (multi_line ? text.compare(i, 3, quotes) == 0 : text[i] == c) {
+          // A multi-line string may hold up to two quotes right before its closing three: the
+          // whole run of quotes ends it.
+          if (multi_line)
+            while (i + 1 < size && text[i + 1] == c) ++i;
+          break;
+        } else if (!multi_line && text[i] == '\n') {
+          break;  // an unterminated one-line string: toml11 stops there
+        }
+      }
+      continue;  // a quoted key component keeps the dotted-key count going
+    }
+    if (c == '#') {
       i = text.find('\n', i);
       if (i == std::string::npos) break;
+      key_dots = 0;
     } else if (c == '[' || c == '{') {
       deepest = std::max(deepest, ++depth);
+      key_dots = 0;
     } else if (c == ']' || c == '}') {
       --depth;
+      key_dots = 0;
+    } else if (c == '.') {
+      deepest = std::max(deepest, depth + ++key_dots);
+    } else if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == ' ' || c == '\t')) {
+      key_dots = 0;  // '=', ',', a newline...: the end of a key
     }
   }
   return deepest;
 }
 
-void check_nesting(const std::string& text, const std::string& origin) {
+/// Offset of the first byte that does not begin a valid UTF-8 sequence (overlong forms,
+/// surrogates and code points above U+10FFFF are invalid), or npos.
+std::size_t invalid_utf8_at(const std::string& text) {
+  const auto byte = [&](std::size_t i) { return static_cast<std::uint32_t>(static_cast<unsigned char>(text[i])); };
+  for (std::size_t i = 0; i < text.size();) {
+    const std::uint32_t lead = byte(i);
+    std::size_t length = 1;
+    std::uint32_t code = lead, smallest = 0;
+    if (lead >= 0x80) {
+      if ((lead & 0xE0) == 0xC0) length = 2, code = lead & 0x1F, smallest = 0x80;
+      else if ((lead & 0xF0) == 0xE0) length = 3, code = lead & 0x0F, smallest = 0x800;
+      else if ((lead & 0xF8) == 0xF0) length = 4, code = lead & 0x07, smallest = 0x10000;
+      else return i;
+      if (i + length > text.size()) return i;
+      for (std::size_t k = 1; k < length; ++k) {
+        if ((byte(i + k) & 0xC0) != 0x80) return i;
+        code = (code << 6) | (byte(i + k) & 0x3F);
+      }
+      if (code < smallest || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return i;
+    }
+    i += length;
+  }
+  return std::string::npos;
+}
+
+/// The checks made before toml11 sees a text: UTF-8 (TOML requires it, and toml11's report of
+/// an invalid sequence in a literal string reads past the end of its buffer: it rewinds a copy
+/// of the location to an iterator of the original), then the nesting depth.
+void check_before_parsing(const std::string& text, const std::string& origin) {
+  if (const std::size_t at = invalid_utf8_at(text); at != std::string::npos)
+    throw InputError(fmt::format("{}: not valid UTF-8 at byte {} (line {}, byte 0x{:02x}); allowed: "
+                                 "UTF-8 text, as TOML requires", origin, at,
+                                 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'),
+                                 static_cast<unsigned char>(text[at])));
   const int depth = toml_nesting(text);
   if (depth > max_toml_nesting)
-    throw InputError(fmt::format("{}: arrays or tables nested {} deep; allowed: at most {}",
+    throw InputError(fmt::format("{}: arrays, tables or dotted-key parts nested {} deep; allowed: at most {}",
                                  origin, depth, max_toml_nesting));
 }
 
@@ -241,7 +298,7 @@ std::optional<toml::value> toml_value(const std::string& raw) {
 }
 
 Value parse_override(const ParameterSpec& spec, const std::string& raw) {
-  check_nesting(raw, fmt::format("--set {}", spec.key));
+  check_before_parsing(raw, fmt::format("--set {}", spec.key));
   // A TOML value ("foo" with its quotes, 1e-6, [10, 20.5], true) is read as TOML; a bare word
   // is a string for text keys, and numbers and lists keep the plain forms below (80,90).
   if (const auto v = toml_value(raw)) {
@@ -317,7 +374,7 @@ Config parse_document(std::istream& in, const std::string& origin) {
   toml::value document;
   try {
     const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    check_nesting(text, origin);
+    check_before_parsing(text, origin);
     std::istringstream copy(text);
     document = toml::parse(copy, origin);
   } catch (const InputError&) {

@@ -143,6 +143,15 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
     throw InputError(fmt::format("cycle_samples/cycles is not a [{} phases x samples] matrix",
                                  phases));
   const std::size_t m = shape[1];
+  // Every shape is checked before the sums are allocated, so that the data in the file, not
+  // its attributes, bounds the allocation (4 phases x 30,000 bins of profiles and a 4 x 30,000
+  // cycles matrix asked for 144 GB: std::bad_alloc instead of InputError).
+  for (const auto& [name, member] : sample_sums) {
+    const auto dims = h5::shape(group.id(), name);
+    if (dims.size() != 2 || dims[0] != phases * m || dims[1] != bins)
+      throw InputError(fmt::format("cycle_samples/{} is not a [{} x {}] matrix", name,
+                                   phases * m, bins));
+  }
   const auto flat_cycles = h5::read_doubles(group.id(), "cycles");
   std::vector<std::vector<double>> cycles(phases);
   std::vector<std::vector<BinSums>> sums(phases, std::vector<BinSums>(m * bins));
@@ -154,10 +163,6 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
         throw InputError(fmt::format("cycle_samples/cycles holds {}, allowed: whole numbers >= 1", c));
   }
   for (const auto& [name, member] : sample_sums) {
-    const auto dims = h5::shape(group.id(), name);
-    if (dims.size() != 2 || dims[0] != phases * m || dims[1] != bins)
-      throw InputError(fmt::format("cycle_samples/{} is not a [{} x {}] matrix", name,
-                                   phases * m, bins));
     const auto values = h5::read_doubles(group.id(), name);
     for (std::size_t k = 0; k < phases; ++k)
       for (std::size_t i = 0; i < m * bins; ++i) sums[k][i].*member = values[k * m * bins + i];

@@ -46,7 +46,7 @@ struct SeriesRows {
       "t", "phase", "plate_z", "com_z", "kinetic", "potential", "plate_work",
       "collisional_loss", "energy_closure", "pair_collisions", "plate_collisions",
       "ceiling_collisions", "cell_crossings", "guard_activations", "overlaps", "near_plate",
-      "collisions"};
+      "collisions", "queue_consistent"};
   std::vector<std::vector<double>> columns;
   explicit SeriesRows(const std::vector<double>& crossing_heights) {
     for (double h : crossing_heights) names.push_back(crossing_column(h));
@@ -115,7 +115,8 @@ class SeriesObserver final : public RunObserver {
                static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
                static_cast<double>(tally.guard_activations),
                static_cast<double>(sim_.count_overlaps(r, 1e-9)), near_plate,
-               static_cast<double>(tally.pair - origin_.tally.pair)},
+               static_cast<double>(tally.pair - origin_.tally.pair),
+               sim_.queue_consistent() ? 1.0 : 0.0},
               sim_.crossings_at(t), sim_.distinct_particles_at(t));
   }
 

@@ -49,7 +49,9 @@ struct RunOutcome {
   /// (relative, see EnergyBudget), pair/plate/ceiling_collisions and cell_crossings (running
   /// totals), guard_activations, overlaps (pairs closer than 1 - 1e-9), near_plate (particles
   /// less than half a diameter above the plate), collisions (pair collisions since the start
-  /// of this run), crossings_z<h> for each h of md.crossing_heights (upward crossings of the
+  /// of this run), queue_consistent (1 if the event queue passes Simulation::queue_consistent
+  /// at the row's time, else 0: the soak test's per-cycle check), crossings_z<h> for each h of
+  /// md.crossing_heights (upward crossings of the
   /// lab-frame height h by any particle since the start of this run, exact: each free flight
   /// is checked at the particle's updates, flights under way up to the row's time), and
   /// particles_z<h> for each h (summed over the cycles since the start of this run: the

@@ -22,20 +22,7 @@ namespace {
 using shaker::InputError;
 using shaker::config::Config;
 
-/// Runs f, expects InputError, and checks that the message contains every fragment.
-void expect_input_error(const std::function<void()>& f, const std::vector<std::string>& fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError; expected a message with '" << fragments.front() << "'";
-  } catch (const InputError& error) {
-    const std::string message = error.what();
-    for (const auto& fragment : fragments)
-      EXPECT_NE(message.find(fragment), std::string::npos)
-          << "message '" << message << "' does not contain '" << fragment << "'";
-  } catch (const std::exception& error) {
-    ADD_FAILURE() << "threw something other than InputError: " << error.what();
-  }
-}
+using shaker::testing::expect_input_error;
 
 void expect_bad_document(const std::string& toml, const std::vector<std::string>& fragments) {
   SCOPED_TRACE(toml);

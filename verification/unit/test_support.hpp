@@ -4,9 +4,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <vector>
+
+#include "common/errors.hpp"
 
 namespace shaker::testing {
 
@@ -40,6 +45,27 @@ class TemporaryDirectory {
 inline double relative_error(double actual, double expected) {
   const double difference = std::abs(actual - expected);
   return expected == 0.0 ? difference : difference / std::abs(expected);
+}
+
+/// Runs f, expects InputError, and checks that the message contains every fragment; with
+/// `seconds` > 0, also that the refusal took less than that.
+inline void expect_input_error(const std::function<void()>& f, const std::vector<std::string>& fragments,
+                               double seconds = 0.0) {
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    f();
+    ADD_FAILURE() << "no InputError; expected a message with '" << fragments.front() << "'";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    for (const auto& fragment : fragments)
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "message '" << message.substr(0, 400) << "' does not contain '" << fragment << "'";
+  } catch (const std::exception& error) {
+    ADD_FAILURE() << "threw something other than InputError: " << error.what();
+  }
+  if (seconds > 0.0) {
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), seconds);
+  }
 }
 
 }  // namespace shaker::testing
