@@ -96,6 +96,15 @@ class Query:
         return self._compare(self.run(case_a, solver_a), self.run(case_b, solver_b))
 
 
+def _window_rows(q):
+    """The run of the claim's first case and its stored phases in [from, to]."""
+    view = q.run(q.cases[0])
+    idx = _window(view.analysis, q.params["from"], q.params["to"])
+    if not len(idx):
+        raise NotMeasured("no stored phase in the window")
+    return view, idx
+
+
 def _resolutions(view, column, rows):
     resolution = view.resolution.get(column)
     return [None if resolution is None or resolution[k] is None else float(resolution[k])
@@ -121,10 +130,7 @@ def q_width_over_mfp_peak_phase(q):
 
 
 def q_width_over_mfp_in_window(q):
-    view = q.run(q.cases[0])
-    idx = _window(view.analysis, q.params["from"], q.params["to"])
-    if not len(idx):
-        raise NotMeasured("no stored phase in the window")
+    view, idx = _window_rows(q)
     return Quantized([float(v) for v in view.analysis["width_over_mfp"][idx]],
                      _resolutions(view, "width_over_mfp", idx))
 
@@ -143,11 +149,8 @@ def q_center_of_mass_at(q):
 
 
 def q_front_width_over_mfp_in_window(q):
-    t = q.table(q.cases[0])
-    idx = _window(t, q.params["from"], q.params["to"])
-    if not len(idx):
-        raise NotMeasured("no stored phase in the window")
-    return [float(v) for v in t["front_width_over_mfp"][idx]]
+    view, idx = _window_rows(q)
+    return [float(v) for v in view.analysis["front_width_over_mfp"][idx]]
 
 
 def q_shock_lifetime(q):
@@ -162,19 +165,13 @@ def q_shock_width_at(q):
 
 
 def q_max_mach_in_window(q):
-    t = q.table(q.cases[0])
-    idx = _window(t, q.params["from"], q.params["to"])
-    if not len(idx):
-        raise NotMeasured("no stored phase in the window")
-    return float(np.max(t["max_mach"][idx]))
+    view, idx = _window_rows(q)
+    return float(np.max(view.analysis["max_mach"][idx]))
 
 
 def q_min_max_mach_in_window(q):
-    t = q.table(q.cases[0])
-    idx = _window(t, q.params["from"], q.params["to"])
-    if not len(idx):
-        raise NotMeasured("no stored phase in the window")
-    return float(np.min(t["max_mach"][idx]))
+    view, idx = _window_rows(q)
+    return float(np.min(view.analysis["max_mach"][idx]))
 
 
 def q_layer_temperature_fraction_at(q):
@@ -433,13 +430,3 @@ def verdict(inside):
         return "pass"
     return "fail" if inside < -DECISION_ERRORS else "unresolved"
 
-
-def describe_band(comparison, band):
-    return {
-        "range": lambda: f"{band[0]:g} to {band[1]:g}",
-        "all_in_range": lambda: f"all measured phases in {band[0]:g} to {band[1]:g}",
-        "less_than": lambda: f"< {band[0]:g}",
-        "greater_than": lambda: f"> {band[0]:g}",
-        "strictly_increasing": lambda: "strictly increasing",
-        "true": lambda: "detected",
-    }[comparison]()
