@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "app/commands.hpp"
+#include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/version.hpp"
@@ -74,7 +75,9 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  install_signal_cleanup();  // SIGTERM/SIGINT/SIGHUP: remove partial files, exit 128 + signal
+  // SIGTERM/SIGINT/SIGHUP: remove partial files, exit 128 + signal; inside a solver's run loop
+  // SIGTERM and SIGINT first write a checkpoint (StopRequested).
+  install_signal_cleanup();
   try {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
@@ -82,6 +85,9 @@ int main(int argc, char** argv) {
       return describe ? command_describe(markdown) : command_config(show_config);
     if (app.got_subcommand("analyze")) return command_analyze(analysis);
     if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
+  } catch (const StopRequested& stop) {
+    fmt::print(stderr, "{}\n", stop.what());
+    return stop.exit_code();
   } catch (const InputError& error) {
     fmt::print(stderr, "shaker: error: {}\n", error.what());
     return 2;

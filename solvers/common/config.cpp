@@ -67,7 +67,37 @@ const std::vector<ParameterSpec>& schema() {
   return all;
 }
 
+namespace {
+
+/// Keys and values of earlier versions, with what replaced them: a case file that still holds
+/// one is refused with the new key's name; a configuration stored in an older output file
+/// skips them (they named that run's files, not its physics).
+struct Retired {
+  const char* key;
+  const char* value;  ///< nullptr: any value
+  const char* instead;
+};
+constexpr const char* restart_key = "run.restart_from = FILE (the checkpoint to continue from; nothing else is needed)";
+constexpr const char* checkpoint_key = "run.checkpoint = FILE (where the final, periodic and stop-signal checkpoints go)";
+constexpr Retired retired_keys[] = {
+    {"md.checkpoint", nullptr, restart_key},
+    {"continuum.restart", nullptr, restart_key},
+    {"md.initial_state", "checkpoint", restart_key},
+    {"md.checkpoint_output", nullptr, checkpoint_key},
+    {"continuum.checkpoint", nullptr, checkpoint_key},
+};
+
+const Retired* retired(const std::string& key, const std::string* value) {
+  for (const Retired& r : retired_keys)
+    if (key == r.key && (r.value == nullptr || (value != nullptr && *value == r.value))) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
 const ParameterSpec& find_spec(const std::string& key) {
+  if (const Retired* r = retired(key, nullptr))
+    throw InputError(fmt::format("configuration key '{}' was replaced: use {}", key, r->instead));
   const auto& specs = schema();
   const auto it =
       std::find_if(specs.begin(), specs.end(), [&](const auto& s) { return s.key == key; });
@@ -151,6 +181,9 @@ Value validate(const ParameterSpec& spec, Value value) {
       break;
     case Kind::text: {
       const auto& s = std::get<std::string>(value);
+      if (const Retired* r = retired(spec.key, &s))
+        throw InputError(fmt::format("configuration key '{}' = \"{}\" was replaced: use {}", spec.key, s,
+                                     r->instead));
       if (!spec.choices.empty() &&
           std::find(spec.choices.begin(), spec.choices.end(), s) == spec.choices.end())
         throw InputError(fmt::format("configuration key '{}' = \"{}\" is not allowed (allowed: {})",
@@ -370,7 +403,8 @@ Config::Config() {
 }
 
 namespace {
-Config parse_document(std::istream& in, const std::string& origin) {
+/// `stored`: a configuration stored in an output file, which may hold retired keys.
+Config parse_document(std::istream& in, const std::string& origin, bool stored) {
   toml::value document;
   try {
     const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -388,6 +422,7 @@ Config parse_document(std::istream& in, const std::string& origin) {
             [](const auto& a, const auto& b) { return a.first < b.first; });
   Config config;
   for (const auto& [key, v] : entries) {
+    if (stored && retired(key, v.is_string() ? &v.as_string().str : nullptr)) continue;
     try {
       config.set_value(key, from_toml_value(key, v));
     } catch (const InputError& error) {
@@ -406,7 +441,7 @@ Config Config::load(const std::filesystem::path& file, const std::vector<std::st
                                    file.string()));
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(fmt::format("cannot open configuration file '{}'", file.string()));
-    config = parse_document(in, file.string());
+    config = parse_document(in, file.string(), false);
   }
   for (const auto& assignment : overrides) config.set(assignment);
   return config;
@@ -414,7 +449,7 @@ Config Config::load(const std::filesystem::path& file, const std::vector<std::st
 
 Config Config::from_toml(const std::string& toml_text, const std::string& origin) {
   std::istringstream in(toml_text);
-  return parse_document(in, origin);
+  return parse_document(in, origin, true);
 }
 
 void Config::set(const std::string& assignment) {

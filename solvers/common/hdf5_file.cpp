@@ -313,11 +313,31 @@ extern "C" void remove_partial_files_and_exit(int signal) {
   ::_exit(128 + signal);
 }
 
+// Read and written by the handler: lock-free atomics, which are async-signal safe.
+std::atomic<bool> stop_deferred{false};
+std::atomic<int> stop_signal{0};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
+
+extern "C" void on_signal(int signal) {
+  if (signal != SIGHUP && stop_deferred.load()) {
+    int none = 0;
+    if (stop_signal.compare_exchange_strong(none, signal)) return;
+  }
+  remove_partial_files_and_exit(signal);
+}
+
 }  // namespace
+
+DeferredStop::DeferredStop() {
+  stop_signal.store(0);
+  stop_deferred.store(true);
+}
+DeferredStop::~DeferredStop() { stop_deferred.store(false); }
+int DeferredStop::requested() { return stop_signal.load(); }
 
 void install_signal_cleanup() {
   struct sigaction action {};
-  action.sa_handler = remove_partial_files_and_exit;
+  action.sa_handler = on_signal;
   sigemptyset(&action.sa_mask);
   for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&action.sa_mask, s);
   for (int s : {SIGTERM, SIGINT, SIGHUP}) ::sigaction(s, &action, nullptr);

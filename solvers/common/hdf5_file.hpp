@@ -93,6 +93,20 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
 /// slots, no allocation in the handler). Installed once by the program's main.
 void install_signal_cleanup();
 
+/// While an object of this class lives (a solver's run loop with its checkpoint observer),
+/// SIGTERM and SIGINT only record that a stop was asked for: the run polls requested() at its
+/// stored phases, writes a checkpoint there and exits. A second such signal, or SIGHUP, stops at
+/// once as install_signal_cleanup says.
+class DeferredStop {
+ public:
+  DeferredStop();
+  DeferredStop(const DeferredStop&) = delete;
+  DeferredStop& operator=(const DeferredStop&) = delete;
+  ~DeferredStop();
+  /// The signal that asked for the stop, or 0.
+  static int requested();
+};
+
 /// A file the program reads or writes, named by the key or option that gave it.
 struct NamedPath {
   std::string what;  ///< "run.output", "--csv", "configuration file", ...

@@ -1,4 +1,5 @@
 // Keys shared by both solvers. Defaults reproduce the paper's base case (docs/models.md).
+#include "common/checkpoints.hpp"
 #include "common/config.hpp"
 
 namespace shaker::config {
@@ -31,6 +32,17 @@ std::vector<ParameterSpec> common_parameters() {
       real("run.switch_e", 0.9, closed(0.0, 1.0), "single_shock: e after the switch").in("1"),
       integer("run.seed", 1, closed(0, 9.0e15), "seed of every random choice of the run").in("-"),
       text("run.output", "run.h5", {}, "HDF5 output file (written atomically)").in("-"),
+      text("run.restart_from", "", {},
+           "checkpoint to continue from (empty: the solver's initial state): the run continues the "
+           "checkpoint's schedule, its cycles counted from that run's start, up to "
+           "run.transient_cycles + run.sampled_cycles").in("-"),
+      text("run.checkpoint", "", {},
+           "checkpoint file written (atomically) at the end of the run, every "
+           "run.checkpoint_every cycles and on SIGTERM or SIGINT; the one it replaces is kept as "
+           "NAME.previous.h5 (empty: none, and a stop signal's checkpoint goes to "
+           "OUTPUT.checkpoint.h5)").in("-"),
+      integer("run.checkpoint_every", 0, checkpoint_every_range,
+              "cycles between periodic checkpoints to run.checkpoint (0: none)").in("cycles"),
   };
 }
 

@@ -47,8 +47,6 @@ std::vector<ParameterSpec> continuum_parameters() {
            "paper transport: nu_art, the volume fraction below which artificial dissipation acts").in("1"),
       real_list("continuum.field_phases", {}, closed(0.0, 1.0),
                 "3D: phases f t of the last sampled cycle whose full fields are written (HDF5 + XDMF)").in("1 (f t)"),
-      text("continuum.checkpoint", "", {}, "file for the final state (empty: none)").in("-"),
-      text("continuum.restart", "", {}, "checkpoint to start from (empty: the flat layer)").in("-"),
   };
 }
 

@@ -11,16 +11,12 @@ std::vector<ParameterSpec> md_parameters() {
            "height of the fixed ceiling in the lab frame; must lie above the plate's top 2A + 1").in("sigma"),
       real("md.bin_height", 1.0, at_least(1e-3, 10.0),
            "height of the sampling bins (at least 1e-3: finer bins hold no particle)").in("sigma"),
-      text("md.initial_state", "flat_layer", {"flat_layer", "gas", "checkpoint"},
+      text("md.initial_state", "flat_layer", {"flat_layer", "gas"},
            "flat_layer: slightly randomised layer at rest on the plate; gas: homogeneous gas "
-           "at md.gas_volume_fraction and md.gas_temperature; checkpoint: md.checkpoint").in("-"),
+           "at md.gas_volume_fraction and md.gas_temperature (run.restart_from replaces it)").in("-"),
       real("md.gas_volume_fraction", 0.1, Range{0.0, 0.55, true, false},
            "gas initial state: volume fraction").in("1"),
       real("md.gas_temperature", 1.0, positive(1e6), "gas initial state: temperature").in("g sigma"),
-      text("md.checkpoint", "", {}, "checkpoint file to start from (initial_state = checkpoint)").in("-"),
-      text("md.checkpoint_output", "", {},
-           "if not empty: checkpoint file written (atomically) with the state at the end of the "
-           "run; a run started from it continues the same trajectory bit for bit").in("-"),
       text("md.collapse_guard", "off", {"off", "tc"},
            "off: stop with an error when inelastic collapse starts; tc: collisions within "
            "md.tc of a particle's previous collision are elastic (TC model)").in("-"),

@@ -42,8 +42,9 @@ ProgressReport::ProgressReport(std::string label, std::string rate_unit, std::fu
 
 void ProgressReport::at_phase(const PhaseInstant& instant) {
   cycles_ = instant.cycles;
+  resumed_at_ = instant.resumed_at;
   // Nothing done yet gives neither a rate nor a time left.
-  if (settings_.quiet || instant.cycles_done() <= 0.0) return;
+  if (settings_.quiet || instant.cycles_done() <= instant.resumed_at) return;
   if (since_line_.seconds() < (live_ ? live_refresh_seconds : settings_.interval_seconds)) return;
   write(instant.cycles_done(), instant.cycle + 1, instant.cycles, instant.t);
 }
@@ -59,7 +60,8 @@ void ProgressReport::write(double cycles_done, std::int64_t cycle, std::int64_t 
   since_line_ = Stopwatch();
   const double elapsed = run_.seconds();
   const double rate = (work_() - work_at_start_) / elapsed;
-  const double left = elapsed / cycles_done * (static_cast<double>(cycles) - cycles_done);
+  // A continued run's pace is that of the cycles this process ran.
+  const double left = elapsed / (cycles_done - resumed_at_) * (static_cast<double>(cycles) - cycles_done);
   const std::string line = fmt::format("{}: cycle {} of {}, t = {:.6g}, {:.3g} {}, {} left", label_,
                                        cycle, cycles, t, rate, rate_unit_, duration_text(left));
   // The spaces clear what a longer previous live line left behind.

@@ -59,6 +59,7 @@ class ProgressReport final : public RunObserver {
   Stopwatch run_, since_line_;
   double work_at_start_;
   std::int64_t cycles_ = 0;  ///< of the run, from the first instant
+  double resumed_at_ = 0.0;  ///< PhaseInstant::resumed_at
 };
 
 /// A duration for people: "0.42 s", "42 s", "12.5 min", "3.2 h".

@@ -1,14 +1,19 @@
 #include "common/run_loop.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
+
+#include "common/errors.hpp"
 
 namespace shaker {
 
 PhaseSchedule::PhaseSchedule(const RunProtocol& run, const ShakerKinematics& shaker, Clock clock,
-                             double origin)
+                             double start_time, double origin)
     : clock_(clock),
       f_(shaker.f),
       period_(shaker.period()),
+      start_time_(start_time),
       origin_(origin),
       transient_(run.transient_cycles),
       sampled_(run.kind == RunProtocol::Kind::single_shock ? 1 : run.sampled_cycles),
@@ -18,7 +23,7 @@ PhaseSchedule::PhaseSchedule(const RunProtocol& run, const ShakerKinematics& sha
 PhaseSchedule PhaseSchedule::whole_cycles(const RunProtocol& run, const ShakerKinematics& shaker,
                                           double t0) {
   // The tolerance keeps a run continued from a whole cycle (t0 f = m up to round-off) at m.
-  PhaseSchedule s(run, shaker, Clock::by_frequency, std::ceil(t0 * shaker.f - 1e-9));
+  PhaseSchedule s(run, shaker, Clock::by_frequency, t0, std::ceil(t0 * shaker.f - 1e-9));
   if (run.kind == RunProtocol::Kind::single_shock)
     s.switch_time_ = (s.origin_ + static_cast<double>(run.transient_cycles) + run.switch_phase) / shaker.f;
   return s;
@@ -26,7 +31,7 @@ PhaseSchedule PhaseSchedule::whole_cycles(const RunProtocol& run, const ShakerKi
 
 PhaseSchedule PhaseSchedule::from_start(const RunProtocol& run, const ShakerKinematics& shaker,
                                         double t0) {
-  PhaseSchedule s(run, shaker, Clock::by_period, t0 / shaker.period());
+  PhaseSchedule s(run, shaker, Clock::by_period, t0, t0 / shaker.period());
   if (run.kind == RunProtocol::Kind::single_shock)
     s.switch_time_ = t0 + (static_cast<double>(run.transient_cycles) + run.switch_phase) * shaker.period();
   return s;
@@ -42,21 +47,56 @@ double PhaseSchedule::target(std::int64_t m, std::int64_t k) const {
 
 double PhaseSchedule::end() const { return time_of(origin_ + static_cast<double>(cycles())); }
 
+SchedulePosition PhaseSchedule::position(std::int64_t m, std::int64_t k) const {
+  return SchedulePosition{start_time_, m, k, phases_};
+}
+
+void PhaseSchedule::resume_at(const SchedulePosition& p, double time, const std::string& source) {
+  if (p.phase != 0 && p.phases != phases_)
+    throw InputError(fmt::format(
+        "run.phases_per_cycle = {} but {} stopped at stored phase {} of {} in cycle {}: a run "
+        "continued mid-cycle keeps the checkpoint's phases; allowed: run.phases_per_cycle = {}",
+        phases_, source, p.phase, p.phases, p.cycle, p.phases));
+  const std::int64_t first = p.cycle * phases_ + p.phase;
+  if (first >= cycles() * phases_)
+    throw InputError(fmt::format(
+        "{} was written at cycle {} (phase {} of {}) of its run, and run.transient_cycles + "
+        "run.sampled_cycles = {} leaves nothing to run: a continued run counts its cycles from "
+        "the checkpoint run's start; allowed: run.transient_cycles + run.sampled_cycles >= {}",
+        source, p.cycle, p.phase, p.phases, cycles(), p.cycle + 1));
+  const double next = target(first / phases_, first % phases_);
+  if (!(time <= next))
+    throw InputError(fmt::format("{} is not a valid checkpoint: its time t = {} lies after the "
+                                 "stored phase it continues at (cycle {}, phase {}: t = {})",
+                                 source, time, p.cycle, p.phase, next));
+  first_ = first;
+}
+
+bool PhaseSchedule::switched_before_start() const {
+  if (!switch_time_ || first_ == 0) return false;
+  return *switch_time_ <= target((first_ - 1) / phases_, (first_ - 1) % phases_);
+}
+
 void PhaseSchedule::run(DrivenSolver& solver, const std::vector<RunObserver*>& observers) const {
   bool switched = !switch_time_;
-  for (std::int64_t m = 0; m < cycles(); ++m) {
-    PhaseInstant instant{m, cycles(), 0, phases_, 0.0, m >= transient_};
-    for (std::int64_t k = 0; k < phases_; ++k) {
-      instant.phase = k;
-      instant.t = target(m, k);
-      if (!switched && *switch_time_ <= instant.t) {
-        solver.advance_to(*switch_time_);
-        solver.switch_restitution(after_switch_);
-        switched = true;
-      }
-      solver.advance_to(instant.t);
-      for (RunObserver* observer : observers) observer->at_phase(instant);
+  if (switched_before_start()) {
+    solver.switch_restitution(after_switch_);
+    switched = true;
+  }
+  const SchedulePosition from = start();
+  const double resumed_at =
+      static_cast<double>(from.cycle) + static_cast<double>(from.phase) / static_cast<double>(phases_);
+  for (std::int64_t i = first_; i < cycles() * phases_; ++i) {
+    const std::int64_t m = i / phases_, k = i % phases_;
+    const PhaseInstant instant{m, cycles(), k, phases_, target(m, k), m >= transient_, resumed_at};
+    if (!switched && *switch_time_ <= instant.t) {
+      solver.advance_to(*switch_time_);
+      solver.switch_restitution(after_switch_);
+      switched = true;
     }
+    solver.advance_to(instant.t);
+    for (RunObserver* observer : observers) observer->at_phase(instant);
+    if (k + 1 < phases_) continue;
     const CycleEnd cycle_end{m, cycles(), instant.t, instant.sampled};
     for (RunObserver* observer : observers) observer->at_cycle_end(cycle_end);
   }

@@ -8,6 +8,7 @@
 // the trajectory.
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/case_parameters.hpp"
@@ -33,11 +34,22 @@ struct PhaseInstant {
   std::int64_t phase = 0, phases = 0;  ///< stored phase k of K: k / K of a cycle past its start
   double t = 0.0;                      ///< the target time
   bool sampled = false;                ///< in a sampled cycle (a single shock's recorded cycle)
+  /// cycles_done() where this process took the run up: 0, or a continued run's checkpoint.
+  double resumed_at = 0.0;
   bool last_cycle() const { return cycle + 1 == cycles; }
   /// Cycles of the run behind this instant, fractions included.
   double cycles_done() const {
     return static_cast<double>(cycle) + static_cast<double>(phase) / static_cast<double>(phases);
   }
+};
+
+/// Where a run stands in its schedule, as every checkpoint records it: the time the run first
+/// started (from which its schedule was built) and the next stored phase to reach, phase
+/// `phase` of `phases` in cycle `cycle` (from 0). A run continued from it rebuilds the same
+/// schedule, so it meets the target times of the run that wrote it, mid-cycle included.
+struct SchedulePosition {
+  double start_time = 0.0;
+  std::int64_t cycle = 0, phase = 0, phases = 1;
 };
 
 /// A cycle whose stored phases have all been observed.
@@ -77,6 +89,16 @@ class PhaseSchedule {
   /// The end of the last cycle.
   double end() const;
 
+  /// Continues the run a checkpoint at `position`, of time `time`, belongs to; the schedule
+  /// must have been built from position.start_time. InputError (naming `source`, the key that
+  /// gave the checkpoint) if no stored phase of this schedule is left after the position,
+  /// or if the position lies mid-cycle and run.phases_per_cycle differs from the checkpoint's.
+  void resume_at(const SchedulePosition& position, double time, const std::string& source);
+  /// The position of stored phase k of cycle m; (cycles(), 0) is the end of the run.
+  SchedulePosition position(std::int64_t m, std::int64_t k) const;
+  /// Where run() starts: (0, 0), or where resume_at put it.
+  SchedulePosition start() const { return position(first_ / phases_, first_ % phases_); }
+
   /// Takes the solver through every stored phase of every cycle and on to end(), calling each
   /// observer, in the order given, at each phase, at each cycle end and at the end.
   void run(DrivenSolver& solver, const std::vector<RunObserver*>& observers) const;
@@ -85,12 +107,17 @@ class PhaseSchedule {
   // The two solvers turn cycle counts into times with different roundings (x / f against
   // x * period); each keeps its own, so their trajectories stay what they were.
   enum class Clock { by_frequency, by_period };
-  PhaseSchedule(const RunProtocol& run, const ShakerKinematics& shaker, Clock clock, double origin);
+  PhaseSchedule(const RunProtocol& run, const ShakerKinematics& shaker, Clock clock, double start_time,
+                double origin);
   double time_of(double cycle_count) const;
+  /// A continued run past the single shock's switch.
+  bool switched_before_start() const;
 
   Clock clock_;
   double f_, period_;
-  double origin_;  ///< the cycle count of the run's start
+  double start_time_;  ///< the time the run first started from
+  double origin_;      ///< the cycle count of the run's start
+  std::int64_t first_ = 0;  ///< m * phases + k of the first stored phase run() reaches
   std::int64_t transient_, sampled_, phases_;
   std::optional<double> switch_time_;  ///< single shock only
   Restitution after_switch_;

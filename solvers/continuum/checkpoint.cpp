@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/units.hpp"
@@ -15,10 +16,10 @@ const char* const names[variable_count] = {"density", "momentum_x", "momentum_y"
 }
 
 void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
-                      const std::string& configuration_toml) {
+                      const SchedulePosition& position, const std::string& configuration_toml) {
   const Grid& g = solver.op().grid();
   write_hdf5_atomically(path, [&](const hid_t file) {
-    h5::write_attribute(file, "kind", std::string("shaker continuum checkpoint"));
+    write_checkpoint_header(file, checkpoint_kind, position, configuration_toml);
     h5::write_attribute(file, "time", solver.time());
     h5::write_attribute(file, "dimension", std::int64_t{g.dimension});
     h5::write_attribute(file, "nx", std::int64_t{g.nx});
@@ -30,7 +31,6 @@ void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& s
     const EnergyBudget& b = solver.budget();
     h5::write(file, "energy_budget",
               std::vector<double>{b.body_work, b.collisional_loss, b.floor_energy});
-    h5::write_attribute(file, "configuration", configuration_toml);
     const Counters& k = solver.counters();
     h5::write(file, "counters",
               std::vector<std::int64_t>{k.steps, k.rejected_steps, k.temperature_floor_uses,
@@ -68,16 +68,15 @@ void load_checked(hid_t file, const std::filesystem::path& path, TimeIntegrator&
   const auto check = [&](const char* key, std::int64_t expected) {
     const std::int64_t found = h5::read_integer_attribute(file, key);
     if (found != expected)
-      throw InputError(fmt::format("continuum.restart = \"{}\": checkpoint has {} = {}, the "
-                                   "configuration needs {}", path.string(), key, found, expected));
+      throw InputError(fmt::format("{}: checkpoint has {} = {}, the configuration needs {}",
+                                   restart_source(path), key, found, expected));
   };
   check("dimension", g.dimension);
   check("nx", g.nx);
   check("ny", g.ny);
   check("nz", g.nz);
   if (h5::read_double_attribute(file, "cell_size") != g.h)
-    throw InputError(fmt::format("continuum.restart = \"{}\": cell size differs from continuum.cell_size = {}",
-                                 path.string(), g.h));
+    throw InputError(fmt::format("{}: cell size differs from continuum.cell_size = {}", restart_source(path), g.h));
   const double time = h5::read_double_attribute(file, "time");
   if (!std::isfinite(time))
     throw InputError(fmt::format("attribute 'time' = {}; allowed: a finite time", time));
@@ -123,28 +122,25 @@ void load_checked(hid_t file, const std::filesystem::path& path, TimeIntegrator&
 
 }  // namespace
 
-void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver) {
-  h5::Handle file = h5::open_file(path);
-  if (!h5::has_attribute(file.id(), "kind") ||
-      h5::read_string_attribute(file.id(), "kind") != "shaker continuum checkpoint")
-    throw InputError(fmt::format("continuum.restart = \"{}\" is not a continuum checkpoint", path.string()));
+SchedulePosition read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver) {
+  const h5::Handle file = open_checkpoint(path, checkpoint_kind);
   try {
+    const SchedulePosition position = read_schedule_position(file.id());
     load_checked(file.id(), path, solver);
+    return position;
   } catch (const std::exception& error) {
     const std::string what = error.what();
-    if (what.rfind("continuum.restart", 0) == 0) throw InputError(what);  // a grid mismatch
-    throw InputError(fmt::format("continuum.restart = \"{}\" is not a valid checkpoint: {}",
-                                 path.string(), what));
+    if (what.rfind("run.restart_from", 0) == 0) throw InputError(what);  // a grid mismatch
+    throw InputError(fmt::format("{} is not a valid checkpoint: {}", restart_source(path), what));
   }
 }
 
 std::string checkpoint_configuration(const std::filesystem::path& path) {
-  const h5::Handle file = h5::open_file(path);
+  const h5::Handle file = open_checkpoint(path, checkpoint_kind);
   try {
     return h5::read_string_attribute(file.id(), "configuration");
   } catch (const std::exception& error) {
-    throw InputError(fmt::format("continuum.restart = \"{}\" is not a valid checkpoint: {}",
-                                 path.string(), error.what()));
+    throw InputError(fmt::format("{} is not a valid checkpoint: {}", restart_source(path), error.what()));
   }
 }
 

@@ -6,15 +6,19 @@
 #include <filesystem>
 #include <string>
 
+#include "common/run_loop.hpp"
 #include "continuum/time_integrator.hpp"
 
 namespace shaker::continuum {
 
+inline constexpr const char* checkpoint_kind = "shaker continuum checkpoint";
+
 void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
-                      const std::string& configuration_toml);
-/// Loads a checkpoint into the solver; throws InputError ("not a valid checkpoint: ...") if it
+                      const SchedulePosition& position, const std::string& configuration_toml);
+/// Loads a checkpoint into the solver and returns its schedule position; throws InputError
+/// naming run.restart_from ("not a valid checkpoint: ...") if it is not a continuum checkpoint,
 /// does not match the grid or holds a damaged value (the solver is then left unchanged).
-void read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver);
+SchedulePosition read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver);
 /// The effective configuration (TOML) of the run that wrote the checkpoint.
 std::string checkpoint_configuration(const std::filesystem::path& path);
 

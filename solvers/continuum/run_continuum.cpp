@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 
+#include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/progress.hpp"
 #include "common/run_file.hpp"
@@ -117,9 +118,14 @@ class ProfileAverage final : public RunObserver {
     const auto k = static_cast<std::size_t>(instant.phase);
     add(sums_[k], horizontal_profile(solver_, shaker_), cycles_[k]++ == 0);
   }
+  /// Phases no sampled cycle reached (a run continued within its last cycle) are left out.
   std::vector<Profile> averages() const {
-    std::vector<Profile> out = sums_;
-    for (std::size_t k = 0; k < out.size(); ++k) divide(out[k], static_cast<double>(cycles_[k]));
+    std::vector<Profile> out;
+    for (std::size_t k = 0; k < sums_.size(); ++k) {
+      if (cycles_[k] == 0) continue;
+      out.push_back(sums_[k]);
+      divide(out.back(), static_cast<double>(cycles_[k]));
+    }
     return out;
   }
 
@@ -194,34 +200,45 @@ std::filesystem::path last_good_path(std::filesystem::path output) {
 }
 
 /// Every file the run may write, none equal to an input or to another (checked before work).
-void check_outputs(const ContinuumCase& c, std::vector<NamedPath> inputs) {
+void check_outputs(const ContinuumCase& c, const CheckpointSettings& checkpoints, const std::vector<NamedPath>& inputs) {
   const std::filesystem::path output = c.parameters.run.output;
   std::vector<NamedPath> outputs{{"run.output", output}};
   if (!output.empty()) outputs.push_back({"run.output's last-good checkpoint", last_good_path(output)});
-  if (!c.checkpoint.empty()) outputs.push_back({"continuum.checkpoint", c.checkpoint});
   if (c.grid.dimension == 3 && !c.field_phases.empty() && !output.empty()) {
     std::filesystem::path fields = output;
     outputs.push_back({"run.output's fields file", fields.replace_extension(".fields.h5")});
   }
-  inputs.push_back({"continuum.restart", c.restart});
-  check_output_paths(outputs, inputs);
+  checkpoints.check_paths(outputs, inputs);
+}
+
+/// The continuum's schedule: a new one from t = 0, or the checkpoint's, continued with the
+/// checkpoint's state loaded into the solver.
+PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& config, const std::filesystem::path& restart_from,
+                                TimeIntegrator& solver) {
+  const RunProtocol& run = c.parameters.run;
+  if (restart_from.empty()) return PhaseSchedule::from_start(run, c.parameters.shaker, solver.time());
+  const std::string source = restart_source(restart_from);
+  config::require_same_keys(config, checkpoint_configuration(restart_from),
+                            {"material.restitution", "material.e", "layer.particles", "md.box_width", "shaker.frequency"},
+                            source);
+  const SchedulePosition position = read_checkpoint(restart_from, solver);
+  PhaseSchedule schedule = PhaseSchedule::from_start(run, c.parameters.shaker, position.start_time);
+  schedule.resume_at(position, solver.time(), source);
+  return schedule;
 }
 
 int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
             const ProgressSettings& progress_settings) {
   const Stopwatch wall;
   const ContinuumCase c = continuum_case(config);
-  check_outputs(c, inputs);
-  if (!c.restart.empty())
-    config::require_same_keys(config, checkpoint_configuration(c.restart),
-                              {"material.restitution", "material.e", "layer.particles", "md.box_width"},
-                              fmt::format("continuum.restart = \"{}\"", c.restart));
+  const CheckpointSettings checkpoints = CheckpointSettings::from(config);
+  check_outputs(c, checkpoints, inputs);
   const RunProtocol& run = c.parameters.run;
   const ShakerKinematics& shaker = c.parameters.shaker;
   TimeIntegrator solver = make_solver(c);
-  if (!c.restart.empty()) read_checkpoint(c.restart, solver);
+  const PhaseSchedule schedule = starting_schedule(c, config, checkpoints.restart_from, solver);
+  const std::string configuration = config.to_toml();
   const std::filesystem::path output = run.output;
-  const PhaseSchedule schedule = PhaseSchedule::from_start(run, shaker, solver.time());
   const auto K = static_cast<std::size_t>(schedule.phases());
 
   Recorder recorder(solver, shaker, K);
@@ -231,14 +248,19 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   ProgressReport progress("shaker continuum", "cell updates/s",
                           [&] { return cells * static_cast<double>(solver.counters().steps); },
                           progress_settings);
+  const auto write = [&](const std::filesystem::path& path, const SchedulePosition& position) {
+    write_checkpoint(path, solver, position, configuration);
+  };
+  CheckpointObserver checkpointing(checkpoints, schedule, write, "shaker continuum");
   std::vector<RunObserver*> observers{&recorder, &profiles, &progress};
   if (c.grid.dimension == 3) observers.push_back(&fields);
+  observers.push_back(&checkpointing);
   DrivenIntegrator driven(solver);
   try {
     schedule.run(driven, observers);
   } catch (const StepFailure& failure) {
     const std::filesystem::path last_good = last_good_path(output);
-    write_checkpoint(last_good, solver, config.to_toml());
+    write(last_good, checkpointing.next());
     fmt::print(stderr, "shaker continuum: {}\nThe last good state is in {}\n", failure.what(),
                last_good.string());
     return 1;
@@ -248,7 +270,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   record.solver = "continuum";
   record.model_variant = fmt::format("{} transport, {}D", model::to_string(c.physics.transport),
                                      c.grid.dimension);
-  record.configuration = config.to_toml();
+  record.configuration = configuration;
   record.e = driven.switched ? run.after_switch.e : c.parameters.restitution.e;  // e of the recorded cycle
   record.profiles = profiles.averages();
   record.series = recorder.series();
@@ -257,7 +279,6 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
     fields_path.replace_extension(".fields.h5");
     write_fields(fields_path, c.grid, fields.snapshots);
   }
-  if (!c.checkpoint.empty()) write_checkpoint(c.checkpoint, solver, config.to_toml());
   write_run_file(output, record);
   const Counters& counters = solver.counters();
   fmt::print("shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "

@@ -49,8 +49,6 @@ ContinuumCase continuum_case(const config::Config& config) {
   l.perturbation = config.real("continuum.perturbation");
   l.seed = c.parameters.run.seed;
   c.field_phases = config.real_list("continuum.field_phases");
-  c.checkpoint = config.text("continuum.checkpoint");
-  c.restart = config.text("continuum.restart");
   // The layer must fit under the ceiling: checked now, before anything runs or is written.
   State probe;
   probe.resize(c.grid.size());

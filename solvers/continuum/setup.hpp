@@ -15,7 +15,6 @@ struct ContinuumCase {
   IntegratorSettings integration;
   LayerSpecification layer;
   std::vector<double> field_phases;
-  std::string checkpoint, restart;
 };
 
 ContinuumCase continuum_case(const config::Config& config);

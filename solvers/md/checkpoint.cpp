@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 
@@ -25,14 +26,13 @@ template <class T> std::vector<T> narrow(const std::vector<std::int64_t>& values
 
 }  // namespace
 
-void write_checkpoint(const std::filesystem::path& path, const SimulationData& d,
-                      const Geometry& geometry, const std::string& configuration) {
+void write_checkpoint(const std::filesystem::path& path, const SimulationData& d, const Geometry& geometry,
+                      const SchedulePosition& position, const std::string& configuration) {
   write_hdf5_atomically(path, [&](const hid_t f) {
-    h5::write_attribute(f, "kind", std::string("shaker md checkpoint"));
+    write_checkpoint_header(f, checkpoint_kind, position, configuration);
     h5::write_attribute(f, "time", d.time);
     h5::write_attribute(f, "box_width", geometry.width);
     h5::write_attribute(f, "box_height", geometry.height);
-    h5::write_attribute(f, "configuration", configuration);
     const std::size_t n = d.particles.size();
     std::vector<double> table;
     table.reserve(n * particle_columns);
@@ -74,12 +74,11 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
 }
 
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
-  if (!std::filesystem::exists(path))
-    throw InputError(fmt::format("md.checkpoint = \"{}\": no such file", path.string()));
-  const h5::Handle file = h5::open_file(path);
+  const h5::Handle file = open_checkpoint(path, checkpoint_kind);
   const hid_t f = file.id();
   Checkpoint c;
   try {
+    c.position = read_schedule_position(f);
     SimulationData& d = c.data;
     d.time = h5::read_double_attribute(f, "time");
     c.width = h5::read_double_attribute(f, "box_width");
@@ -156,8 +155,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     t.wall_loss = energy.at(2);
     t.virial = energy.at(3);
   } catch (const std::exception& error) {
-    throw InputError(fmt::format("md.checkpoint = \"{}\" is not a valid checkpoint: {}",
-                                 path.string(), error.what()));
+    throw InputError(fmt::format("{} is not a valid checkpoint: {}", restart_source(path), error.what()));
   }
   return c;
 }

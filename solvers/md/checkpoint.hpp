@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "common/run_loop.hpp"
 #include "md/geometry.hpp"
 #include "md/simulation.hpp"
 
@@ -14,11 +15,16 @@ struct Checkpoint {
   SimulationData data;
   std::string configuration;  ///< effective configuration of the run that wrote it
   double width = 0.0, height = 0.0;  ///< geometry the cell lists belong to
+  SchedulePosition position;         ///< where in its run's schedule it was written
 };
 
+inline constexpr const char* checkpoint_kind = "shaker md checkpoint";
+
 void write_checkpoint(const std::filesystem::path& path, const SimulationData& data,
-                      const Geometry& geometry, const std::string& configuration);
-/// Throws InputError if the file is missing or malformed.
+                      const Geometry& geometry, const SchedulePosition& position,
+                      const std::string& configuration);
+/// Throws InputError naming run.restart_from if the file is missing, not an MD checkpoint or
+/// malformed.
 Checkpoint read_checkpoint(const std::filesystem::path& path);
 
 /// Throws InputError naming the particle(s) if a particle lies outside the box (below the

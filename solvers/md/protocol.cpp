@@ -22,8 +22,6 @@ MdSettings MdSettings::from(const config::Config& c) {
   s.initial_state = c.text("md.initial_state");
   s.gas_volume_fraction = c.real("md.gas_volume_fraction");
   s.gas_temperature = c.real("md.gas_temperature");
-  s.checkpoint = c.text("md.checkpoint");
-  s.checkpoint_output = c.text("md.checkpoint_output");
   s.tc_guard = c.text("md.collapse_guard") == "tc";
   s.tc = c.real("md.tc");
   s.queue = c.text("md.event_queue") == "calendar" ? QueueKind::calendar : QueueKind::heap;
@@ -131,7 +129,12 @@ class SeriesObserver final : public RunObserver {
 
 RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters, const MdSettings& settings,
                         const std::vector<RunObserver*>& also) {
-  const PhaseSchedule schedule = PhaseSchedule::whole_cycles(parameters.run, parameters.shaker, sim.time());
+  return run_protocol(sim, PhaseSchedule::whole_cycles(parameters.run, parameters.shaker, sim.time()),
+                      parameters, settings, also);
+}
+
+RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, const CaseParameters& parameters,
+                        const MdSettings& settings, const std::vector<RunObserver*>& also) {
   const BudgetOrigin origin{sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time()), sim.tally()};
   PhaseSampler sampler(static_cast<int>(schedule.phases()), settings.bin_height, settings.ceiling,
                        sim.geometry().width);

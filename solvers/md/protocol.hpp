@@ -20,7 +20,6 @@ struct MdSettings {
   double bin_height = 1.0;
   std::string initial_state = "flat_layer";
   double gas_volume_fraction = 0.1, gas_temperature = 1.0;
-  std::string checkpoint, checkpoint_output;
   bool tc_guard = false;
   double tc = 1e-5;
   QueueKind queue = QueueKind::calendar;
@@ -78,8 +77,11 @@ class DrivenSimulation final : public DrivenSolver {
 };
 
 /// Runs the case's protocol from the simulation's state; `also` observe the run besides the
-/// MD's own recorders (progress).
+/// MD's own recorders (progress, checkpoints), after them.
 RunOutcome run_protocol(Simulation& simulation, const CaseParameters& parameters,
+                        const MdSettings& settings, const std::vector<RunObserver*>& also = {});
+/// The same on a given schedule (a continued run's).
+RunOutcome run_protocol(Simulation& simulation, const PhaseSchedule& schedule, const CaseParameters& parameters,
                         const MdSettings& settings, const std::vector<RunObserver*>& also = {});
 
 }  // namespace shaker::md

@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "common/case_parameters.hpp"
+#include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/memory.hpp"
 #include "common/progress.hpp"
@@ -43,28 +45,43 @@ std::string variant_name(const Restitution& r, const MdSettings& s) {
   return model + ", " + guard;
 }
 
-Simulation make_simulation(const config::Config& config, const CaseParameters& c,
-                           const MdSettings& s, const Geometry& g, const CollisionRules& rules) {
+/// The simulation at the case's initial state, or at the checkpoint `restart_from` (whose
+/// schedule position goes to `position`).
+Simulation make_simulation(const config::Config& config, const CaseParameters& c, const MdSettings& s,
+                           const Geometry& g, const CollisionRules& rules,
+                           const std::filesystem::path& restart_from, std::optional<SchedulePosition>& position) {
   const auto n = static_cast<std::size_t>(c.particles);
-  if (s.initial_state == "flat_layer") return Simulation(g, rules, flat_layer(g, n, c.run.seed), s.queue);
-  if (s.initial_state == "gas")
-    return Simulation(g, rules, homogeneous_gas(g, n, s.gas_volume_fraction, s.gas_temperature, c.run.seed),
-                      s.queue);
-  if (s.checkpoint.empty())
-    throw InputError("md.initial_state = \"checkpoint\" needs md.checkpoint = the file to start from");
-  Checkpoint saved = read_checkpoint(s.checkpoint);
+  if (restart_from.empty()) {
+    if (s.initial_state == "gas")
+      return Simulation(g, rules, homogeneous_gas(g, n, s.gas_volume_fraction, s.gas_temperature, c.run.seed),
+                        s.queue);
+    return Simulation(g, rules, flat_layer(g, n, c.run.seed), s.queue);
+  }
+  Checkpoint saved = read_checkpoint(restart_from);
+  const std::string source = restart_source(restart_from);
   if (saved.data.particles.size() != n)
     throw InputError(fmt::format("layer.particles = {} but the checkpoint {} holds {} particles; "
-                                 "allowed: {}", n, s.checkpoint, saved.data.particles.size(),
+                                 "allowed: {}", n, source, saved.data.particles.size(),
                                  saved.data.particles.size()));
-  // The restart rule (docs/output-schema.md); another box is allowed (see below).
-  config::require_same_keys(config, saved.configuration, {"material.restitution", "material.e"},
-                            fmt::format("md.checkpoint = \"{}\"", s.checkpoint));
+  // The restart rule (README); another box is allowed (see below). The schedule's times
+  // are counted in the checkpoint's cycles.
+  config::require_same_keys(config, saved.configuration, {"material.restitution", "material.e", "shaker.frequency"},
+                            source);
   validate_state(g, saved.data);
+  position = saved.position;
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
   State state{saved.data.time, std::move(saved.data.particles), std::move(saved.data.last_collision)};
   return Simulation(g, rules, state, s.queue);
+}
+
+/// The MD's schedule: a new one from the simulation's time, or the checkpoint's, continued.
+PhaseSchedule schedule_of(const CaseParameters& c, const Simulation& simulation,
+                          const std::optional<SchedulePosition>& resume, const std::filesystem::path& restart_from) {
+  if (!resume) return PhaseSchedule::whole_cycles(c.run, c.shaker, simulation.time());
+  PhaseSchedule schedule = PhaseSchedule::whole_cycles(c.run, c.shaker, resume->start_time);
+  schedule.resume_at(*resume, simulation.time(), restart_source(restart_from));
+  return schedule;
 }
 
 /// The memory of the particles, the cell list and the phase sampler, before any is allocated.
@@ -95,24 +112,29 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   const CaseParameters parameters = CaseParameters::from(config);
   const MdSettings settings = MdSettings::from(config);
   const Geometry geometry = geometry_of(parameters, settings);
-  {
-    std::vector<NamedPath> outputs{{"run.output", parameters.run.output}}, read = inputs;
-    if (!settings.checkpoint_output.empty())
-      outputs.push_back({"md.checkpoint_output", settings.checkpoint_output});
-    if (settings.initial_state == "checkpoint") read.push_back({"md.checkpoint", settings.checkpoint});
-    check_output_paths(outputs, read);
-  }
+  const CheckpointSettings checkpoints = CheckpointSettings::from(config);
+  checkpoints.check_paths({{"run.output", parameters.run.output}}, inputs);
   check_md_memory(parameters, settings, geometry);
   CollisionRules rules;
   rules.restitution = parameters.restitution;
   rules.tc_guard = settings.tc_guard;
   rules.tc = settings.tc;
-  Simulation simulation = make_simulation(config, parameters, settings, geometry, rules);
+  std::optional<SchedulePosition> resume;
+  Simulation simulation =
+      make_simulation(config, parameters, settings, geometry, rules, checkpoints.restart_from, resume);
+  const PhaseSchedule schedule = schedule_of(parameters, simulation, resume, checkpoints.restart_from);
 
   ProgressReport progress("shaker md", "collisions/s",
                           [&] { return static_cast<double>(simulation.tally().collisions()); },
                           progress_settings);
-  const RunOutcome outcome = run_protocol(simulation, parameters, settings, {&progress});
+  const std::string configuration = config.to_toml();
+  CheckpointObserver checkpointing(
+      checkpoints, schedule,
+      [&](const std::filesystem::path& path, const SchedulePosition& position) {
+        write_checkpoint(path, simulation.save(), geometry, position, configuration);
+      },
+      "shaker md");
+  const RunOutcome outcome = run_protocol(simulation, schedule, parameters, settings, {&progress, &checkpointing});
 
   RunRecord record;
   record.solver = "md";
@@ -122,14 +144,12 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   if (switched) record.model_variant += fmt::format(" (switched from {} at f t = {})",
                                                     variant_name(parameters.restitution, settings),
                                                     parameters.run.switch_phase);
-  record.configuration = config.to_toml();
+  record.configuration = configuration;
   record.e = final_restitution.e;
   record.profiles = outcome.profiles;
   record.samples = outcome.samples;
   record.series = outcome.series;
   write_run_file(parameters.run.output, record);
-  if (!settings.checkpoint_output.empty())
-    write_checkpoint(settings.checkpoint_output, simulation.save(), geometry, config.to_toml());
 
   const Tally& tally = simulation.tally();
   fmt::print("shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", simulation.size(),

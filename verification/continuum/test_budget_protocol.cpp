@@ -75,7 +75,7 @@ TEST(SingleShock, SwitchesEAtThePhaseAndKeepsItInTheCheckpoint) {
   c.set("run.transient_cycles=1");
   c.set("run.phases_per_cycle=50");
   c.set("run.switch_e=0.6");
-  c.set("continuum.checkpoint=" + (dir / "checkpoint.h5").string());
+  c.set("run.checkpoint=" + (dir / "checkpoint.h5").string());
   ASSERT_EQ(run(c), 0);
   const ContinuumCase cc = continuum_case(c);
   const double before = cc.parameters.restitution.e, after = cc.parameters.run.after_switch.e;

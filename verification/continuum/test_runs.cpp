@@ -90,7 +90,7 @@ TEST(Restart, ContinuesIdentically) {
   straight.advance_to(2 * half);
   TimeIntegrator first = make_solver(cc);
   first.advance_to(half);
-  write_checkpoint(dir / "checkpoint.h5", first, c.to_toml());
+  write_checkpoint(dir / "checkpoint.h5", first, SchedulePosition{}, c.to_toml());
   TimeIntegrator second = make_solver(cc);
   read_checkpoint(dir / "checkpoint.h5", second);
   second.advance_to(2 * half);
@@ -114,12 +114,14 @@ TEST(Restart, ThroughTheProgramGivesTheSameProfiles) {
   c.set("run.transient_cycles=1");
   c.set("run.output=" + (dir / "straight.h5").string());
   ASSERT_EQ(run(c), 0);
+  // The first cycle alone, then the same two-cycle run continued from its checkpoint.
   c.set("run.transient_cycles=0");
   c.set("run.output=" + (dir / "first.h5").string());
-  c.set("continuum.checkpoint=" + (dir / "checkpoint.h5").string());
+  c.set("run.checkpoint=" + (dir / "checkpoint.h5").string());
   ASSERT_EQ(run(c), 0);
-  c.set("continuum.checkpoint=");
-  c.set("continuum.restart=" + (dir / "checkpoint.h5").string());
+  c.set("run.transient_cycles=1");
+  c.set("run.checkpoint=");
+  c.set("run.restart_from=" + (dir / "checkpoint.h5").string());
   c.set("run.output=" + (dir / "second.h5").string());
   ASSERT_EQ(run(c), 0);
   const RunRecord a = read_run_file(dir / "straight.h5"), b = read_run_file(dir / "second.h5");

@@ -41,7 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     shaker::config::require_same_keys(small.config, shaker::continuum::checkpoint_configuration(path),
                                       {"material.restitution", "material.e", "layer.particles",
-                                       "md.box_width"},
+                                       "md.box_width", "shaker.frequency"},
                                       "the fuzz input");
     shaker::continuum::read_checkpoint(path, small.solver);
   } catch (const shaker::InputError&) {

@@ -1,5 +1,5 @@
 // Fuzz target: the MD checkpoint reader shaker::md::read_checkpoint, followed by what
-// `shaker md` does with md.initial_state = "checkpoint" (run_md.cpp, make_simulation): the
+// `shaker md` does with run.restart_from (run_md.cpp, make_simulation): the
 // restart rule against the stored configuration, the state check, and the Simulation built
 // from the saved cells and events (same box) or from the particles alone (another box).
 // Contract: a damaged checkpoint throws shaker::InputError; anything else escaping (another
@@ -46,7 +46,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     shaker::md::Checkpoint saved = shaker::md::read_checkpoint(path);
     shaker::config::require_same_keys(small.config, saved.configuration,
-                                      {"material.restitution", "material.e"}, "the fuzz input");
+                                      {"material.restitution", "material.e", "shaker.frequency"},
+                                      "the fuzz input");
     shaker::md::validate_state(small.geometry, saved.data);
     if (saved.width == small.geometry.width && saved.height == small.geometry.height) {
       shaker::md::Simulation(small.geometry, small.rules, std::move(saved.data), small.settings.queue);

@@ -28,9 +28,9 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/shaker-fuzz-corpus.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
 "$shaker" md "$case_file" --set run.output="$work/md.h5" \
-    --set md.checkpoint_output="$work/md-checkpoint.h5" > "$work/md.log"
+    --set run.checkpoint="$work/md-checkpoint.h5" > "$work/md.log"
 "$shaker" continuum "$case_file" --set run.output="$work/continuum.h5" \
-    --set continuum.checkpoint="$work/continuum-checkpoint.h5" > "$work/continuum.log"
+    --set run.checkpoint="$work/continuum-checkpoint.h5" > "$work/continuum.log"
 
 rm -rf "$output"
 mkdir -p "$output"/{fuzz_config,fuzz_run_file,fuzz_md_checkpoint,fuzz_continuum_checkpoint}

@@ -57,7 +57,7 @@ TEST(MdBadInput, CrossingHeightTwice) {
   expect_rejected("--set md.crossing_heights=[80,80.0]", "md.crossing_heights");
 }
 TEST(MdBadInput, MissingCheckpoint) {
-  expect_rejected("--set md.initial_state=checkpoint --set md.checkpoint=/nonexistent.h5", "md.checkpoint");
+  expect_rejected("--set run.restart_from=/nonexistent.h5", "run.restart_from = \"/nonexistent.h5\": no such file");
 }
 
 /// A checkpoint of the base case after a few events, changed by `damage`.
@@ -70,8 +70,9 @@ template <class Damage> std::string checkpoint_with(const std::filesystem::path&
   SimulationData data = sim.save();
   damage(data);
   const auto path = dir / "bad-checkpoint.h5";
-  write_checkpoint(path, data, g, config::Config().to_toml());
-  return "--set md.initial_state=checkpoint --set md.checkpoint=" + path.string();
+  // Continued at the start of cycle 1: after the few events, before its first stored phase.
+  write_checkpoint(path, data, g, SchedulePosition{0.0, 1, 0, 50}, config::Config().to_toml());
+  return "--set run.restart_from=" + path.string();
 }
 
 /// A damaged checkpoint is refused with a message containing `names`.
@@ -86,7 +87,7 @@ template <class Damage> void expect_checkpoint_rejected(Damage damage, const std
 TEST(MdBadInput, UndamagedCheckpointIsAccepted) {  // the checks below refuse only the damage
   const auto dir = testing::test_directory();
   const Outcome outcome =
-      run_shaker(dir, checkpoint_with(dir, [](SimulationData&) {}) + " --set run.transient_cycles=0 --set run.sampled_cycles=1");
+      run_shaker(dir, checkpoint_with(dir, [](SimulationData&) {}) + " --set run.transient_cycles=0 --set run.sampled_cycles=2");
   EXPECT_EQ(outcome.exit_code, 0) << outcome.errors;
   EXPECT_TRUE(std::filesystem::exists(dir / "out.h5"));
 }

@@ -346,7 +346,7 @@ TEST(MdVibrated, RestartFromCheckpointContinuesBitForBit) {
   rules.restitution = Restitution{Restitution::Kind::constant, 0.9};
   Simulation straight(g, rules, flat_layer(g, 3937, 3));
   straight.advance_to(1.3 / shaker.f);
-  write_checkpoint(dir / "stop.h5", straight.save(), g, "test");
+  write_checkpoint(dir / "stop.h5", straight.save(), g, SchedulePosition{}, "test");
   straight.advance_to(2.0 / shaker.f);
   Checkpoint saved = read_checkpoint(dir / "stop.h5");
   validate_state(g, saved.data);
@@ -359,27 +359,27 @@ TEST(MdVibrated, RestartFromCheckpointContinuesBitForBit) {
 }
 
 TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
-  // shaker md with md.checkpoint_output, then md.initial_state = checkpoint, against one run.
+  // shaker md for 2 cycles with run.checkpoint, then the 3-cycle run continued from it with
+  // run.restart_from, against the 3-cycle run straight through.
   const auto dir = testing::test_directory();
   config::Config first = base_case(dir / "a.h5");
   first.set("md.crossing_heights=[12.5]");
   first.set("run.transient_cycles=1");
   first.set("run.sampled_cycles=1");
-  first.set("md.checkpoint_output=" + (dir / "a-end.h5").string());
+  first.set("run.checkpoint=" + (dir / "a-end.h5").string());
   ASSERT_EQ(run(first), 0);
   config::Config second = base_case(dir / "b.h5");
   second.set("md.crossing_heights=[12.5]");
-  second.set("run.transient_cycles=0");
-  second.set("run.sampled_cycles=1");
-  second.set("md.initial_state=checkpoint");
-  second.set("md.checkpoint=" + (dir / "a-end.h5").string());
-  second.set("md.checkpoint_output=" + (dir / "b-end.h5").string());
+  second.set("run.transient_cycles=1");
+  second.set("run.sampled_cycles=2");
+  second.set("run.restart_from=" + (dir / "a-end.h5").string());
+  second.set("run.checkpoint=" + (dir / "b-end.h5").string());
   ASSERT_EQ(run(second), 0);
   config::Config straight = base_case(dir / "c.h5");
   straight.set("md.crossing_heights=[12.5]");
   straight.set("run.transient_cycles=1");
   straight.set("run.sampled_cycles=2");
-  straight.set("md.checkpoint_output=" + (dir / "c-end.h5").string());
+  straight.set("run.checkpoint=" + (dir / "c-end.h5").string());
   ASSERT_EQ(run(straight), 0);
   const Checkpoint b = read_checkpoint(dir / "b-end.h5"), c = read_checkpoint(dir / "c-end.h5");
   EXPECT_NEAR(b.data.time, 3.0 / 0.095, 1e-12);

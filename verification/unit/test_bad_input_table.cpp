@@ -1,7 +1,7 @@
 // Issue 18's contract for bad input and failures, as data: every row of bad_input_cases.toml
 // runs `shaker` in its own temporary directory (named after the case and the process id,
 // removed when the case passes) and checks the exit code, a fragment of the message, the files
-// that must not exist and the files that must be left unchanged; no NAME.partial-PID file may be
+// that must not exist, must exist and must be left unchanged; no NAME.partial-PID file may be
 // left in the directory. The columns are described at the top of the data file.
 // SHAKER_PROGRAM is $<TARGET_FILE:shaker>, BAD_INPUT_CASES the data file, passed in by CMake.
 #include <fcntl.h>
@@ -113,10 +113,10 @@ class Fixtures : public ::testing::Environment {
     std::ofstream(dir / "case.toml") << toml::find<std::string>(table(), "case_toml");
     // One MD run gives a run file and an MD checkpoint; one continuum run its checkpoint.
     const Outcome md = run_shaker(dir, {"md", "case.toml", "--set", "run.output=run.h5", "--set",
-                                        "md.checkpoint_output=md.ckpt.h5"});
+                                        "run.checkpoint=md.ckpt.h5"});
     const Outcome continuum =
         run_shaker(dir, {"continuum", "case.toml", "--set", "run.output=continuum.h5", "--set",
-                         "continuum.checkpoint=continuum.ckpt.h5"});
+                         "run.checkpoint=continuum.ckpt.h5"});
     ASSERT_EQ(md.exit_code, 0) << md.output;
     ASSERT_EQ(continuum.exit_code, 0) << continuum.output;
     fs::copy_file(dir / "run.h5", dir / "ref.h5");
@@ -258,6 +258,8 @@ TEST_P(BadInput, MeetsTheContract) {
         << "the output contains '" << fragment << "':\n" << r.output.substr(0, 4000);
   for (const auto& name : strings(row, "absent"))
     EXPECT_FALSE(fs::exists(dir / name)) << name << " was written";
+  for (const auto& name : strings(row, "present"))
+    EXPECT_TRUE(fs::exists(dir / name)) << name << " was not written";
   for (const auto& [name, text] : before)
     EXPECT_TRUE(read_text(dir / name) == text) << name << " was changed";
   for (const auto& sub : {dir, dir / "small"}) {

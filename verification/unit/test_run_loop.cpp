@@ -1,17 +1,29 @@
 // The run loop of common/run_loop.hpp with a stand-in solver: the target times of both
-// clocks to the bit, the order of advances, switch and observer calls, and the progress
-// observer's lines (plain, live and quiet).
+// clocks to the bit, the order of advances, switch and observer calls, a run continued from a
+// schedule position (mid-cycle too) against the straight run, the progress observer's lines
+// (plain, live and quiet), and the checkpoint observer: the last two periodic checkpoints kept,
+// and a real SIGTERM / SIGINT answered at the next stored phase.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/progress.hpp"
 #include "common/run_loop.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -40,11 +52,13 @@ class LoggingSolver final : public shaker::DrivenSolver {
     EXPECT_GE(t, t_) << "the loop went back in time";
     t_ = t;
     log.push_back("advance " + std::to_string(t));
+    times.push_back(t);
   }
   void switch_restitution(const shaker::Restitution& after) override {
     log.push_back("switch " + std::to_string(after.e));
   }
   std::vector<std::string> log;
+  std::vector<double> times;  ///< of the advances, to the bit
 
  private:
   double t_;
@@ -210,6 +224,152 @@ TEST(ProgressReport, DurationsReadAsPeopleSayThem) {
   EXPECT_EQ(shaker::duration_text(42.0), "42 s");
   EXPECT_EQ(shaker::duration_text(750.0), "12.5 min");
   EXPECT_EQ(shaker::duration_text(3.2 * 3600.0), "3.2 h");
+}
+
+/// The schedule of `run` from `t0` by either clock.
+PhaseSchedule schedule(bool whole, const RunProtocol& run, double t0) {
+  return whole ? PhaseSchedule::whole_cycles(run, shaker_base, t0) : PhaseSchedule::from_start(run, shaker_base, t0);
+}
+
+/// The loop continued at `position` of a run of `run`, from a solver at `time`.
+LoggingSolver continued_run(bool whole, const RunProtocol& run, const shaker::SchedulePosition& position,
+                            double time) {
+  PhaseSchedule continued = schedule(whole, run, position.start_time);
+  continued.resume_at(position, time, "the test");
+  LoggingSolver solver(time);
+  continued.run(solver, {});
+  return solver;
+}
+
+TEST(PhaseSchedule, ContinuedRunMeetsTheStraightRunsTargets) {
+  const RunProtocol run = protocol(2, 3, 7);
+  for (const bool whole : {true, false}) {
+    const double t0 = whole ? 2.5 / shaker_base.f : 1.2345;
+    const PhaseSchedule straight = schedule(whole, run, t0);
+    LoggingSolver all(t0);
+    straight.run(all, {});
+    // After stored phase 3 of cycle 1 (mid-cycle), after the last of cycle 1, and at cycle 4.
+    for (const auto& [m, k] : {std::pair<std::int64_t, std::int64_t>{1, 4}, {2, 0}, {4, 0}}) {
+      const auto done = static_cast<std::ptrdiff_t>(m * 7 + k);  // stored phases before
+      const LoggingSolver rest = continued_run(whole, run, straight.position(m, k), all.times[done - 1]);
+      const std::vector<double> expected(all.times.begin() + done, all.times.end());
+      EXPECT_EQ(rest.times, expected) << (whole ? "whole_cycles" : "from_start") << " at " << m << ", " << k;
+    }
+  }
+}
+
+TEST(PhaseSchedule, ContinuedSingleShockSwitchesOnceWhereTheStraightRunDid) {
+  RunProtocol run = protocol(2, 10, 4);
+  run.kind = RunProtocol::Kind::single_shock;
+  run.switch_phase = -0.3;
+  run.after_switch.e = 0.5;
+  for (const bool whole : {true, false}) {
+    const PhaseSchedule straight = schedule(whole, run, 0.0);
+    LoggingSolver all(0.0);
+    straight.run(all, {});
+    // The switch at f t = 1.7 lies between stored phases (1, 2) and (1, 3): a run continued
+    // before (1, 3) switches where the straight run did, one continued after it at once.
+    const LoggingSolver before = continued_run(whole, run, straight.position(1, 3), straight.target(1, 2));
+    EXPECT_EQ(before.log, std::vector<std::string>(all.log.begin() + 7, all.log.end()));
+    const LoggingSolver after = continued_run(whole, run, straight.position(2, 0), straight.target(1, 3));
+    std::vector<std::string> expected{"switch " + std::to_string(0.5)};
+    expected.insert(expected.end(), all.log.begin() + 10, all.log.end());
+    EXPECT_EQ(after.log, expected);
+  }
+}
+
+TEST(PhaseSchedule, ResumeRefusesNothingLeftOtherPhasesMidCycleAndALaterState) {
+  const PhaseSchedule two = PhaseSchedule::whole_cycles(protocol(1, 1, 5), shaker_base, 0.0);
+  const std::string source = "run.restart_from = \"c.h5\"";
+  shaker::testing::expect_input_error([&] { PhaseSchedule(two).resume_at({0.0, 2, 0, 5}, two.end(), source); },
+                                      {source + " was written at cycle 2", "run.transient_cycles + "
+                                       "run.sampled_cycles >= 3"});
+  shaker::testing::expect_input_error([&] { PhaseSchedule(two).resume_at({0.0, 1, 2, 4}, two.target(1, 0), source); },
+                                      {"run.phases_per_cycle = 5", "stored phase 2 of 4",
+                                       "allowed: run.phases_per_cycle = 4"});
+  shaker::testing::expect_input_error(
+      [&] { PhaseSchedule(two).resume_at({0.0, 1, 0, 5}, two.target(1, 0) * (1 + 1e-12), source); },
+      {source + " is not a valid checkpoint", "lies after the stored phase"});
+  // At a cycle boundary the phases per cycle may change.
+  PhaseSchedule other_phases = two;
+  other_phases.resume_at({0.0, 1, 0, 4}, two.target(0, 4), source);
+  EXPECT_EQ(other_phases.start().cycle, 1);
+  EXPECT_EQ(other_phases.start().phase, 0);
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Checkpoints of the stand-in solver: its time and the position, as text, counted.
+shaker::CheckpointWriter text_writer(const LoggingSolver& solver, int& writes) {
+  return [&solver, &writes](const std::filesystem::path& path, const shaker::SchedulePosition& p) {
+    ++writes;
+    shaker::write_text_atomically(path, fmt::format("{} {} {} {}\n", solver.time(), p.cycle, p.phase, p.phases));
+  };
+}
+
+TEST(CheckpointObserver, PeriodicCheckpointsKeepTheLastTwo) {
+  const shaker::testing::TemporaryDirectory dir;
+  const PhaseSchedule s = PhaseSchedule::whole_cycles(protocol(1, 4, 3), shaker_base, 0.0);
+  shaker::CheckpointSettings settings;
+  settings.file = dir / "c.h5";
+  settings.every = 2;
+  settings.run_output = dir / "run.h5";
+  LoggingSolver solver(0.0);
+  int writes = 0;
+  {
+    shaker::CheckpointObserver checkpoints(settings, s, text_writer(solver, writes), "shaker test");
+    s.run(solver, {&checkpoints});
+  }
+  EXPECT_EQ(writes, 3);  // after cycles 1 and 3 (from 0) and at the end
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) names.push_back(entry.path().filename());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"c.h5", "c.previous.h5"}));
+  EXPECT_EQ(read_text(dir / "c.h5"), fmt::format("{} 5 0 3\n", s.end()));
+  EXPECT_EQ(read_text(dir / "c.previous.h5"), fmt::format("{} 4 0 3\n", s.target(3, 2)));
+}
+
+/// Sends `signal` to this process at stored phase k of cycle m.
+class RaiseAt final : public shaker::RunObserver {
+ public:
+  RaiseAt(int signal, std::int64_t m, std::int64_t k) : signal_(signal), m_(m), k_(k) {}
+  void at_phase(const PhaseInstant& p) override {
+    if (p.cycle == m_ && p.phase == k_) std::raise(signal_);
+  }
+
+ private:
+  int signal_;
+  std::int64_t m_, k_;
+};
+
+TEST(CheckpointObserver, StopSignalWritesACheckpointAtTheNextStoredPhaseAndStops) {
+  shaker::install_signal_cleanup();
+  const shaker::testing::TemporaryDirectory dir;
+  const PhaseSchedule s = PhaseSchedule::whole_cycles(protocol(1, 2, 5), shaker_base, 0.0);
+  shaker::CheckpointSettings settings;
+  settings.run_output = dir / "run.h5";  // no run.checkpoint: the checkpoint goes beside it
+  for (const auto& [signal, status] : {std::pair{SIGTERM, 143}, {SIGINT, 130}}) {
+    LoggingSolver solver(0.0);
+    int writes = 0;
+    RaiseAt raiser(signal, 1, 2);
+    shaker::CheckpointObserver checkpoints(settings, s, text_writer(solver, writes), "shaker test");
+    try {
+      s.run(solver, {&raiser, &checkpoints});
+      ADD_FAILURE() << "the run went on after signal " << signal;
+    } catch (const shaker::StopRequested& stop) {
+      EXPECT_EQ(stop.exit_code(), status);
+      EXPECT_NE(std::string(stop.what()).find("stopped by signal " + std::to_string(signal)), std::string::npos)
+          << stop.what();
+    }
+    EXPECT_EQ(writes, 1);
+    EXPECT_EQ(solver.time(), s.target(1, 2));
+    EXPECT_EQ(read_text(dir / "run.checkpoint.h5"), fmt::format("{} 1 3 5\n", s.target(1, 2)));
+  }
 }
 
 }  // namespace

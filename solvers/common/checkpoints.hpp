@@ -1,0 +1,100 @@
+#pragma once
+// Checkpoints of both solvers as an observer of the run loop, in the manner of progress: the
+// periodic ones (every run.checkpoint_every cycles), the final one, and the one a stop signal
+// (SIGTERM, SIGINT) asks for, after which the program exits with 128 + signal. Every
+// checkpoint records its schedule position, so a run continued from it (run.restart_from)
+// meets the target times of the run that wrote it. Each file is written atomically; the one a
+// new checkpoint replaces is kept as NAME.previous.h5, so the last two are always on disk.
+#include <hdf5.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/config.hpp"
+#include "common/hdf5_file.hpp"
+#include "common/run_loop.hpp"
+
+namespace shaker {
+
+/// The allowed run.checkpoint_every, cycles: 0 writes no periodic checkpoint.
+inline constexpr config::Range checkpoint_every_range{0.0, 1e6, false, false};
+
+/// The run.* keys of checkpoints, typed.
+struct CheckpointSettings {
+  std::filesystem::path restart_from;  ///< run.restart_from: the checkpoint to continue from
+  std::filesystem::path file;          ///< run.checkpoint: where checkpoints go (empty: none)
+  std::int64_t every = 0;              ///< run.checkpoint_every, cycles
+  std::filesystem::path run_output;    ///< run.output
+  /// Throws InputError for periodic checkpoints without a file to write them to.
+  static CheckpointSettings from(const config::Config& config);
+  /// Where a stop signal's checkpoint goes: run.checkpoint, else OUTPUT.checkpoint.h5.
+  std::filesystem::path stop_file() const;
+  /// Every file checkpoints may write, named for check_output_paths.
+  std::vector<NamedPath> outputs() const;
+  /// Checks `written` (the solver's other outputs) and the checkpoint files against each other
+  /// and against `inputs` and run.restart_from; the newest checkpoint alone may be the file the
+  /// run continues from (which is then kept as the previous checkpoint).
+  void check_paths(std::vector<NamedPath> written, const std::vector<NamedPath>& inputs) const;
+};
+
+/// How messages name the checkpoint read: run.restart_from = "PATH".
+std::string restart_source(const std::filesystem::path& path);
+
+/// The name the checkpoint before the newest is kept under: NAME.previous.h5.
+std::filesystem::path previous_checkpoint(std::filesystem::path file);
+
+/// The root attributes every checkpoint carries besides its solver's state.
+void write_checkpoint_header(hid_t file, const std::string& kind, const SchedulePosition& position,
+                             const std::string& configuration);
+/// Opens run.restart_from = `path` for reading; InputError naming the key if it is missing, not
+/// HDF5, or not a checkpoint of `kind` ("shaker md checkpoint"), e.g. of the other solver.
+h5::Handle open_checkpoint(const std::filesystem::path& path, const std::string& kind);
+/// The position a checkpoint records; InputError if absent or out of range.
+SchedulePosition read_schedule_position(hid_t file);
+
+/// A run stopped by SIGTERM or SIGINT after writing its checkpoint: the program exits with
+/// 128 + signal.
+class StopRequested : public std::runtime_error {
+ public:
+  StopRequested(int signal, const std::string& message) : std::runtime_error(message), signal_(signal) {}
+  int exit_code() const { return 128 + signal_; }
+
+ private:
+  int signal_;
+};
+
+/// Writes the solver's checkpoint of `position` to a file (atomically).
+using CheckpointWriter = std::function<void(const std::filesystem::path&, const SchedulePosition&)>;
+
+class CheckpointObserver final : public RunObserver {
+ public:
+  /// `label` starts the stop message ("shaker md"). While the observer lives, SIGTERM and SIGINT
+  /// are deferred to the next stored phase (DeferredStop).
+  CheckpointObserver(const CheckpointSettings& settings, const PhaseSchedule& schedule,
+                     CheckpointWriter write, std::string label);
+
+  void at_phase(const PhaseInstant& instant) override;
+  void at_cycle_end(const CycleEnd& end) override;
+  void at_run_end(double t) override;
+  /// The stored phase the run reaches next: where a failure's last good state continues.
+  const SchedulePosition& next() const { return next_; }
+
+ private:
+  void save(const std::filesystem::path& path) const;
+  /// Throws StopRequested after writing the checkpoint if a stop signal came in.
+  void stop_if_asked(double t) const;
+
+  CheckpointSettings settings_;
+  const PhaseSchedule& schedule_;
+  CheckpointWriter write_;
+  std::string label_;
+  SchedulePosition next_;
+  std::optional<DeferredStop> deferred_;
+};
+
+}  // namespace shaker
