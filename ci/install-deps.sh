@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libgsl-dev libhdf5-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtoml11-dev libcli11-dev libfmt-dev
+  libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-matplotlib python3-h5py
 )
 

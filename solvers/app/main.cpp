@@ -8,6 +8,7 @@
 #include "app/commands.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/ranks.hpp"
 #include "common/version.hpp"
 
 int main(int argc, char** argv) {
@@ -75,6 +76,9 @@ int main(int argc, char** argv) {
   }
 
   install_signal_cleanup();  // SIGTERM/SIGINT/SIGHUP: remove partial files, exit 128 + signal
+  struct FinalizeRanks {
+    ~FinalizeRanks() { Ranks::finalize(); }
+  } finalize_ranks;
   try {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
@@ -83,10 +87,12 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("analyze")) return command_analyze(analysis);
     if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
   } catch (const InputError& error) {
+    // Every rank reads the same input and fails alike, so none is left waiting.
     fmt::print(stderr, "shaker: error: {}\n", error.what());
     return 2;
   } catch (const std::exception& error) {
     fmt::print(stderr, "shaker: failed: {}\n", error.what());
+    Ranks::abort_others(1);
     return 1;
   }
   return 2;

@@ -21,6 +21,12 @@ std::vector<ParameterSpec> md_parameters() {
       text("md.checkpoint_output", "", {},
            "if not empty: checkpoint file written (atomically) with the state at the end of the "
            "run; a run started from it continues the same trajectory bit for bit").in("-"),
+      integer("md.replicas", 1, closed(1, 100000),
+              "independent replicas of the case, pooled into one run file (profiles and "
+              "standard errors over all replicas' samples; time series of replica 0). Replica r "
+              "of the periodic protocol takes seed run.seed + r; of the single shock, "
+              "run.transient_cycles + r from run.seed. Spread over the ranks of `mpirun -np P "
+              "shaker md`; the file is the same for every P. Without a checkpoint only").in("1"),
       text("md.collapse_guard", "off", {"off", "tc"},
            "off: stop with an error when inelastic collapse starts; tc: collisions within "
            "md.tc of a particle's previous collision are elastic (TC model)").in("-"),
