@@ -223,10 +223,17 @@ def plan_runs(shaker, studies, case_names, quick):
 
 
 def run_key(shaker, run):
-    """The effective configuration and its key: the hash of its values (not of its text, so
-    that comments and formatting in `shaker config` do not invalidate finished runs)."""
+    """The effective configuration and its key: the hash of the values that can change the
+    solver's result (not of the text, so that comments and formatting in `shaker config` do
+    not invalidate finished runs; and not the other solver's section, so that a key added
+    there does not either: the continuum reads only md.box_width of [md])."""
     text = effective_config(shaker, run["case"], run["overrides"])
-    canonical = json.dumps(tomllib.loads(text), sort_keys=True)
+    values = tomllib.loads(text)
+    if run["solver"] == "continuum":
+        values["md"] = {"box_width": values["md"]["box_width"]}
+    else:
+        values.pop("continuum", None)
+    canonical = json.dumps(values, sort_keys=True)
     return text, hashlib.sha256(canonical.encode()).hexdigest()
 
 
