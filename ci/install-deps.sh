@@ -1,6 +1,11 @@
 #!/usr/bin/env bash
-# Installs granular-shaker's build and plot dependencies from Debian 12 packages.
+# Installs granular-shaker's build, test and plot dependencies from Debian 12 packages.
 # Idempotent: packages already present are left alone and apt-get is not called at all.
+#
+#   ci/install-deps.sh             what ci/test.sh and ci/base-case.sh need (the default set)
+#   ci/install-deps.sh --nightly   also what only the nightly tests need (ci/nightly runs this):
+#                                  ParaView, whose XDMF readers read the 3D fields
+#                                  (ctest continuum.FieldsXdmf.ParaView)
 set -euo pipefail
 
 packages=(
@@ -8,8 +13,14 @@ packages=(
   libeigen3-dev libgsl-dev libhdf5-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtoml11-dev libcli11-dev libfmt-dev
-  python3 python3-numpy python3-matplotlib python3-h5py
+  libopenmpi-dev openmpi-bin
+  python3 python3-numpy python3-matplotlib python3-h5py python3-meshio
 )
+case ${1:-} in
+  "") ;;
+  --nightly) packages+=(paraview python3-paraview) ;;
+  *) echo "install-deps: unknown argument '$1' (allowed: --nightly)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

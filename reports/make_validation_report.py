@@ -654,13 +654,13 @@ def header(results, counts):
     lines += ["- MD collisions per second: " + (", ".join(cps) if cps else
                                                 "not available (needs a cumulative `collisions`"
                                                 " time-series column and a fresh run)"), ""]
-    lines += ["| case | solver | member | status | seconds | reused | program |",
+    lines += ["| case | solver | replicas | status | seconds | reused | program |",
               "| --- | --- | --- | --- | --- | --- | --- |"]
     for r in d["runs"]:
         status = r["status"] + (f" (with {', '.join(r['fallback'])})" if r.get("fallback")
                                 else "")
         lines.append(f"| {r['case']} | {r['solver']} | "
-                     f"{'' if r['member'] is None else r['member']} | {status} | "
+                     f"{r.get('replicas', 1)} | {status} | "
                      f"{r['seconds']:.1f} | {'yes' if r['reused'] else 'no'} | "
                      f"{(r.get('program') or '')[:10]} |")
     return lines + [""]

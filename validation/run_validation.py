@@ -3,18 +3,18 @@
 
     validation/run_validation.py --shaker build/release/solvers/app/shaker [--quick]
         [--cases base,depth_h4p5] [--workdir DIR] [--report reports/validation.md]
-        [--jobs 2] [--require C1,C4,C10] [--reuse-only] [--rerun]
+        [--jobs 2] [--launcher "mpirun -np 8"] [--require C1,C4,C10] [--reuse-only] [--rerun]
 
 Steps (data flows one way: case file -> solver -> run file -> analysis -> claims -> report):
 1. every case of validation/studies.toml (or the --cases / --quick subset) is run with each
    solver that the paper used for it. A run is keyed by the SHA-256 of its effective
    configuration (`shaker config CASE --set ...`), so a finished run is reused, never
-   re-simulated; --rerun forces new runs. MD single-shock cases are run md_pool times from
-   consecutive cycles of the periodic state (run.transient_cycles + k).
+   re-simulated; --rerun forces new runs. An MD single-shock case is one ensemble of md_pool
+   replicas started from consecutive cycles of the periodic state (md.replicas; replica k
+   has run.transient_cycles + k), through --launcher (e.g. "mpirun -np 8") if given.
 2. every finished run is analysed by `shaker analyze --csv` (the project's one analysis
-   implementation), which pools the runs of a single-shock case and gives every MD number
-   a jackknife error over the independent samples (the pooled runs, or the sampled cycles
-   of a periodic run).
+   implementation), which gives every MD number a jackknife error over the independent
+   samples (the replicas of an ensemble, or the sampled cycles of a periodic run).
 3. `shaker compare --csv` gives the agreement metrics of every case run by both solvers.
 4. every claim of reference-data/claims.toml is evaluated per solver against its band
    (validation/quantities.py), and reports/make_validation_report.py writes the report.
@@ -31,6 +31,7 @@ import hashlib
 import json
 import math
 import os
+import shlex
 import subprocess
 import sys
 import time
@@ -129,19 +130,15 @@ def _array(values):
     return np.array([_number(v) for v in values], dtype=float)
 
 
-def analyze(shaker, run_files, json_path, pooled=None, with_profiles=False):
-    """`shaker analyze RUN... --json`: the analysis of docs/analysis.md of one run (or the pool
-    of several), with jackknife errors and replicates over its samples. Returns the view's
-    fields: (per-phase columns, their errors, per-run values, their errors, crossings,
-    replicates as (per-phase, per-run) pairs)."""
-    cmd = [shaker, "analyze", *run_files, "--json", json_path, "--quiet"]
-    if pooled:
-        cmd += ["--pooled", pooled]
-    if with_profiles:
-        cmd += ["--profiles-csv", (pooled or run_files[0]) + ".profiles.csv"]
+def analyze(shaker, run_file, json_path):
+    """`shaker analyze RUN --json`: the analysis of docs/analysis.md of one run, with jackknife
+    errors and replicates over its samples (and its profiles as CSV beside it): the parsed
+    JSON."""
+    cmd = [shaker, "analyze", run_file, "--json", json_path, "--quiet",
+           "--profiles-csv", run_file + ".profiles.csv"]
     result = subprocess.run(cmd, capture_output=True, text=True)
     if result.returncode != 0:
-        raise RuntimeError(f"shaker analyze {' '.join(run_files)}: {result.stderr.strip()}")
+        raise RuntimeError(f"shaker analyze {run_file}: {result.stderr.strip()}")
     with open(json_path) as f:
         data = json.load(f)
     return data
@@ -205,36 +202,38 @@ class Comparer:
 # ---- running the solvers --------------------------------------------------------------------
 
 def plan_runs(shaker, studies, case_names, quick):
-    """The list of solver runs: dicts with case, solver, member (pool index), overrides,
-    config text and key."""
+    """The list of solver runs: dicts with case, solver, replicas, overrides, timeout,
+    fallback and expect_failure. An MD single-shock case is one ensemble of md_pool replicas
+    (md.replicas: replica r starts r cycles later in the periodic state, docs/parallel.md)."""
     quick_overrides = studies["quick"]["overrides"] if quick else []
     plan = []
     for name in case_names:
         case = studies["by_name"][name]
         for solver in case["solvers"]:
-            pool = case.get("md_pool", 0) if solver == "md" else 0
-            if quick and pool:
+            pool = case.get("md_pool", 1) if solver == "md" else 1
+            if quick:
                 pool = min(pool, studies["quick"]["md_pool"])
-            base_config = tomllib.loads(effective_config(shaker, name, quick_overrides))
-            members = range(pool) if pool else [None]
-            for member in members:
-                overrides = list(quick_overrides)
-                if member is not None:
-                    first = base_config["run"]["transient_cycles"]
-                    overrides.append(f"run.transient_cycles={first + member}")
-                plan.append(dict(case=name, solver=solver, member=member, overrides=overrides,
-                                 timeout=case.get("timeout", studies["quick" if quick else
-                                                                     "defaults"]["timeout"]),
-                                 fallback=case.get("md_fallback", []) if solver == "md" else [],
-                                 expect_failure=case.get("expect_failure", False)))
+            overrides = list(quick_overrides) + ([f"md.replicas={pool}"] if pool > 1 else [])
+            plan.append(dict(case=name, solver=solver, replicas=pool, overrides=overrides,
+                             timeout=case.get("timeout", studies["quick" if quick else
+                                                                 "defaults"]["timeout"]),
+                             fallback=case.get("md_fallback", []) if solver == "md" else [],
+                             expect_failure=case.get("expect_failure", False)))
     return plan
 
 
 def run_key(shaker, run):
-    """The effective configuration and its key: the hash of its values (not of its text, so
-    that comments and formatting in `shaker config` do not invalidate finished runs)."""
+    """The effective configuration and its key: the hash of the values that can change the
+    solver's result (not of the text, so that comments and formatting in `shaker config` do
+    not invalidate finished runs; and not the other solver's section, so that a key added
+    there does not either: the continuum reads only md.box_width of [md])."""
     text = effective_config(shaker, run["case"], run["overrides"])
-    canonical = json.dumps(tomllib.loads(text), sort_keys=True)
+    values = tomllib.loads(text)
+    if run["solver"] == "continuum":
+        values["md"] = {"box_width": values["md"]["box_width"]}
+    else:
+        values.pop("continuum", None)
+    canonical = json.dumps(values, sort_keys=True)
     return text, hashlib.sha256(canonical.encode()).hexdigest()
 
 
@@ -250,8 +249,9 @@ def solver_environment(jobs):
     return env
 
 
-def execute(shaker, workdir, run, rerun, reuse_only, env=None):
-    """Runs (or reuses) one solver run; returns its record (status, path, seconds, ...)."""
+def execute(shaker, workdir, run, rerun, reuse_only, env=None, launcher=()):
+    """Runs (or reuses) one solver run; returns its record (status, path, seconds, ...). An
+    ensemble (replicas > 1) is started through `launcher` (e.g. mpirun -np 8) if one is given."""
     text, key = run_key(shaker, run)
     stem = os.path.join(workdir, "runs", f"{run['solver']}-{key[:20]}")
     record_path, output = stem + ".json", stem + ".h5"
@@ -260,18 +260,21 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None):
             record = json.load(f)
         if record["status"] in ("ok", "collapse") and (record["status"] != "ok"
                                                        or os.path.exists(output)):
-            record["reused"] = True
+            # The workdir may have moved since: the run file is where the key puts it.
+            record.update(reused=True, path=output if record["status"] == "ok" else None)
             return record
     if reuse_only:
         status = "ok" if os.path.exists(output) else "not run"
         return dict(status=status, path=output if status == "ok" else None, seconds=0.0,
                     key=key, config=text, reused=status == "ok", returncode=None,
                     stderr="--reuse-only: no finished run", command="")
-    cmd = [shaker, run["solver"], case_file(run["case"])]
+    cmd = list(launcher) if run["replicas"] > 1 else []
+    cmd += [shaker, run["solver"], case_file(run["case"])]
     cmd += [a for o in run["overrides"] for a in ("--set", o)]
     cmd += ["--set", f"run.output={output}"]
-    log(f"run {run['solver']} {run['case']}" + (f" [{run['member']}]" if run["member"] is not None
-                                                else "") + f" -> {os.path.basename(output)}")
+    log(f"run {run['solver']} {run['case']}" + (f" [{run['replicas']} replicas]"
+                                                if run["replicas"] > 1 else "")
+        + f" -> {os.path.basename(output)}")
     start = time.monotonic()
     try:
         result = subprocess.run(cmd, capture_output=True, text=True, timeout=run["timeout"],
@@ -301,14 +304,14 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None):
     return record
 
 
-def execute_all(shaker, workdir, plan, jobs, rerun, reuse_only):
+def execute_all(shaker, workdir, plan, jobs, rerun, reuse_only, launcher=()):
     env = solver_environment(jobs)
 
     def one(run):
-        record = execute(shaker, workdir, run, rerun, reuse_only, env)
+        record = execute(shaker, workdir, run, rerun, reuse_only, env, launcher)
         if record["status"] == "collapse" and run["fallback"] and not run["expect_failure"]:
             guarded = dict(run, overrides=run["overrides"] + run["fallback"])
-            record = execute(shaker, workdir, guarded, rerun, reuse_only, env)
+            record = execute(shaker, workdir, guarded, rerun, reuse_only, env, launcher)
             record["fallback"] = run["fallback"]
         return record
 
@@ -321,36 +324,25 @@ def execute_all(shaker, workdir, plan, jobs, rerun, reuse_only):
 
 # ---- analysis of the runs -------------------------------------------------------------------
 
-def build_view(shaker, case, solver, records, workdir):
-    """The view of one case in one solver: a run, or the pool of an MD single-shock case, as
-    `shaker analyze` sees it; MD views carry the jackknife replicates over their samples
-    (sampled cycles of a run, or the pooled runs)."""
-    ok = [r for r in records if r["status"] == "ok"]
-    statuses = sorted({r["status"] for r in records})
-    config = tomllib.loads(records[0]["config"]) if records else {}
-    if not ok:
-        view = RunView(case, solver, statuses[0] if len(statuses) == 1 else "/".join(statuses),
-                       config=config)
-        view.runs = records
-        view.stderr_tail = " | ".join(r.get("stderr", "").strip()[-300:] for r in records)
+def build_view(shaker, case, solver, record, workdir):
+    """The view of one case in one solver, as `shaker analyze` sees its run file; MD views
+    carry the jackknife replicates over their samples (sampled cycles of a run, or the
+    replicas of an ensemble)."""
+    config = tomllib.loads(record["config"]) if record.get("config") else {}
+    if record["status"] != "ok":
+        view = RunView(case, solver, record["status"], config=config)
+        view.runs = [record]
+        view.stderr_tail = record.get("stderr", "").strip()[-300:]
         return view
     derived = os.path.join(workdir, "derived")
     os.makedirs(derived, exist_ok=True)
-    key = hashlib.sha256("|".join(r["key"] for r in ok).encode()).hexdigest()[:20]
-    pooled = os.path.join(derived, f"pool-{solver}-{key}.h5") if len(ok) > 1 else None
-    view = RunView(case, solver, "ok", pooled or ok[0]["path"], config)
-    data = analyze(shaker, [r["path"] for r in ok],
-                   os.path.join(derived, f"analysis-{solver}-{key}.json"), pooled=pooled,
-                   with_profiles=True)
-    fill_view(view, data)
-    view.analysis_json = os.path.join(derived, f"analysis-{solver}-{key}.json")
-    if len(ok) < len(records):
-        view.notes.add(f"{len(records) - len(ok)} of {len(records)} pooled runs failed")
-    guarded = [r for r in records if r.get("fallback")]
-    if guarded:
-        view.notes.add(f"{len(guarded)} of {len(records)} MD runs stopped by inelastic collapse "
-                       "and were rerun with " + ", ".join(guarded[0]["fallback"]))
-    view.runs = records
+    view = RunView(case, solver, "ok", record["path"], config)
+    view.analysis_json = os.path.join(derived, f"analysis-{solver}-{record['key'][:20]}.json")
+    fill_view(view, analyze(shaker, record["path"], view.analysis_json))
+    if record.get("fallback"):
+        view.notes.add("the MD run stopped by inelastic collapse and was rerun with "
+                       + ", ".join(record["fallback"]))
+    view.runs = [record]
     return view
 
 
@@ -630,6 +622,9 @@ def main(argv=None):
     parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
     parser.add_argument("--diagnoses", default=os.path.join(HERE, "diagnoses.toml"))
     parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
+    parser.add_argument("--launcher", default="",
+                        help="how MD ensembles (md_pool cases) are started, e.g. "
+                        "\"mpirun -np 8\" (default: in one process)")
     parser.add_argument("--require", default="",
                         help="comma-separated claim ids that must pass (else exit status 1); "
                         "ID:SOLVER requires only that solver's check (e.g. C1:md)")
@@ -663,12 +658,12 @@ def main(argv=None):
 
     started = time.monotonic()
     plan = execute_all(shaker, workdir, plan_runs(shaker, studies, names, args.quick), args.jobs,
-                       args.rerun, args.reuse_only)
+                       args.rerun, args.reuse_only, shlex.split(args.launcher))
     views = {}
     for name in names:
         for solver in studies["by_name"][name]["solvers"]:
-            records = [r["record"] for r in plan if r["case"] == name and r["solver"] == solver]
-            views[(name, solver)] = build_view(shaker, name, solver, records, workdir)
+            record = next(r["record"] for r in plan if r["case"] == name and r["solver"] == solver)
+            views[(name, solver)] = build_view(shaker, name, solver, record, workdir)
     comparer = Comparer(shaker, os.path.join(workdir, "derived"))
     metrics = {}
     for name in names:
@@ -682,7 +677,7 @@ def main(argv=None):
     results = evaluate_claims(claims, views, comparer, partial)
     diagnosed, undiagnosed = diagnose(diagnoses, results, views, comparer, partial)
 
-    runs = [dict(case=r["case"], solver=r["solver"], member=r["member"],
+    runs = [dict(case=r["case"], solver=r["solver"], replicas=r["replicas"],
                  status=r["record"]["status"], seconds=r["record"]["seconds"],
                  reused=r["record"].get("reused", False), path=r["record"].get("path"),
                  fallback=r["record"].get("fallback"), program=run_program(r["record"]),

@@ -367,27 +367,6 @@ std::vector<double> crossings_per_cycle(const RunRecord& run, const std::string&
   return per_cycle;
 }
 
-RunRecord pool_runs(const std::vector<RunRecord>& runs) {
-  if (runs.empty()) throw InputError("no run to pool");
-  RunRecord pooled = runs.front();
-  if (runs.size() == 1) return pooled;
-  for (std::size_t r = 1; r < runs.size(); ++r) {
-    if (runs[r].samples.empty() || runs.front().samples.empty())
-      throw InputError("only MD runs that keep their per-cycle sums can be pooled");
-    if (runs[r].profiles.size() != pooled.profiles.size())
-      throw InputError(fmt::format("the runs to pool store {} and {} phases",
-                                   pooled.profiles.size(), runs[r].profiles.size()));
-    try {
-      pooled.samples.append(runs[r].samples);
-    } catch (const std::invalid_argument& error) {
-      throw InputError(error.what());
-    }
-  }
-  for (std::size_t k = 0; k < pooled.profiles.size(); ++k) pooled.samples.pool(k, pooled.profiles[k]);
-  pooled.model_variant += fmt::format(" (pooled over {} runs)", runs.size());
-  return pooled;
-}
-
 std::vector<Profile> profiles_without(const RunRecord& run, std::size_t left_out) {
   std::vector<Profile> profiles = run.profiles;
   std::vector<char> use(run.samples.samples(), 1);

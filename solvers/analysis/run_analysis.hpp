@@ -86,11 +86,6 @@ std::vector<NamedValues> run_values(const RunQuantities& r);
 /// column crossings_z<h>): one count per cycle.
 std::vector<double> crossings_per_cycle(const RunRecord& run, const std::string& column);
 
-/// Runs of one configuration pooled into one record: their samples appended, the profiles
-/// rebuilt from all samples. Throws InputError if a run lacks samples or the runs differ in
-/// their phases or bins.
-RunRecord pool_runs(const std::vector<RunRecord>& runs);
-
 /// The profiles of `run` rebuilt from every sample but `left_out`.
 std::vector<Profile> profiles_without(const RunRecord& run, std::size_t left_out);
 

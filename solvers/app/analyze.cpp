@@ -229,7 +229,7 @@ int command_analyze(const AnalyzeOptions& o) {
   check_output_paths(outputs, inputs);
   std::vector<RunRecord> runs;
   for (const auto& file : o.run_files) runs.push_back(read_run_file(file));
-  const RunRecord run = analysis::pool_runs(runs);
+  const RunRecord run = pool_runs(runs);
   const auto config = config::Config::from_toml(run.configuration, o.run_files.front());
   analysis::AnalysisOptions options;
   options.criteria = o.criteria;

@@ -11,6 +11,7 @@
 #include "common/errors.hpp"
 #include "common/describe.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/ranks.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
 #include "md/run_md.hpp"
@@ -53,6 +54,10 @@ int command_md(const RunOptions& options) {
 }
 int command_continuum(const RunOptions& options) {
   options.progress.validate();
+  if (Ranks::world().size() > 1)
+    throw InputError(fmt::format("the continuum runs on one rank, not on {}: start it without "
+                                 "mpirun (MPI ranks serve MD ensembles, md.replicas)",
+                                 Ranks::world().size()));
   return continuum::run(load(options), {{"configuration file", options.config_file}}, options.progress);
 }
 

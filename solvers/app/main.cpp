@@ -9,6 +9,7 @@
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/ranks.hpp"
 #include "common/version.hpp"
 
 int main(int argc, char** argv) {
@@ -78,6 +79,9 @@ int main(int argc, char** argv) {
   // SIGTERM/SIGINT/SIGHUP: remove partial files, exit 128 + signal; inside a solver's run loop
   // SIGTERM and SIGINT first write a checkpoint (StopRequested).
   install_signal_cleanup();
+  struct FinalizeRanks {
+    ~FinalizeRanks() { Ranks::finalize(); }
+  } finalize_ranks;
   try {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
@@ -89,10 +93,12 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "{}\n", stop.what());
     return stop.exit_code();
   } catch (const InputError& error) {
+    // Every rank reads the same input and fails alike, so none is left waiting.
     fmt::print(stderr, "shaker: error: {}\n", error.what());
     return 2;
   } catch (const std::exception& error) {
     fmt::print(stderr, "shaker: failed: {}\n", error.what());
+    Ranks::abort_others(1);
     return 1;
   }
   return 2;

@@ -234,7 +234,7 @@ template <class T> bool parse_number(const std::string& s, T& out) {
 /// key or table header (a.b.c is a table in a table), with strings and comments skipped as
 /// TOML delimits them (basic "...", literal '...', multi-line """...""" and '''...''').
 /// toml11 parses nesting by recursion (a hostile depth overflows the stack) and slows down
-/// quadratically with a key's components (8,000 took 2.4 s and 120 MB), so texts deeper than
+/// quadratically with a key's components (docs/performance.md), so texts deeper than
 /// max_toml_nesting are refused before parsing.
 constexpr int max_toml_nesting = 32;
 int toml_nesting(const std::string& text) {

@@ -44,8 +44,8 @@ Handle string_type() {
 }
 
 template <class T>
-void write_array(hid_t parent, const std::string& name, const T* data,
-                 const std::vector<hsize_t>& dims, hid_t memory_type, hid_t file_type) {
+Handle write_array(hid_t parent, const std::string& name, const T* data,
+                   const std::vector<hsize_t>& dims, hid_t memory_type, hid_t file_type) {
   Handle space(checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
                        "dataspace for " + name));
   Handle set(checked(H5Dcreate2(parent, name.c_str(), file_type, space.id(), H5P_DEFAULT,
@@ -53,6 +53,21 @@ void write_array(hid_t parent, const std::string& name, const T* data,
                      "create dataset " + name));
   checked_status(H5Dwrite(set.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
                  "write dataset " + name);
+  return set;
+}
+
+template <class T>
+void write_with_units(hid_t parent, const std::string& name, const std::vector<T>& data,
+                      const std::vector<std::size_t>& dims, const std::string& units,
+                      hid_t memory_type, hid_t file_type) {
+  std::size_t count = 1;
+  for (const std::size_t d : dims) count *= d;
+  if (count != data.size())
+    throw std::logic_error(fmt::format("dataset {}: {} values for a shape of {} values", name,
+                                       data.size(), count));
+  const Handle set = write_array(parent, name, data.data(),
+                                 std::vector<hsize_t>(dims.begin(), dims.end()), memory_type, file_type);
+  write_attribute(set.id(), "units", units);
 }
 
 template <class T> std::vector<T> read_array(hid_t parent, const std::string& name, hid_t type) {
@@ -176,6 +191,14 @@ void write(hid_t parent, const std::string& name, const std::vector<double>& dat
     throw std::logic_error(fmt::format("dataset {}: {} values for a {}x{} matrix", name,
                                        data.size(), rows, cols));
   write_array(parent, name, data.data(), {rows, cols}, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE);
+}
+void write(hid_t parent, const std::string& name, const std::vector<double>& data,
+           const std::vector<std::size_t>& dims, const std::string& units) {
+  write_with_units(parent, name, data, dims, units, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE);
+}
+void write(hid_t parent, const std::string& name, const std::vector<std::int64_t>& data,
+           const std::vector<std::size_t>& dims, const std::string& units) {
+  write_with_units(parent, name, data, dims, units, H5T_NATIVE_INT64, H5T_STD_I64LE);
 }
 std::vector<double> read_doubles(hid_t parent, const std::string& name) {
   return read_array<double>(parent, name, H5T_NATIVE_DOUBLE);

@@ -45,6 +45,12 @@ void write(hid_t parent, const std::string& name, const std::vector<std::int64_t
 /// Row-major matrix (rows x cols).
 void write(hid_t parent, const std::string& name, const std::vector<double>& data,
            std::size_t rows, std::size_t cols);
+/// An array of any shape (`dims` slowest first, the data in C order) with its units as the
+/// string attribute `units` (docs/units.md notation; "1" for pure numbers).
+void write(hid_t parent, const std::string& name, const std::vector<double>& data,
+           const std::vector<std::size_t>& dims, const std::string& units);
+void write(hid_t parent, const std::string& name, const std::vector<std::int64_t>& data,
+           const std::vector<std::size_t>& dims, const std::string& units);
 std::vector<double> read_doubles(hid_t parent, const std::string& name);
 std::vector<std::int64_t> read_integers(hid_t parent, const std::string& name);
 /// Dimensions of a dataset.

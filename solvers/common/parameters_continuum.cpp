@@ -45,8 +45,10 @@ std::vector<ParameterSpec> continuum_parameters() {
            "paper transport: kappa_art = coefficient * n h c / (1 + (nu / nu_art)^4)").in("1"),
       real("continuum.artificial_volume_fraction", 0.01, positive(0.65),
            "paper transport: nu_art, the volume fraction below which artificial dissipation acts").in("1"),
-      real_list("continuum.field_phases", {}, closed(0.0, 1.0),
-                "3D: phases f t of the last sampled cycle whose full fields are written (HDF5 + XDMF)").in("1 (f t)"),
+      real_list("continuum.field_phases", {}, Range{0.0, 1.0, false, true},
+                "3D only: phases f t of the last sampled cycle whose full fields are written "
+                "(RUN.fields.h5 + RUN.fields.xdmf), each a stored phase k / run.phases_per_cycle, "
+                "at most once").in("1 (f t)"),
   };
 }
 

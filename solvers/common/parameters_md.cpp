@@ -17,6 +17,13 @@ std::vector<ParameterSpec> md_parameters() {
       real("md.gas_volume_fraction", 0.1, Range{0.0, 0.55, true, false},
            "gas initial state: volume fraction").in("1"),
       real("md.gas_temperature", 1.0, positive(1e6), "gas initial state: temperature").in("g sigma"),
+      integer("md.replicas", 1, closed(1, 100000),
+              "independent replicas of the case, pooled into one run file (profiles and "
+              "standard errors over all replicas' samples; time series of replica 0). Replica r "
+              "of the periodic protocol takes seed run.seed + r; of the single shock, "
+              "run.transient_cycles + r from run.seed. Spread over the ranks of `mpirun -np P "
+              "shaker md`; the file is the same for every P. Without checkpoints only "
+              "(run.restart_from, run.checkpoint, run.checkpoint_every)").in("1"),
       text("md.collapse_guard", "off", {"off", "tc"},
            "off: stop with an error when inelastic collapse starts; tc: collisions within "
            "md.tc of a particle's previous collision are elastic (TC model)").in("-"),

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
+#include "common/errors.hpp"
+
 namespace shaker {
 
 void TimeSeries::add(const std::string& name, std::vector<double> values) {
@@ -21,6 +25,27 @@ const std::vector<double>& TimeSeries::column(const std::string& name) const {
 
 bool TimeSeries::has(const std::string& name) const {
   return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+RunRecord pool_runs(const std::vector<RunRecord>& runs) {
+  if (runs.empty()) throw InputError("no run to pool");
+  RunRecord pooled = runs.front();
+  if (runs.size() == 1) return pooled;
+  for (std::size_t r = 1; r < runs.size(); ++r) {
+    if (runs[r].samples.empty() || runs.front().samples.empty())
+      throw InputError("only MD runs that keep their per-cycle sums can be pooled");
+    if (runs[r].profiles.size() != pooled.profiles.size())
+      throw InputError(fmt::format("the runs to pool store {} and {} phases",
+                                   pooled.profiles.size(), runs[r].profiles.size()));
+    try {
+      pooled.samples.append(runs[r].samples);
+    } catch (const std::invalid_argument& error) {
+      throw InputError(error.what());
+    }
+  }
+  for (std::size_t k = 0; k < pooled.profiles.size(); ++k) pooled.samples.pool(k, pooled.profiles[k]);
+  pooled.model_variant += fmt::format(" (pooled over {} runs)", runs.size());
+  return pooled;
 }
 
 }  // namespace shaker

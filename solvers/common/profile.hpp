@@ -50,4 +50,10 @@ struct RunRecord {
   std::string program_version, git_commit, created;
 };
 
+/// MD runs of one configuration (repeats, or the replicas of an ensemble) pooled into one
+/// record: their samples appended in the order given, the profiles rebuilt from all samples;
+/// everything else (time series, configuration) is the first run's. Throws InputError if a
+/// run lacks samples or the runs differ in their phases or bins.
+RunRecord pool_runs(const std::vector<RunRecord>& runs);
+
 }  // namespace shaker

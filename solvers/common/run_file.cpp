@@ -178,6 +178,17 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
 
 }  // namespace
 
+void write_run_attributes(hid_t file, const RunRecord& record) {
+  h5::write_attribute(file, "schema_version", std::int64_t{output_schema_version});
+  h5::write_attribute(file, "program_version", std::string(program_version()));
+  h5::write_attribute(file, "git_commit", std::string(git_commit()));
+  h5::write_attribute(file, "created", utc_now());
+  h5::write_attribute(file, "solver", record.solver);
+  h5::write_attribute(file, "model_variant", record.model_variant);
+  h5::write_attribute(file, "configuration", record.configuration);
+  h5::write_attribute(file, "restitution_for_analysis", record.e);
+}
+
 void write_run_file(const std::filesystem::path& path, const RunRecord& record) {
   for (const char* name : required_series_columns)
     if (!record.series.has(name))
@@ -185,14 +196,7 @@ void write_run_file(const std::filesystem::path& path, const RunRecord& record) 
           "run file '{}': the time series has no column '{}'; every run file has the columns {} "
           "(docs/output-schema.md)", path.string(), name, fmt::join(required_series_columns, ", ")));
   write_hdf5_atomically(path, [&](hid_t file) {
-    h5::write_attribute(file, "schema_version", std::int64_t{output_schema_version});
-    h5::write_attribute(file, "program_version", std::string(program_version()));
-    h5::write_attribute(file, "git_commit", std::string(git_commit()));
-    h5::write_attribute(file, "created", utc_now());
-    h5::write_attribute(file, "solver", record.solver);
-    h5::write_attribute(file, "model_variant", record.model_variant);
-    h5::write_attribute(file, "configuration", record.configuration);
-    h5::write_attribute(file, "restitution_for_analysis", record.e);
+    write_run_attributes(file, record);
     write_profiles(file, record.profiles);
     write_samples(file, record.samples);
     h5::Handle series = h5::create_group(file, "timeseries");
@@ -206,6 +210,13 @@ RunRecord read_run_file(const std::filesystem::path& path) {
   try {
     h5::Handle file = h5::open_file(path);
     RunRecord record;
+    // A fields file shares the run file's root attributes: refused by what it is, not later by
+    // a missing group.
+    if (h5::has_attribute(file.id(), file_kind_attribute))
+      throw InputError(fmt::format("this is a '{}' file (root attribute {}), not a run file; "
+                                   "allowed: the run.output file of shaker md or shaker continuum",
+                                   h5::read_string_attribute(file.id(), file_kind_attribute),
+                                   file_kind_attribute));
     const std::int64_t version = h5::read_integer_attribute(file.id(), "schema_version");
     if (version != output_schema_version)
       throw InputError(fmt::format("schema version {} is not supported (attribute schema_version; "

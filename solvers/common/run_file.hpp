@@ -1,6 +1,8 @@
 #pragma once
 // The HDF5 run file, schema version `output_schema_version` (documented in
 // docs/output-schema.md). Both solvers write it; the analysis reads it.
+#include <hdf5.h>
+
 #include <array>
 #include <filesystem>
 
@@ -11,6 +13,14 @@ namespace shaker {
 /// The time-series columns of every run file, whichever solver wrote it.
 inline constexpr std::array<const char*, 4> required_series_columns{"t", "phase", "plate_z", "com_z"};
 
+/// Root attribute `kind` of the other HDF5 files a run writes for reading back (the 3D fields
+/// file, the checkpoints), which a run file does not have: read_run_file names it in its refusal.
+inline constexpr const char* file_kind_attribute = "kind";
+
+/// The root attributes of a run file (docs/output-schema.md): schema version, program
+/// version, commit, date, and the record's solver, model variant, configuration and e.
+/// Every file a run writes for analysis carries them, so that each says what made it.
+void write_run_attributes(hid_t file, const RunRecord& record);
 /// Writes the record atomically; provenance (schema, version, commit, date) is added here.
 /// Throws std::invalid_argument, writing nothing, if the series lacks a required column.
 void write_run_file(const std::filesystem::path& path, const RunRecord& record);

@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
-#include <stdexcept>
+#include <cstdint>
+#include <string>
+#include <utility>
 
 #include "common/hdf5_file.hpp"
+#include "common/run_file.hpp"
 
 namespace shaker::continuum {
 
@@ -70,7 +73,8 @@ FieldSnapshot snapshot(const TimeIntegrator& solver, const ShakerKinematics& sha
   FieldSnapshot f;
   f.time = solver.time();
   f.phase = shaker.phase(f.time);
-  const double plate_v = shaker.velocity(f.time);
+  f.plate_z = shaker.position(f.time);
+  f.plate_v = shaker.velocity(f.time);
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i) {
@@ -78,61 +82,132 @@ FieldSnapshot snapshot(const TimeIntegrator& solver, const ShakerKinematics& sha
         f.n.push_back(w.n);
         f.ux.push_back(w.ux);
         f.uy.push_back(w.uy);
-        f.uz.push_back(w.uz + plate_v);
+        f.uz.push_back(w.uz + f.plate_v);
         f.T.push_back(w.T);
       }
   return f;
 }
 
 namespace {
-void write_3d(hid_t group, const std::string& name, const std::vector<double>& data, const Grid& g) {
-  const hsize_t dims[3] = {static_cast<hsize_t>(g.nz), static_cast<hsize_t>(g.ny),
-                           static_cast<hsize_t>(g.nx)};
-  h5::Handle space(H5Screate_simple(3, dims, nullptr));
-  h5::Handle set(H5Dcreate2(group, name.c_str(), H5T_NATIVE_DOUBLE, space.id(), H5P_DEFAULT,
-                            H5P_DEFAULT, H5P_DEFAULT));
-  if (space.id() < 0 || set.id() < 0 ||
-      H5Dwrite(set.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
-    throw std::runtime_error("HDF5: write dataset " + name + " failed");
+
+// The XDMF describes the box as an unstructured grid of hexahedra, not as a 3DCoRectMesh:
+// meshio reads only unstructured topologies with XYZ geometry, and the corners of an
+// unstructured grid can carry each snapshot's plate position.
+
+/// Index of corner (i, j, k), x fastest: (nx + 1) (ny + 1) (nz + 1) corners.
+std::int64_t corner(const Grid& g, int i, int j, int k) {
+  return (static_cast<std::int64_t>(k) * (g.ny + 1) + j) * (g.nx + 1) + i;
 }
+
+/// The corners of each cell in VTK/XDMF hexahedron order (the bottom face anticlockwise seen
+/// from above, then the top face), cells in the order of the field arrays.
+std::vector<std::int64_t> hexahedra(const Grid& g) {
+  constexpr std::pair<int, int> face[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  std::vector<std::int64_t> cells;
+  cells.reserve(8 * g.interior_cells());
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i)
+        for (int dk = 0; dk < 2; ++dk)
+          for (const auto& [di, dj] : face)
+            cells.push_back(corner(g, i + di, j + dj, k + dk));
+  return cells;
+}
+
+/// Lab-frame corner coordinates (x, y, z) of the grid when the plate is at plate_z.
+std::vector<double> corners(const Grid& g, double plate_z) {
+  std::vector<double> xyz;
+  xyz.reserve(3 * static_cast<std::size_t>(g.nx + 1) * (g.ny + 1) * (g.nz + 1));
+  for (int k = 0; k <= g.nz; ++k)
+    for (int j = 0; j <= g.ny; ++j)
+      for (int i = 0; i <= g.nx; ++i) {
+        xyz.push_back(i * g.h);
+        xyz.push_back(j * g.h);
+        xyz.push_back(k * g.h + plate_z);
+      }
+  return xyz;
+}
+
+std::string hdf_item(const std::string& dimensions, const char* number_type,
+                     const std::string& file, const std::string& dataset) {
+  return fmt::format("<DataItem Dimensions=\"{}\" NumberType=\"{}\" Precision=\"8\" "
+                     "Format=\"HDF\">{}:/{}</DataItem>\n",
+                     dimensions, number_type, file, dataset);
+}
+
+struct FieldColumn {
+  const char* name;
+  std::vector<double> FieldSnapshot::*values;
+  const char* units;
+};
+constexpr FieldColumn field_columns[] = {{"n", &FieldSnapshot::n, "1/sigma^3"},
+                                         {"ux", &FieldSnapshot::ux, "sqrt(g sigma)"},
+                                         {"uy", &FieldSnapshot::uy, "sqrt(g sigma)"},
+                                         {"uz", &FieldSnapshot::uz, "sqrt(g sigma)"},
+                                         {"T", &FieldSnapshot::T, "g sigma"}};
+
+std::string snapshot_group(std::size_t s) { return fmt::format("snapshot_{:03d}", s); }
+
+/// The XDMF 3 sidecar: a temporal collection of the snapshots, each an unstructured grid of the
+/// shared hexahedra on its own corners, fields cell-centred; `file` is the HDF5 file's name.
+std::string xdmf_text(const std::string& file, const Grid& g,
+                      const std::vector<FieldSnapshot>& snapshots) {
+  const std::size_t cells = g.interior_cells();
+  const std::size_t points = static_cast<std::size_t>(g.nx + 1) * (g.ny + 1) * (g.nz + 1);
+  std::string xdmf = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
+                     "<Grid Name=\"fields\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (std::size_t s = 0; s < snapshots.size(); ++s) {
+    const std::string group = snapshot_group(s);
+    // Time in shortest round-trip form, so that a reader gets the stored double.
+    xdmf += fmt::format("<Grid Name=\"{}\" GridType=\"Uniform\">\n<Time Value=\"{}\"/>\n"
+                        "<Topology TopologyType=\"Hexahedron\" NumberOfElements=\"{}\">\n",
+                        group, snapshots[s].time, cells) +
+            hdf_item(fmt::format("{} 8", cells), "Int", file, "hexahedra") +
+            "</Topology>\n<Geometry GeometryType=\"XYZ\">\n" +
+            hdf_item(fmt::format("{} 3", points), "Float", file, group + "/points") +
+            "</Geometry>\n";
+    for (const auto& column : field_columns)
+      xdmf += fmt::format("<Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"Cell\">\n",
+                          column.name) +
+              hdf_item(fmt::format("{} {} {}", g.nz, g.ny, g.nx), "Float", file,
+                       group + "/" + column.name) +
+              "</Attribute>\n";
+    xdmf += "</Grid>\n";
+  }
+  return xdmf + "</Grid>\n</Domain>\n</Xdmf>\n";
+}
+
 }  // namespace
 
 void write_fields(const std::filesystem::path& h5_path, const Grid& g,
-                  const std::vector<FieldSnapshot>& snapshots) {
-  std::string xdmf = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
-                     "<Grid Name=\"fields\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  const std::string dims = fmt::format("{} {} {}", g.nz, g.ny, g.nx);
-  const std::string node_dims = fmt::format("{} {} {}", g.nz + 1, g.ny + 1, g.nx + 1);
-  write_hdf5_atomically(h5_path, [&](const hid_t file) {
+                  const std::vector<FieldSnapshot>& snapshots, const RunRecord& run) {
+  const std::size_t points = static_cast<std::size_t>(g.nx + 1) * (g.ny + 1) * (g.nz + 1);
+  const std::vector<std::size_t> shape{static_cast<std::size_t>(g.nz),
+                                       static_cast<std::size_t>(g.ny),
+                                       static_cast<std::size_t>(g.nx)};
+  write_hdf5_atomically(h5_path, [&](const hid_t root) {
+    write_run_attributes(root, run);
+    h5::write_attribute(root, file_kind_attribute, std::string(fields_file_kind));
+    h5::write_attribute(root, "cell_size", g.h);
+    h5::write_attribute(root, "nx", std::int64_t{g.nx});
+    h5::write_attribute(root, "ny", std::int64_t{g.ny});
+    h5::write_attribute(root, "nz", std::int64_t{g.nz});
+    h5::write(root, "hexahedra", hexahedra(g), {g.interior_cells(), 8}, "1");
     for (std::size_t s = 0; s < snapshots.size(); ++s) {
       const FieldSnapshot& f = snapshots[s];
-      const std::string group_name = fmt::format("snapshot_{:03d}", s);
-      h5::Handle group = h5::create_group(file, group_name);
+      h5::Handle group = h5::create_group(root, snapshot_group(s));
       h5::write_attribute(group.id(), "time", f.time);
       h5::write_attribute(group.id(), "phase", f.phase);
-      xdmf += fmt::format("<Grid Name=\"{}\" GridType=\"Uniform\">\n<Time Value=\"{}\"/>\n"
-                          "<Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{}\"/>\n"
-                          "<Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
-                          "<DataItem Dimensions=\"3\" Format=\"XML\">0 0 0</DataItem>\n"
-                          "<DataItem Dimensions=\"3\" Format=\"XML\">{} {} {}</DataItem>\n"
-                          "</Geometry>\n",
-                          group_name, f.time, node_dims, g.h, g.h, g.h);
-      const std::pair<const char*, const std::vector<double>*> fields[] = {
-          {"n", &f.n}, {"ux", &f.ux}, {"uy", &f.uy}, {"uz", &f.uz}, {"T", &f.T}};
-      for (const auto& [name, data] : fields) {
-        write_3d(group.id(), name, *data, g);
-        xdmf += fmt::format("<Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-                            "<DataItem Dimensions=\"{}\" NumberType=\"Float\" Precision=\"8\" "
-                            "Format=\"HDF\">{}:/{}/{}</DataItem>\n</Attribute>\n",
-                            name, dims, h5_path.filename().string(), group_name, name);
-      }
-      xdmf += "</Grid>\n";
+      h5::write_attribute(group.id(), "plate_z", f.plate_z);
+      h5::write_attribute(group.id(), "plate_v", f.plate_v);
+      h5::write(group.id(), "points", corners(g, f.plate_z), {points, 3}, "sigma");
+      for (const auto& column : field_columns)
+        h5::write(group.id(), column.name, f.*column.values, shape, column.units);
     }
   });
-  xdmf += "</Grid>\n</Domain>\n</Xdmf>\n";
   std::filesystem::path sidecar = h5_path;
   sidecar.replace_extension(".xdmf");
-  write_text_atomically(sidecar, xdmf);
+  write_text_atomically(sidecar, xdmf_text(h5_path.filename().string(), g, snapshots));
 }
 
 }  // namespace shaker::continuum

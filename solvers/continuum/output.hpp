@@ -1,7 +1,7 @@
 #pragma once
 // What a continuum run reports: horizontally averaged profiles in the lab frame (the MD
 // schema: z_lab = z + plate_z(t), u_lab = u_z + V_p(t)), integral diagnostics for the time
-// series, and for 3D full fields in HDF5 with an XDMF sidecar for ParaView.
+// series, and for 3D full fields in HDF5 with an XDMF sidecar for ParaView (also lab frame).
 #include <filesystem>
 #include <vector>
 
@@ -19,13 +19,18 @@ struct Diagnostics {
 };
 Diagnostics diagnostics(const TimeIntegrator& solver, const ShakerKinematics& shaker);
 
+/// The full fields at one instant, in the lab frame like the profiles: the cells sit at their
+/// container-frame centres + plate_z, and u_z includes plate_v.
 struct FieldSnapshot {
-  double time = 0, phase = 0;
+  double time = 0, phase = 0, plate_z = 0, plate_v = 0;
   std::vector<double> n, ux, uy, uz, T;  ///< interior cells, x fastest, lab-frame u_z
 };
 FieldSnapshot snapshot(const TimeIntegrator& solver, const ShakerKinematics& shaker);
-/// Writes fields.h5 and its .xdmf sidecar atomically.
+/// Root attribute `kind` of the fields file: a reader of run files refuses it by this.
+inline constexpr const char* fields_file_kind = "shaker continuum fields";
+/// Writes the fields file (h5_path) and its .xdmf sidecar atomically; the file's root carries
+/// the run file's attributes, from `run` (docs/output-schema.md).
 void write_fields(const std::filesystem::path& h5_path, const Grid& grid,
-                  const std::vector<FieldSnapshot>& snapshots);
+                  const std::vector<FieldSnapshot>& snapshots, const RunRecord& run);
 
 }  // namespace shaker::continuum

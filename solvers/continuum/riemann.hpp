@@ -24,7 +24,7 @@ inline void physical_flux(const FaceState& s, double E, double* F) {
 }
 
 // Always inlined into the per-face loop of the flux kernel: GCC declined once that loop became
-// a template over the number of pencils, and the call cost ~5 % of a 1D run.
+// a template over the number of pencils, and the call costs time (docs/performance.md).
 template <RiemannSolver Solver>
 [[gnu::always_inline]] inline void riemann_flux(const FaceState& L, const FaceState& R, double* F) {
   const double SL = std::min(L.un - L.c, R.un - R.c);

@@ -10,7 +10,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "common/checkpoints.hpp"
@@ -157,25 +159,22 @@ class ProfileAverage final : public RunObserver {
   std::vector<int> cycles_;
 };
 
-/// 3D fields at the stored phases nearest to continuum.field_phases, in the last cycle.
+/// 3D fields at the stored phases of continuum.field_phases, in the last cycle.
 class FieldSnapshots final : public RunObserver {
  public:
-  FieldSnapshots(const TimeIntegrator& solver, const ShakerKinematics& shaker, std::vector<double> phases)
-      : solver_(solver), shaker_(shaker), field_phases_(std::move(phases)) {}
+  FieldSnapshots(const TimeIntegrator& solver, const ShakerKinematics& shaker,
+                 std::vector<std::int64_t> phases)
+      : solver_(solver), shaker_(shaker), phases_(std::move(phases)) {}
   void at_phase(const PhaseInstant& instant) override {
-    if (!instant.last_cycle()) return;
-    const auto K = static_cast<std::size_t>(instant.phases);
-    for (double phase : field_phases_)
-      if (static_cast<std::size_t>(std::lround(phase * static_cast<double>(K))) % K ==
-          static_cast<std::size_t>(instant.phase))
-        snapshots.push_back(snapshot(solver_, shaker_));
+    if (instant.last_cycle() && std::binary_search(phases_.begin(), phases_.end(), instant.phase))
+      snapshots.push_back(snapshot(solver_, shaker_));
   }
   std::vector<FieldSnapshot> snapshots;
 
  private:
   const TimeIntegrator& solver_;
   const ShakerKinematics& shaker_;
-  std::vector<double> field_phases_;
+  std::vector<std::int64_t> phases_;  ///< increasing
 };
 
 /// The solver as the run loop drives it.
@@ -204,9 +203,10 @@ void check_outputs(const ContinuumCase& c, const CheckpointSettings& checkpoints
   const std::filesystem::path output = c.parameters.run.output;
   std::vector<NamedPath> outputs{{"run.output", output}};
   if (!output.empty()) outputs.push_back({"run.output's last-good checkpoint", last_good_path(output)});
-  if (c.grid.dimension == 3 && !c.field_phases.empty() && !output.empty()) {
+  if (!c.field_phases.empty() && !output.empty()) {
     std::filesystem::path fields = output;
     outputs.push_back({"run.output's fields file", fields.replace_extension(".fields.h5")});
+    outputs.push_back({"run.output's fields sidecar", fields.replace_extension(".xdmf")});
   }
   checkpoints.check_paths(outputs, inputs);
 }
@@ -253,7 +253,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   };
   CheckpointObserver checkpointing(checkpoints, schedule, write, "shaker continuum");
   std::vector<RunObserver*> observers{&recorder, &profiles, &progress};
-  if (c.grid.dimension == 3) observers.push_back(&fields);
+  if (!c.field_phases.empty()) observers.push_back(&fields);
   observers.push_back(&checkpointing);
   DrivenIntegrator driven(solver);
   try {
@@ -277,7 +277,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   if (!fields.snapshots.empty()) {
     std::filesystem::path fields_path = output;
     fields_path.replace_extension(".fields.h5");
-    write_fields(fields_path, c.grid, fields.snapshots);
+    write_fields(fields_path, c.grid, fields.snapshots, record);
   }
   write_run_file(output, record);
   const Counters& counters = solver.counters();

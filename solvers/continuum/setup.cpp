@@ -2,9 +2,56 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "common/errors.hpp"
 
 namespace shaker::continuum {
+
+namespace {
+
+/// continuum.field_phases as stored phases k of K. A phase between stored phases, or one listed
+/// twice, once gave a snapshot at the nearest stored phase, twice over; in 1D the key was
+/// ignored. Each is refused instead, naming the allowed values.
+std::vector<std::int64_t> field_phase_indices(const config::Config& config, int dimension,
+                                              std::int64_t phases) {
+  constexpr const char* key = "continuum.field_phases";
+  const std::vector<double>& listed = config.real_list(key);
+  const std::string given = fmt::format("{} = {}", key, config.value_text(key));
+  if (listed.empty()) return {};
+  if (dimension != 3)
+    throw InputError(fmt::format("{}: full fields are written only by a 3D run, and "
+                                 "continuum.dimension = {}; allowed with it: [] (the default)",
+                                 given, dimension));
+  const auto K = static_cast<double>(phases);
+  std::string grid;
+  for (std::int64_t k = 0; k < phases; ++k) {
+    if (phases > 12 && k == 3) {
+      grid += ", ...";
+      k = phases - 1;
+    }
+    grid += fmt::format("{}{}", k == 0 ? "" : ", ", static_cast<double>(k) / K);
+  }
+  const std::string allowed = fmt::format(
+      "allowed: the stored phases k / {} (run.phases_per_cycle = {}), each at most once: {}",
+      phases, phases, grid);
+  std::vector<std::int64_t> indices;
+  for (const double phase : listed) {
+    const double k = std::round(phase * K);
+    if (std::abs(phase * K - k) > 1e-9 || k >= K)
+      throw InputError(fmt::format("{}: {} is not a stored phase; {}", given, phase, allowed));
+    const auto index = static_cast<std::int64_t>(k);
+    if (std::find(indices.begin(), indices.end(), index) != indices.end())
+      throw InputError(fmt::format("{}: the stored phase {} is listed twice; {}", given,
+                                   static_cast<double>(index) / K, allowed));
+    indices.push_back(index);
+  }
+  std::sort(indices.begin(), indices.end());
+  return indices;
+}
+
+}  // namespace
 
 ContinuumCase continuum_case(const config::Config& config) {
   ContinuumCase c;
@@ -48,7 +95,7 @@ ContinuumCase continuum_case(const config::Config& config) {
   l.temperature = config.real("continuum.initial_temperature");
   l.perturbation = config.real("continuum.perturbation");
   l.seed = c.parameters.run.seed;
-  c.field_phases = config.real_list("continuum.field_phases");
+  c.field_phases = field_phase_indices(config, c.grid.dimension, c.parameters.run.phases_per_cycle);
   // The layer must fit under the ceiling: checked now, before anything runs or is written.
   State probe;
   probe.resize(c.grid.size());

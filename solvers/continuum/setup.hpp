@@ -1,6 +1,10 @@
 #pragma once
 // The typed, validated continuum configuration of a case (continuum.* keys and the shared
 // case keys). Every inconsistency is an InputError naming the key and the allowed range.
+#include <cstdint>
+#include <string>
+#include <vector>
+
 #include "common/case_parameters.hpp"
 #include "common/config.hpp"
 #include "continuum/initial_state.hpp"
@@ -14,7 +18,9 @@ struct ContinuumCase {
   PhysicsSettings physics;
   IntegratorSettings integration;
   LayerSpecification layer;
-  std::vector<double> field_phases;
+  /// Stored phases k of run.phases_per_cycle = K (f t = k / K) whose 3D fields are written in
+  /// the last cycle: continuum.field_phases, checked, in increasing order.
+  std::vector<std::int64_t> field_phases;
 };
 
 ContinuumCase continuum_case(const config::Config& config);

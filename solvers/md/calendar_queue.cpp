@@ -24,7 +24,7 @@ void CalendarQueue::reset(std::size_t n) {
   cached_valid_ = false;
 }
 
-// (Inlined into update, the hot path: out of line it cost ~2 % at N = 4000.)
+// (Inlined into update, the hot path: out of line it is measurably slower, docs/performance.md.)
 [[gnu::always_inline]] inline void CalendarQueue::unlink(std::int32_t id) {
   const std::int32_t w = node_[id].where;
   if (w == absent) return;
@@ -242,7 +242,7 @@ int CalendarQueue::walk_ahead(std::int32_t reached[2]) {
     for (int k = 0; k < walk_link_count_; ++k) walk_links_[k] = walk_links_[k + 1];
     if (id >= 0) reach(id);
   }
-  // Eight buckets ahead (four was 2 % slower at N = 400000 and 40000).
+  // Eight buckets ahead (four is slower, docs/performance.md).
   const std::int32_t end = std::min(buckets, current_ + 9);
   for (; walk_bucket_ < end; ++walk_bucket_) {
     const std::int32_t id = head_[static_cast<std::size_t>(walk_bucket_)];

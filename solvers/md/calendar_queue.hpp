@@ -46,8 +46,8 @@ class CalendarQueue {
   /// reached[0..1] with the entries it reaches (their queue entries now being prefetched) and
   /// returns how many: the head of the next non-empty bucket (the heads are contiguous, no
   /// wait), and the successor of an entry reached by an earlier call (its node was prefetched
-  /// then: following two links in one call made the second wait for memory, ~8 % of the time
-  /// at N = 400000). A hint: the cursor never changes the order.
+  /// then: following two links in one call makes the second wait for memory; docs/performance.md).
+  /// A hint: the cursor never changes the order.
   int walk_ahead(std::int32_t reached[2]);
   /// Prefetches the queue's entry of id (a hint: nothing is read).
   void prefetch(std::int32_t id) const {

@@ -14,6 +14,7 @@
 #include "common/errors.hpp"
 #include "common/memory.hpp"
 #include "common/progress.hpp"
+#include "common/ranks.hpp"
 #include "common/run_file.hpp"
 #include "md/checkpoint.hpp"
 #include "md/initial_states.hpp"
@@ -104,6 +105,118 @@ void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometr
                "run.phases_per_cycle");
 }
 
+/// Replica r of the case (md.replicas): the periodic protocol takes seed run.seed + r, the
+/// single shock starts r cycles later from run.seed, as repeats of one single shock are pooled.
+config::Config replica_configuration(const config::Config& config, std::int64_t r) {
+  config::Config replica = config;
+  replica.set_value("md.replicas", std::int64_t{1});
+  if (config.text("run.protocol") == "single_shock")
+    replica.set_value("run.transient_cycles", config.integer("run.transient_cycles") + r);
+  else
+    replica.set_value("run.seed", config.integer("run.seed") + r);
+  return replica;
+}
+
+void check_replicas(const config::Config& config, const CheckpointSettings& checkpoints) {
+  const std::int64_t replicas = config.integer("md.replicas");
+  if (replicas == 1) return;
+  if (!checkpoints.restart_from.empty() || !checkpoints.file.empty())
+    throw InputError(fmt::format("md.replicas = {} with a checkpoint (run.restart_from = \"{}\", "
+                                 "run.checkpoint = \"{}\"): a checkpoint holds one replica; "
+                                 "allowed: md.replicas = 1 with run.restart_from or run.checkpoint",
+                                 replicas, checkpoints.restart_from.string(), checkpoints.file.string()));
+  const auto& spec = config::find_spec(config.text("run.protocol") == "single_shock"
+                                           ? "run.transient_cycles" : "run.seed");
+  const double last = static_cast<double>(config.integer(spec.key) + replicas - 1);
+  if (!spec.range.contains(last))
+    throw InputError(fmt::format("md.replicas = {}: replica {} would need {} = {}; allowed: {} "
+                                 "{}", replicas, replicas - 1, spec.key, last, spec.key,
+                                 spec.range.describe()));
+}
+
+/// What the root rank needs of a replica: its samples and the numbers of the summary. Sent
+/// between ranks as doubles (counts stay exact below 2^53).
+struct ReplicaSummary {
+  CycleSamples samples;
+  double time = 0.0, seconds = 0.0, collisions = 0.0, events = 0.0;
+  double pair = 0.0, plate = 0.0, ceiling = 0.0, guard_activations = 0.0, overlaps = 0.0;
+  EnergyBudget budget;
+  bool queue_consistent = false;
+
+  void pack(std::vector<double>& out) const {
+    out.insert(out.end(), {time, seconds, collisions, events, pair, plate, ceiling, guard_activations,
+                           overlaps, budget.plate_work, budget.collisional_loss, budget.energy_change,
+                           budget.relative_closure, queue_consistent ? 1.0 : 0.0,
+                           static_cast<double>(samples.phases()), static_cast<double>(samples.bins()),
+                           samples.bin_volume()});
+    for (std::size_t k = 0; k < samples.phases(); ++k) {
+      out.push_back(static_cast<double>(samples.samples(k)));
+      out.insert(out.end(), samples.cycles(k).begin(), samples.cycles(k).end());
+      for (const BinSums& b : samples.sums(k)) out.insert(out.end(), {b.count, b.vx, b.vy, b.vz, b.v2});
+    }
+  }
+  static ReplicaSummary unpack(const double*& at) {
+    ReplicaSummary r;
+    for (double* x : {&r.time, &r.seconds, &r.collisions, &r.events, &r.pair, &r.plate, &r.ceiling,
+                      &r.guard_activations, &r.overlaps, &r.budget.plate_work, &r.budget.collisional_loss,
+                      &r.budget.energy_change, &r.budget.relative_closure})
+      *x = *at++;
+    r.queue_consistent = *at++ != 0.0;
+    const auto phases = static_cast<std::size_t>(*at++), bins = static_cast<std::size_t>(*at++);
+    const double bin_volume = *at++;
+    std::vector<std::vector<double>> cycles(phases);
+    std::vector<std::vector<BinSums>> sums(phases);
+    for (std::size_t k = 0; k < phases; ++k) {
+      const auto n = static_cast<std::size_t>(*at++);
+      cycles[k].assign(at, at + n);
+      at += n;
+      sums[k].resize(n * bins);
+      for (BinSums& b : sums[k]) b = {at[0], at[1], at[2], at[3], at[4]}, at += 5;
+    }
+    r.samples = CycleSamples::from_arrays(bins, bin_volume, std::move(cycles), std::move(sums));
+    return r;
+  }
+};
+
+ReplicaSummary summary_of(const Simulation& simulation, const RunOutcome& outcome) {
+  ReplicaSummary r;
+  r.samples = outcome.samples;
+  r.time = simulation.time();
+  r.seconds = outcome.seconds;
+  r.collisions = static_cast<double>(outcome.collisions);
+  r.events = static_cast<double>(outcome.events);
+  const Tally& tally = simulation.tally();
+  r.pair = static_cast<double>(tally.pair);
+  r.plate = static_cast<double>(tally.plate);
+  r.ceiling = static_cast<double>(tally.ceiling);
+  r.guard_activations = static_cast<double>(tally.guard_activations);
+  r.overlaps = static_cast<double>(outcome.overlaps);
+  r.budget = outcome.budget;
+  r.queue_consistent = outcome.queue_consistent;
+  return r;
+}
+
+std::uint64_t count(double x) { return static_cast<std::uint64_t>(x); }
+
+/// The summary of all replicas: sums of the counts, the worst energy closure.
+ReplicaSummary combined(const std::vector<ReplicaSummary>& replicas) {
+  ReplicaSummary all;
+  all.time = replicas.front().time;
+  all.queue_consistent = true;
+  for (const ReplicaSummary& r : replicas) {
+    for (auto [into, x] : {std::pair{&all.seconds, r.seconds}, {&all.collisions, r.collisions},
+                           {&all.events, r.events}, {&all.pair, r.pair}, {&all.plate, r.plate},
+                           {&all.ceiling, r.ceiling}, {&all.guard_activations, r.guard_activations},
+                           {&all.overlaps, r.overlaps}, {&all.budget.plate_work, r.budget.plate_work},
+                           {&all.budget.collisional_loss, r.budget.collisional_loss},
+                           {&all.budget.energy_change, r.budget.energy_change}})
+      *into += x;
+    all.budget.relative_closure = std::max(all.budget.relative_closure, r.budget.relative_closure);
+    all.queue_consistent = all.queue_consistent && r.queue_consistent;
+  }
+  return all;
+}
+
 }  // namespace
 
 int run(const config::Config& config, const std::vector<NamedPath>& inputs,
@@ -114,29 +227,66 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   const Geometry geometry = geometry_of(parameters, settings);
   const CheckpointSettings checkpoints = CheckpointSettings::from(config);
   checkpoints.check_paths({{"run.output", parameters.run.output}}, inputs);
+  check_replicas(config, checkpoints);
   check_md_memory(parameters, settings, geometry);
   CollisionRules rules;
   rules.restitution = parameters.restitution;
   rules.tc_guard = settings.tc_guard;
   rules.tc = settings.tc;
-  std::optional<SchedulePosition> resume;
-  Simulation simulation =
-      make_simulation(config, parameters, settings, geometry, rules, checkpoints.restart_from, resume);
-  const PhaseSchedule schedule = schedule_of(parameters, simulation, resume, checkpoints.restart_from);
 
-  ProgressReport progress("shaker md", "collisions/s",
-                          [&] { return static_cast<double>(simulation.tally().collisions()); },
-                          progress_settings);
-  const std::string configuration = config.to_toml();
-  CheckpointObserver checkpointing(
-      checkpoints, schedule,
-      [&](const std::filesystem::path& path, const SchedulePosition& position) {
-        write_checkpoint(path, simulation.save(), geometry, position, configuration);
-      },
-      "shaker md");
-  const RunOutcome outcome = run_protocol(simulation, schedule, parameters, settings, {&progress, &checkpointing});
-
+  // Replica r runs on rank r mod P, and the root pools them in replica order, so the file does
+  // not depend on P.
+  const Ranks& ranks = Ranks::world();
+  const std::int64_t replicas = config.integer("md.replicas");
+  ProgressSettings progress_of_rank = progress_settings;
+  progress_of_rank.quiet = progress_settings.quiet || !ranks.root();
+  std::vector<double> mine;
   RunRecord record;
+  const std::string configuration = config.to_toml();
+  for (std::int64_t r = ranks.rank(); r < replicas; r += ranks.size()) {
+    const config::Config replica = replica_configuration(config, r);
+    const CaseParameters replica_parameters = CaseParameters::from(replica);
+    std::optional<SchedulePosition> resume;
+    Simulation simulation =
+        make_simulation(replica, replica_parameters, settings, geometry, rules, checkpoints.restart_from, resume);
+    const PhaseSchedule schedule = schedule_of(replica_parameters, simulation, resume, checkpoints.restart_from);
+    ProgressReport progress(replicas == 1 ? "shaker md" : fmt::format("shaker md replica {}", r),
+                            "collisions/s",
+                            [&] { return static_cast<double>(simulation.tally().collisions()); },
+                            progress_of_rank);
+    std::vector<RunObserver*> also{&progress};
+    // A checkpoint holds one replica (check_replicas): a signal stops an ensemble at once.
+    std::optional<CheckpointObserver> checkpointing;
+    if (replicas == 1) {
+      checkpointing.emplace(
+          checkpoints, schedule,
+          [&](const std::filesystem::path& path, const SchedulePosition& position) {
+            write_checkpoint(path, simulation.save(), geometry, position, configuration);
+          },
+          "shaker md");
+      also.push_back(&*checkpointing);
+    }
+    const RunOutcome outcome = run_protocol(simulation, schedule, replica_parameters, settings, also);
+    summary_of(simulation, outcome).pack(mine);
+    if (r == 0) {
+      record.profiles = outcome.profiles;
+      record.series = outcome.series;
+    }
+  }
+  const std::vector<std::vector<double>> gathered = ranks.gather(mine);
+  if (!ranks.root()) return 0;
+
+  std::vector<ReplicaSummary> summaries(static_cast<std::size_t>(replicas));
+  for (std::size_t rank = 0; rank < gathered.size(); ++rank) {
+    const double* at = gathered[rank].data();
+    for (std::size_t r = rank; r < summaries.size(); r += gathered.size())
+      summaries[r] = ReplicaSummary::unpack(at);
+  }
+  std::vector<RunRecord> pooled(summaries.size(), record);
+  for (std::size_t r = 0; r < summaries.size(); ++r) pooled[r].samples = summaries[r].samples;
+  record = pool_runs(pooled);
+  const ReplicaSummary all = combined(summaries);
+
   record.solver = "md";
   const bool switched = parameters.run.kind == RunProtocol::Kind::single_shock;
   const Restitution& final_restitution = switched ? parameters.run.after_switch : parameters.restitution;
@@ -144,29 +294,28 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   if (switched) record.model_variant += fmt::format(" (switched from {} at f t = {})",
                                                     variant_name(parameters.restitution, settings),
                                                     parameters.run.switch_phase);
+  if (replicas > 1) record.model_variant += fmt::format(" (pooled over {} replicas)", replicas);
   record.configuration = configuration;
   record.e = final_restitution.e;
-  record.profiles = outcome.profiles;
-  record.samples = outcome.samples;
-  record.series = outcome.series;
   write_run_file(parameters.run.output, record);
 
-  const Tally& tally = simulation.tally();
-  fmt::print("shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", simulation.size(),
+  fmt::print("shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", parameters.particles,
              parameters.run.transient_cycles + (switched ? 1 : parameters.run.sampled_cycles),
-             simulation.time(), duration_text(wall.seconds()));
+             all.time, duration_text(wall.seconds()));
+  if (replicas > 1)
+    fmt::print("  {} replicas on {} rank(s); counts below are summed over replicas, the closure "
+               "is the worst\n", replicas, ranks.size());
   fmt::print("  collisions: {} (pair {}, plate {}, ceiling {}), {:.4g} collisions/s, {:.4g} events/s\n",
-             outcome.collisions, tally.pair, tally.plate, tally.ceiling,
-             static_cast<double>(outcome.collisions) / outcome.seconds,
-             static_cast<double>(outcome.events) / outcome.seconds);
+             count(all.collisions), count(all.pair), count(all.plate), count(all.ceiling),
+             all.collisions / all.seconds,
+             all.events / all.seconds);
   fmt::print("  energy budget: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
-             "relative closure {:.3g}\n", outcome.budget.plate_work, outcome.budget.collisional_loss,
-             outcome.budget.energy_change, outcome.budget.relative_closure);
+             "relative closure {:.3g}\n", all.budget.plate_work, all.budget.collisional_loss,
+             all.budget.energy_change, all.budget.relative_closure);
   fmt::print("  collapse guard activations: {}; overlaps at end: {}; event queue consistent: {}\n",
-             tally.guard_activations, outcome.overlaps, outcome.queue_consistent ? "yes" : "NO");
+             count(all.guard_activations), count(all.overlaps), all.queue_consistent ? "yes" : "NO");
   fmt::print("  output: {}\n", parameters.run.output);
-  const bool ok = outcome.overlaps == 0 && outcome.queue_consistent &&
-                  outcome.budget.relative_closure <= 1e-9;
+  const bool ok = all.overlaps == 0 && all.queue_consistent && all.budget.relative_closure <= 1e-9;
   if (!ok) fmt::print(stderr, "shaker md: end-of-run invariant check FAILED (see summary)\n");
   return ok ? 0 : 1;
 }

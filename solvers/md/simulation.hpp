@@ -65,9 +65,8 @@ class CollapseError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Which future-event list to use: the calendar queue (the default: measured 5-10% faster
-/// than the heap for the gas at N = 4000 and the base case, and more at N = 400000, in the
-/// same minute) or the indexed binary heap (the simple reference). Both pop events in the
+/// Which future-event list to use: the calendar queue (the default: faster than the heap at
+/// every N measured, docs/performance.md) or the indexed binary heap (the simple reference). Both pop events in the
 /// same order, so a run is identical with either.
 enum class QueueKind { calendar, heap };
 
@@ -163,8 +162,8 @@ class Simulation {
   /// reading only what an earlier one brought in. Stage 1, for entries the calendar queue's
   /// cursor meets a few buckets ahead, and for event k + 3: their event, state and cell.
   /// Stage 2, for event k + 2 (the guesses come from the queue): the heads of its 27 cells,
-  /// and the partner's state, event and cell (stage 2 for k + 3 as well read events that had
-  /// not arrived yet: 2 % slower at N = 400000). Stage 3, for event k + 1: the
+  /// and the partner's state, event and cell (stage 2 for k + 3 as well would read events that
+  /// have not arrived yet: slower, docs/performance.md). Stage 3, for event k + 1: the
   /// first member of each of its cells, and the partner's cell heads; event k itself prefetches
   /// its partner's first members before the collision. Hints only: the same results either way.
   void prefetch_stage1(std::int32_t a) const;
@@ -175,7 +174,7 @@ class Simulation {
   void prefetch_members(int c, int axis = -1, int step = 0) const;
   static constexpr std::size_t lookahead_min_particles = 30000;
   /// Stage 3 (the members of the cells) only pays once the cell lists no longer fit in the
-  /// cache: at N = 40000 it cost 3-5 %, at 400000 it is most of the gain.
+  /// cache (docs/performance.md).
   static constexpr std::size_t lookahead_members_min_particles = 100000;
   bool lookahead_ = false, lookahead_members_ = false;
 

@@ -79,7 +79,9 @@ def fields_at(config, solver, phase, z_lab, plate_z, plate_v, rng):
 def write_cycle_samples(h, config, out, rng):
     """Per-cycle sums (docs/output-schema.md, cycle_samples) that pool to the profiles within
     1 % noise per cycle: count n V, momentum count u_z, energy count (3 T + u_z^2)."""
-    cycles = 1 if config["run"]["protocol"] == "single_shock" else config["run"]["sampled_cycles"]
+    # One sample per sampled cycle of each replica (md.replicas, docs/parallel.md).
+    per_replica = 1 if config["run"]["protocol"] == "single_shock" else config["run"]["sampled_cycles"]
+    cycles = per_replica * config["md"]["replicas"]
     volume = config["md"]["box_width"] ** 2 * config["md"]["bin_height"]
     n, uz, T = (np.array(out[k], dtype=float) for k in ("n", "uz", "T"))
     count = n[:, None, :] * volume * (1 + 0.01 * rng.standard_normal((n.shape[0], cycles,

@@ -4,7 +4,7 @@ without the solvers.
 
 synthetic_runs.py writes cartoon run files (docs/output-schema.md) under the names the runner
 reuses; run_validation.py --reuse-only then analyses them with the real `shaker analyze` and
-`shaker compare`, pools the single-shock runs, evaluates every claim and writes the report.
+`shaker compare`, analyses the single-shock ensembles, evaluates every claim and writes the report.
 Checks: every claim id C1..C20 in the claims table, pass, FAIL and "not measured" marks all
 present, the seven figure PNGs exist and are non-empty, no run was re-simulated, values the
 cartoon fixes exactly (per cycle above z = 80: crossings 0.3 and 5, distinct particles 0.8 x those;
@@ -118,10 +118,10 @@ def main():
     md_c13 = claims["C13"]["per_solver"]["md"]["status"]
     expect(md_c13 == "not measured", f"C13 without the e = 0.80 runs: {md_c13}")
     expect(claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None,
-           "C14 has a jackknife error from the pooled runs")
+           "C14 has a jackknife error from the ensemble's replicas")
 
     # The report's numbers are those `shaker analyze` prints: run it again, by hand, on the
-    # pooled single-shock runs of e = 0.9 and on the base case, and compare.
+    # single-shock ensemble of e = 0.9 and on the base case, and compare.
     for claim, solver, case, name in (("C4", "md", "base", "exit_phase"),
                                       ("C1", "md", "base", "formation_phase"),
                                       ("C14", "md", "single_shock_e0p90", None)):

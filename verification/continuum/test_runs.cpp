@@ -4,8 +4,12 @@
 #include <fstream>
 
 #include "analysis/analysis.hpp"
+#include "common/errors.hpp"
+#include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
+#include "common/version.hpp"
 #include "continuum/checkpoint.hpp"
+#include "continuum/output.hpp"
 #include "continuum/run_continuum.hpp"
 #include "continuum/setup.hpp"
 #include "support.hpp"
@@ -214,7 +218,9 @@ namespace shaker::continuum::testing {
 namespace {
 
 // A small 3D run through the program: profiles at every phase, full fields at the chosen
-// phases in HDF5 with an XDMF sidecar naming them.
+// phases (listed out of order) in time order, in the lab frame, with the run file's root
+// attributes and units, and an XDMF sidecar naming them. (Every value through an XDMF reader:
+// check_fields_xdmf.py.)
 TEST(Output3D, ProfilesFieldsAndXdmf) {
   const auto dir = test_directory();
   config::Config c;
@@ -227,7 +233,7 @@ TEST(Output3D, ProfilesFieldsAndXdmf) {
   c.set("run.transient_cycles=0");
   c.set("run.sampled_cycles=1");
   c.set("run.phases_per_cycle=4");
-  c.set("continuum.field_phases=[0.0, 0.5]");
+  c.set("continuum.field_phases=[0.5, 0.25]");
   ASSERT_EQ(run(c), 0);
   const RunRecord r = read_run_file(dir / "run3d.h5");
   EXPECT_EQ(r.profiles.size(), 4u);
@@ -235,6 +241,54 @@ TEST(Output3D, ProfilesFieldsAndXdmf) {
   EXPECT_NE(r.configuration.find("dimension = 3"), std::string::npos);
   ASSERT_TRUE(std::filesystem::exists(dir / "run3d.fields.h5"));
   ASSERT_TRUE(std::filesystem::exists(dir / "run3d.fields.xdmf"));
+  {
+    const h5::Handle file = h5::open_file(dir / "run3d.fields.h5");
+    EXPECT_EQ(h5::read_integer_attribute(file.id(), "schema_version"), output_schema_version);
+    EXPECT_EQ(h5::read_string_attribute(file.id(), "configuration"), r.configuration);
+    EXPECT_EQ(h5::read_string_attribute(file.id(), "solver"), "continuum");
+    EXPECT_EQ(h5::read_string_attribute(file.id(), "model_variant"), r.model_variant);
+    EXPECT_EQ(h5::read_string_attribute(file.id(), "git_commit"), r.git_commit);
+    EXPECT_EQ(h5::read_string_attribute(file.id(), "kind"), fields_file_kind);
+    EXPECT_EQ(h5::members(file.id()),
+              (std::vector<std::string>{"hexahedra", "snapshot_000", "snapshot_001"}));
+    // Snapshot s is the profile row of its phase: the same instant and plate.
+    for (const auto& [group_name, k] : {std::pair{"snapshot_000", 1}, std::pair{"snapshot_001", 2}}) {
+      SCOPED_TRACE(group_name);
+      const h5::Handle group = h5::open_group(file.id(), group_name);
+      EXPECT_EQ(h5::read_double_attribute(group.id(), "phase"), 0.25 * k);
+      EXPECT_EQ(h5::read_double_attribute(group.id(), "time"), r.profiles[k].time);
+      const double plate_z = h5::read_double_attribute(group.id(), "plate_z");
+      EXPECT_EQ(plate_z, r.profiles[k].plate_z);
+      EXPECT_EQ(h5::read_double_attribute(group.id(), "plate_v"), r.profiles[k].plate_v);
+      EXPECT_NE(plate_z, 0.0);
+      const auto points = h5::read_doubles(group.id(), "points");
+      ASSERT_EQ(points.size(), 3u * 5 * 5 * 21);
+      EXPECT_EQ(points[2], plate_z);                          // corner (0, 0, 0)
+      EXPECT_EQ(points.back(), 20 * 0.5 + plate_z);           // corner (4, 4, 20)
+      EXPECT_EQ(points[points.size() - 3], 4 * 0.5);
+      // One sampled cycle: the profile is the horizontal mean of these fields.
+      const auto n = h5::read_doubles(group.id(), "n");
+      ASSERT_EQ(n.size(), 4u * 4 * 20);
+      for (int cell = 0; cell < 20; cell += 7) {
+        double sum = 0;
+        for (int column = 0; column < 16; ++column) sum += n[static_cast<std::size_t>(cell * 16 + column)];
+        EXPECT_NEAR(sum / 16, r.profiles[k].n[static_cast<std::size_t>(cell)], 1e-12 * sum);
+      }
+      for (const auto& [name, units] : {std::pair{"n", "1/sigma^3"}, std::pair{"uz", "sqrt(g sigma)"},
+                                        std::pair{"T", "g sigma"}, std::pair{"points", "sigma"}}) {
+        const h5::Handle set(H5Dopen2(group.id(), name, H5P_DEFAULT));
+        EXPECT_EQ(h5::read_string_attribute(set.id(), "units"), units) << name;
+      }
+    }
+  }
+  // The fields file is not a run file, and says so.
+  try {
+    read_run_file(dir / "run3d.fields.h5");
+    ADD_FAILURE() << "the fields file was read as a run file";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("'shaker continuum fields' file"), std::string::npos)
+        << error.what();
+  }
   std::ifstream xdmf(dir / "run3d.fields.xdmf");
   const std::string text((std::istreambuf_iterator<char>(xdmf)), std::istreambuf_iterator<char>());
   std::size_t grids = 0;
@@ -243,6 +297,7 @@ TEST(Output3D, ProfilesFieldsAndXdmf) {
     ++grids;
   EXPECT_EQ(grids, 2u);
   EXPECT_NE(text.find("run3d.fields.h5:/snapshot_001/T"), std::string::npos);
+  if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -1,0 +1,178 @@
+#!/usr/bin/env python3
+"""MD ensembles (md.replicas, docs/parallel.md): checks of the pooled run file.
+
+  check_md_ensemble.py SHAKER pooling
+      md.replicas = K in one process equals K separate runs (seeds run.seed + r; for the
+      single shock, run.transient_cycles + r) pooled by `shaker analyze --pooled`, bit for bit.
+  check_md_ensemble.py SHAKER ranks P [P ...] [--mpirun CMD]
+      `mpirun -np P shaker md` writes the same file as the plain run for every P (more ranks
+      than replicas included), every dataset and attribute but the creation date.
+  check_md_ensemble.py SHAKER continuum-refused [--mpirun CMD]
+      `mpirun -np 2 shaker continuum` exits 2 with a message, writing nothing.
+
+Exit status 0 when every check holds; each failure is printed. Runs in a temporary directory,
+removed on success.
+"""
+import argparse
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+
+CASE = """
+[layer]
+particles = 40
+[md]
+box_width = 4.0
+ceiling = 60.0
+[run]
+transient_cycles = 1
+sampled_cycles = 2
+phases_per_cycle = 5
+seed = 7
+"""
+REPLICAS = 3
+# What differs between an ensemble's file and its pooled separate runs by construction: the
+# creation date, the configuration (md.replicas, the seed) and the variant's wording.
+IGNORED_ATTRIBUTES = {"created", "configuration", "model_variant"}
+
+
+def mpirun_prefix(command, ranks):
+    """The launcher's words for P ranks; as root OpenMPI needs its explicit consent."""
+    words = shlex.split(command) + ["-np", str(ranks), "--oversubscribe"]
+    if os.geteuid() == 0:
+        words.append("--allow-run-as-root")
+    return words
+
+
+def run(words, cwd, expect=0):
+    result = subprocess.run(words, cwd=cwd, capture_output=True, text=True)
+    if result.returncode != expect:
+        raise SystemExit(f"{' '.join(words)}: exit {result.returncode}, expected {expect}\n"
+                         f"{result.stdout[-2000:]}\n{result.stderr[-2000:]}")
+    return result
+
+
+def contents(path, groups=None):
+    """Every dataset (as arrays) and attribute of a file, by path; `groups` limits the
+    datasets to those under the named top-level groups."""
+    found = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, item):
+            if groups and name.split("/")[0] not in groups:
+                return
+            if isinstance(item, h5py.Dataset):
+                found[name] = np.asarray(item[()])
+            for key, value in item.attrs.items():
+                if key not in IGNORED_ATTRIBUTES:
+                    found[f"{name}@{key}"] = np.asarray(value)
+        f.visititems(visit)
+        if not groups:
+            for key, value in f.attrs.items():
+                if key not in IGNORED_ATTRIBUTES:
+                    found[f"@{key}"] = np.asarray(value)
+    return found
+
+
+def differences(a, b, label):
+    """The names whose values differ bit for bit (NaN equal to NaN), or exist in only one."""
+    out = [f"{label}: {n} only in one file" for n in sorted(set(a) ^ set(b))]
+    for name in sorted(set(a) & set(b)):
+        x, y = a[name], b[name]
+        same = x.shape == y.shape and (x.tobytes() == y.tobytes() or
+                                       (x.dtype.kind == "f" and np.array_equal(x, y, equal_nan=True)
+                                        and np.all(np.signbit(x) == np.signbit(y))))
+        if not same:
+            out.append(f"{label}: {name} differs")
+    return out
+
+
+def check_pooling(shaker, work):
+    failures = []
+    for protocol, varied in (("periodic", "run.seed"), ("single_shock", "run.transient_cycles")):
+        protocol_set = ["--set", f"run.protocol={protocol}"]
+        run([shaker, "md", "case.toml", *protocol_set, "--set", f"md.replicas={REPLICAS}",
+             "--set", "run.output=ensemble.h5", "--quiet"], work)
+        first = 7 if varied == "run.seed" else 1
+        singles = []
+        for r in range(REPLICAS):
+            singles.append(f"single{r}.h5")
+            run([shaker, "md", "case.toml", *protocol_set, "--set", f"{varied}={first + r}",
+                 "--set", f"run.output={singles[-1]}", "--quiet"], work)
+        run([shaker, "analyze", *singles, "--pooled", "pooled.h5", "--quiet", "--json",
+             "pooled.json"], work)
+        pooled = contents(os.path.join(work, "pooled.h5"), {"profiles", "cycle_samples"})
+        ensemble = contents(os.path.join(work, "ensemble.h5"), {"profiles", "cycle_samples"})
+        failures += differences(ensemble, pooled, f"{protocol}: ensemble vs pooled runs")
+        samples = ensemble.get("cycle_samples/cycles")
+        print(f"{protocol}: {len(pooled)} datasets and attributes compared; "
+              f"{'no' if not failures else len(failures)} differences")
+        if samples is None:
+            failures.append(f"{protocol}: the ensemble file has no cycle_samples/cycles")
+    return failures
+
+
+def check_ranks(shaker, work, launcher, counts):
+    failures = []
+    run([shaker, "md", "case.toml", "--set", f"md.replicas={REPLICAS}", "--set",
+         "run.output=plain.h5", "--quiet"], work)
+    plain = contents(os.path.join(work, "plain.h5"))
+    for p in counts:
+        out = f"ranks{p}.h5"
+        result = run(mpirun_prefix(launcher, p) + [shaker, "md", "case.toml", "--set",
+                                                   f"md.replicas={REPLICAS}", "--set",
+                                                   f"run.output={out}", "--quiet"], work)
+        found = differences(contents(os.path.join(work, out)), plain, f"{p} ranks vs plain")
+        summaries = result.stdout.count("shaker md:")
+        if summaries != 1:
+            found.append(f"{p} ranks: {summaries} summaries printed, expected 1 (the root's)")
+        print(f"{p} rank(s): {len(plain)} datasets and attributes compared; "
+              f"{len(found)} differences")
+        failures += found
+    return failures
+
+
+def check_continuum_refused(shaker, work, launcher):
+    result = run(mpirun_prefix(launcher, 2) + [shaker, "continuum", "case.toml", "--set",
+                                               "run.output=c.h5", "--quiet"], work, expect=2)
+    failures = []
+    if "one rank" not in result.stderr:
+        failures.append(f"continuum on 2 ranks: message lacks 'one rank': {result.stderr[-500:]}")
+    if os.path.exists(os.path.join(work, "c.h5")):
+        failures.append("continuum on 2 ranks: c.h5 was written")
+    print(f"continuum on 2 ranks: exit 2, {len(failures)} problems")
+    return failures
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("shaker")
+    parser.add_argument("check", choices=["pooling", "ranks", "continuum-refused"])
+    parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
+    parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
+    args = parser.parse_args()
+    work = tempfile.mkdtemp(prefix=f"md-ensemble-{args.check}-")
+    with open(os.path.join(work, "case.toml"), "w") as f:
+        f.write(CASE)
+    if args.check == "pooling":
+        failures = check_pooling(args.shaker, work)
+    elif args.check == "ranks":
+        failures = check_ranks(args.shaker, work, args.mpirun, args.ranks)
+    else:
+        failures = check_continuum_refused(args.shaker, work, args.mpirun)
+    for failure in failures:
+        print("FAIL:", failure)
+    if failures:
+        print(f"kept {work}")
+        return 1
+    shutil.rmtree(work)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
