@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -23,25 +24,57 @@ struct FieldName {
   const char* name;
   FieldOf field;
   bool optional;
+  const char* units;  ///< docs/units.md notation, stored as the dataset's attribute `units`
 };
 // Per-phase fields stored as [phases x bins] matrices.
 constexpr FieldName profile_fields[] = {
-    {"z", &Profile::z, false},          {"n", &Profile::n, false},
-    {"nu", &Profile::nu, false},        {"uz", &Profile::uz, false},
-    {"T", &Profile::T, false},          {"samples", &Profile::samples, true},
-    {"n_se", &Profile::n_se, true},     {"uz_se", &Profile::uz_se, true},
-    {"T_se", &Profile::T_se, true},
+    {"z", &Profile::z, false, "sigma"},
+    {"n", &Profile::n, false, "1/sigma^3"},
+    {"nu", &Profile::nu, false, "1"},
+    {"uz", &Profile::uz, false, "sqrt(g sigma)"},
+    {"T", &Profile::T, false, "g sigma"},
+    {"samples", &Profile::samples, true, "1"},
+    {"n_se", &Profile::n_se, true, "1/sigma^3"},
+    {"uz_se", &Profile::uz_se, true, "sqrt(g sigma)"},
+    {"T_se", &Profile::T_se, true, "g sigma"},
 };
 using ScalarOf = double Profile::*;
 struct ScalarName {
   const char* name;
   ScalarOf field;
+  const char* units;
 };
-constexpr ScalarName profile_scalars[] = {{"time", &Profile::time},
-                                          {"phase", &Profile::phase},
-                                          {"plate_z", &Profile::plate_z},
-                                          {"plate_v", &Profile::plate_v},
-                                          {"bin_height", &Profile::bin_height}};
+constexpr ScalarName profile_scalars[] = {{"time", &Profile::time, "sqrt(sigma/g)"},
+                                          {"phase", &Profile::phase, "1"},
+                                          {"plate_z", &Profile::plate_z, "sigma"},
+                                          {"plate_v", &Profile::plate_v, "sqrt(g sigma)"},
+                                          {"bin_height", &Profile::bin_height, "sigma"}};
+
+/// The units of every time-series column either solver writes (docs/output-schema.md); the
+/// per-height counters crossings_z<h> and particles_z<h> are counts.
+std::string series_units(const std::string& column) {
+  static const std::map<std::string, std::string> units{
+      {"t", "sqrt(sigma/g)"}, {"phase", "1"}, {"plate_z", "sigma"}, {"com_z", "sigma"},
+      // MD
+      {"kinetic", "m g sigma"}, {"potential", "m g sigma"}, {"plate_work", "m g sigma"},
+      {"collisional_loss", "m g sigma"}, {"energy_closure", "1"}, {"pair_collisions", "1"},
+      {"plate_collisions", "1"}, {"ceiling_collisions", "1"}, {"cell_crossings", "1"},
+      {"guard_activations", "1"}, {"overlaps", "1"}, {"near_plate", "1"}, {"collisions", "1"},
+      {"queue_consistent", "1"},
+      // continuum, per unit plate area
+      {"total_mass", "m / sigma^2"}, {"kinetic_energy", "m g / sigma"},
+      {"thermal_energy", "m g / sigma"}, {"potential_energy", "m g / sigma"},
+      {"collisional_loss_rate", "m g^(3/2) / sigma^(3/2)"},
+      {"com_z_change_from_previous_cycle", "sigma"}, {"temperature_floor_uses", "1"},
+      {"steps", "1"}, {"frame_energy", "m g / sigma"}, {"accumulated_body_work", "m g / sigma"},
+      {"accumulated_collisional_loss", "m g / sigma"}, {"accumulated_floor_energy", "m g / sigma"},
+      {"energy_budget_residual", "m g / sigma"}, {"periodicity_last_two_cycles", "1"},
+      {"restitution", "1"}};
+  if (const auto it = units.find(column); it != units.end()) return it->second;
+  if (column.rfind("crossings_z", 0) == 0 || column.rfind("particles_z", 0) == 0) return "1";
+  throw std::logic_error(fmt::format("time-series column '{}' has no units: declare them in "
+                                     "series_units (run_file.cpp) and docs/output-schema.md", column));
+}
 
 std::string utc_now() {
   return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::now()));
@@ -53,12 +86,12 @@ void write_profiles(hid_t file, const std::vector<Profile>& profiles) {
   const std::size_t bins = phases ? profiles.front().size() : 0;
   for (const auto& p : profiles)
     if (p.size() != bins) throw std::logic_error("profiles differ in their number of bins");
-  for (const auto& [name, field] : profile_scalars) {
+  for (const auto& [name, field, units] : profile_scalars) {
     std::vector<double> values;
     for (const auto& p : profiles) values.push_back(p.*field);
-    h5::write(group.id(), name, values);
+    h5::write(group.id(), name, values, {phases}, units);
   }
-  for (const auto& [name, field, optional] : profile_fields) {
+  for (const auto& [name, field, optional, units] : profile_fields) {
     const bool present = phases && !(profiles.front().*field).empty();
     if (!present && optional) continue;
     std::vector<double> matrix;
@@ -69,7 +102,7 @@ void write_profiles(hid_t file, const std::vector<Profile>& profiles) {
         throw std::logic_error(fmt::format("profile field '{}' has the wrong length", name));
       matrix.insert(matrix.end(), column.begin(), column.end());
     }
-    h5::write(group.id(), name, matrix, phases, bins);
+    h5::write(group.id(), name, matrix, {phases, bins}, units);
   }
 }
 
@@ -77,7 +110,7 @@ std::vector<Profile> read_profiles(hid_t file) {
   h5::Handle group = h5::open_group(file, "profiles");
   const auto phase = h5::read_doubles(group.id(), "phase");
   std::vector<Profile> profiles(phase.size());
-  for (const auto& [name, field] : profile_scalars) {
+  for (const auto& [name, field, units] : profile_scalars) {
     const auto values = h5::read_doubles(group.id(), name);
     if (values.size() != profiles.size())
       throw InputError(fmt::format("profiles/{} has {} entries, expected {}", name, values.size(),
@@ -85,7 +118,7 @@ std::vector<Profile> read_profiles(hid_t file) {
     for (std::size_t k = 0; k < profiles.size(); ++k) profiles[k].*field = values[k];
   }
   std::optional<std::size_t> bins;  // of the first field (z); every other field must agree
-  for (const auto& [name, field, optional] : profile_fields) {
+  for (const auto& [name, field, optional, units] : profile_fields) {
     if (optional && !h5::exists(group.id(), name)) continue;
     const auto dims = h5::shape(group.id(), name);
     if (dims.size() != 2 || dims[0] != profiles.size())
@@ -110,9 +143,16 @@ std::vector<Profile> read_profiles(hid_t file) {
 
 // The sums of each sample, one [phases * samples x bins] matrix per sum; "cycles" gives the
 // cycles pooled into each sample, [phases x samples].
-constexpr std::pair<const char*, double BinSums::*> sample_sums[] = {
-    {"count", &BinSums::count}, {"vx", &BinSums::vx}, {"vy", &BinSums::vy},
-    {"vz", &BinSums::vz},       {"v2", &BinSums::v2}};
+struct SampleSum {
+  const char* name;
+  double BinSums::*member;
+  const char* units;
+};
+constexpr SampleSum sample_sums[] = {{"count", &BinSums::count, "1"},
+                                     {"vx", &BinSums::vx, "sqrt(g sigma)"},
+                                     {"vy", &BinSums::vy, "sqrt(g sigma)"},
+                                     {"vz", &BinSums::vz, "sqrt(g sigma)"},
+                                     {"v2", &BinSums::v2, "g sigma"}};
 
 void write_samples(hid_t file, const CycleSamples& samples) {
   if (samples.empty()) return;
@@ -124,13 +164,13 @@ void write_samples(hid_t file, const CycleSamples& samples) {
     if (samples.samples(k) != m) throw std::logic_error("phases hold different sample counts");
     cycles.insert(cycles.end(), samples.cycles(k).begin(), samples.cycles(k).end());
   }
-  h5::write(group.id(), "cycles", cycles, phases, m);
-  for (const auto& [name, member] : sample_sums) {
+  h5::write(group.id(), "cycles", cycles, {phases, m}, "1");
+  for (const auto& [name, member, units] : sample_sums) {
     std::vector<double> matrix;
     matrix.reserve(phases * m * bins);
     for (std::size_t k = 0; k < phases; ++k)
       for (const BinSums& b : samples.sums(k)) matrix.push_back(b.*member);
-    h5::write(group.id(), name, matrix, phases * m, bins);
+    h5::write(group.id(), name, matrix, {phases * m, bins}, units);
   }
 }
 
@@ -146,7 +186,7 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
   // Every shape is checked before the sums are allocated, so that the data in the file, not
   // its attributes, bounds the allocation (4 phases x 30,000 bins of profiles and a 4 x 30,000
   // cycles matrix asked for 144 GB: std::bad_alloc instead of InputError).
-  for (const auto& [name, member] : sample_sums) {
+  for (const auto& [name, member, units] : sample_sums) {
     const auto dims = h5::shape(group.id(), name);
     if (dims.size() != 2 || dims[0] != phases * m || dims[1] != bins)
       throw InputError(fmt::format("cycle_samples/{} is not a [{} x {}] matrix", name,
@@ -162,7 +202,7 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
       if (!(c >= 1.0 && c == std::floor(c)))
         throw InputError(fmt::format("cycle_samples/cycles holds {}, allowed: whole numbers >= 1", c));
   }
-  for (const auto& [name, member] : sample_sums) {
+  for (const auto& [name, member, units] : sample_sums) {
     const auto values = h5::read_doubles(group.id(), name);
     for (std::size_t k = 0; k < phases; ++k)
       for (std::size_t i = 0; i < m * bins; ++i) sums[k][i].*member = values[k * m * bins + i];
@@ -202,7 +242,8 @@ void write_run_file(const std::filesystem::path& path, const RunRecord& record) 
     h5::Handle series = h5::create_group(file, "timeseries");
     h5::write_attribute(series.id(), "columns", fmt::format("{}", fmt::join(record.series.names, ",")));
     for (std::size_t i = 0; i < record.series.names.size(); ++i)
-      h5::write(series.id(), record.series.names[i], record.series.columns[i]);
+      h5::write(series.id(), record.series.names[i], record.series.columns[i],
+                {record.series.columns[i].size()}, series_units(record.series.names[i]));
   });
 }
 

@@ -90,6 +90,19 @@ def main():
             for name, values in expected.items():
                 check(np.array_equal(series[name][()], np.array(values)),
                       f"timeseries/{name} = {series[name][()]}")
+
+            # Every dataset states its units (docs/output-schema.md, docs/units.md).
+            units = {}
+            f.visititems(lambda name, item: units.__setitem__(name, item.attrs.get("units"))
+                         if isinstance(item, h5py.Dataset) else None)
+            expected_units = {"profiles/z": "sigma", "profiles/n": "1/sigma^3", "profiles/nu": "1",
+                              "profiles/uz": "sqrt(g sigma)", "profiles/T": "g sigma",
+                              "profiles/time": "sqrt(sigma/g)", "profiles/phase": "1",
+                              "timeseries/t": "sqrt(sigma/g)", "timeseries/com_z": "sigma"}
+            for name, unit in expected_units.items():
+                check(units.get(name) == unit, f"{name} units {units.get(name)!r}, expected {unit!r}")
+            missing = sorted(name for name, unit in units.items() if not unit)
+            check(not missing, f"datasets without units: {missing}")
     print(f"{'FAILED' if failures else 'OK'}: {len(failures)} failed checks")
     return 1 if failures else 0
 

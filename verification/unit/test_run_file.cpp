@@ -87,11 +87,21 @@ TEST(RunFile, RoundTripWithStandardErrorsIsExact) {
   const TemporaryDirectory dir;
   const RunRecord written = awkward_record(true);
   RunRecord with_nan = written;
-  with_nan.series.add("shock_z", {1.0, std::numeric_limits<double>::quiet_NaN(), 3.5, 4.0});
+  // A column that is NaN by design in a run's first cycle.
+  with_nan.series.add("com_z_change_from_previous_cycle",
+                      {1.0, std::numeric_limits<double>::quiet_NaN(), 3.5, 4.0});
   for (const RunRecord& record : {written, with_nan}) {
     shaker::write_run_file(dir / "run.h5", record);
     expect_same_record(record, shaker::read_run_file(dir / "run.h5"));
   }
+}
+
+TEST(RunFile, AColumnWithoutDeclaredUnitsIsRefused) {
+  const TemporaryDirectory dir;
+  RunRecord record = awkward_record(true);
+  record.series.add("shock_z", {1.0, 2.0, 3.5, 4.0});
+  EXPECT_THROW(shaker::write_run_file(dir / "run.h5", record), std::logic_error);
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.h5"));
 }
 
 TEST(RunFile, RoundTripWithoutStandardErrorsKeepsThemAbsent) {
