@@ -1,7 +1,8 @@
 """What the Python tests share (pytest loads this file for every test in the repository).
 
---shaker names the `shaker` program for the tests that run it (ctest passes the one it built);
-without it those tests are skipped. `work_dir` is a temporary directory that is removed when
+--shaker names the `shaker` program for the tests that run it (ctest passes the one it built),
+--sample-writer the helper that writes the sample run file; without them those tests are
+skipped. `work_dir` is a temporary directory that is removed when
 the test passes and kept, its path printed, when it fails, so a green run leaves nothing in
 the system temporary folder (pytest's own tmp_path keeps the last three runs) and a red one
 can be inspected.
@@ -15,6 +16,8 @@ import pytest
 
 def pytest_addoption(parser):
     parser.addoption("--shaker", help="the shaker program the tests run")
+    parser.addoption("--sample-writer",
+                     help="write_sample_run_file, the helper that writes the sample run file")
 
 
 @pytest.fixture(scope="session")
