@@ -134,7 +134,8 @@ def main():
                   f"![trajectories]({plot_trajectories(analyses, out_dir)})", ""]
         for solver, a in analyses.items():
             lines += [f"## {solver}: analysis per phase (every fifth stored phase)", "",
-                      "| f t | plate | layer bottom | layer top | centre of mass | shock | d | d/xi | max Ma |",
+                      "| f t | plate | layer bottom | layer top | centre of mass | shock | d "
+                      "| d/xi | max Ma |",
                       "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
             for row in a[::5]:
                 lines.append("| " + " | ".join(fmt(row[c]) for c in (

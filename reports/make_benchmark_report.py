@@ -17,14 +17,14 @@ benchmark::Counter::kIsRate).
 
 Comparison with the previous run: for every benchmark present in both runs, the real-time
 samples (or CPU-time samples with --metric cpu_time; real time is what users wait for, CPU
-time is less sensitive to other load on the machine) of the repetitions are compared by a two-sided Mann-Whitney U test, as Google
-Benchmark's tools/compare.py does (implemented here with numpy and the standard library:
-the exact distribution when a sample has at most 8 values and there are no ties, otherwise the normal
-approximation with tie and continuity corrections, as scipy's default). A benchmark whose
-median time grew by more than --threshold (a fraction, default 0.10) with p < --alpha
-(default 0.05) is a slowdown: it is marked in the report, named on stderr, and the exit code
-is 1. Exit code 2: unreadable input. Fewer than 2 repetitions on either side cannot be judged
-and are reported as such.
+time is less sensitive to other load on the machine) of the repetitions are compared by a
+two-sided Mann-Whitney U test, as Google Benchmark's tools/compare.py does (implemented here
+with numpy and the standard library: the exact distribution when a sample has at most 8 values
+and there are no ties, otherwise the normal approximation with tie and continuity corrections,
+as scipy's default). A benchmark whose median time grew by more than --threshold (a fraction,
+default 0.10) with p < --alpha (default 0.05) is a slowdown: it is marked in the report, named
+on stderr, and the exit code is 1. Exit code 2: unreadable input. Fewer than 2 repetitions on
+either side cannot be judged and are reported as such.
 """
 import argparse
 import glob
@@ -40,8 +40,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import report_common as rc  # noqa: E402
+if __package__:
+    from . import report_common as rc
+else:  # run as a script: its folder, reports/, is first on sys.path
+    import report_common as rc
 
 TIME_UNIT_NS = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}
 STANDARD_KEYS = {"name", "family_index", "per_family_instance_index", "run_name", "run_type",
@@ -208,7 +210,8 @@ def compare(previous, latest, threshold, alpha, metric):
             change = float(after / before - 1.0)
             verdict = f"memory only: {counter} {rc.fmt(before, 5)} -> {rc.fmt(after, 5)}"
             if change > threshold:
-                verdict = f"**MEMORY GROWTH** (> {threshold:.0%}): " + verdict[len("memory only: "):]
+                verdict = (f"**MEMORY GROWTH** (> {threshold:.0%}): "
+                           + verdict[len("memory only: "):])
                 slowdowns.append(f"{name}: {counter} {change:+.1%}")
             rows.append(f"| {name} | | | {change:+.1%} | | | {verdict} |")
             continue
@@ -319,7 +322,7 @@ def main(argv=None):
         if len(runs) >= 2:
             previous = runs[-2]
             rows, slowdowns = compare(previous, latest, args.threshold, args.alpha, args.metric)
-            lines += [f"## Latest run against the previous one", "",
+            lines += ["## Latest run against the previous one", "",
                       f"{previous['id']} ({short(previous['commit'])}) → {latest['id']} "
                       f"({short(latest['commit'])}); {args.metric.replace('_', ' ')} per "
                       "iteration in ns (medians over repetitions) judged; the other time's "

@@ -69,8 +69,10 @@ import matplotlib.ticker  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import report_common as rc  # noqa: E402
+if __package__:
+    from . import report_common as rc
+else:  # run as a script: its folder, reports/, is first on sys.path
+    import report_common as rc
 
 ERRORS_HEADER = ["study", "field", "norm", "level", "h", "error"]
 ORDERS_HEADER = ["study", "field", "norm", "fit_points", "fitted_order", "order_std_error",
@@ -167,7 +169,8 @@ def read_inputs(directory):
     for kind, header in (("errors", ERRORS_HEADER), ("orders", ORDERS_HEADER), ("gci", GCI_HEADER),
                          ("sampling", SAMPLING_HEADER), ("sampling-fit", SAMPLING_FIT_HEADER),
                          ("bin-size", BIN_SIZE_HEADER)):
-        for path in sorted(glob.glob(os.path.join(directory, "**", f"*.{kind}.csv"), recursive=True)):
+        for path in sorted(glob.glob(os.path.join(directory, "**", f"*.{kind}.csv"),
+                                     recursive=True)):
             found[kind].extend(read_csv(path, header))
             files.append(os.path.relpath(path, directory))
     return found, files
@@ -216,7 +219,8 @@ def pair_orders(rows):
     out = []
     for coarse, fine in zip(rows, rows[1:]):
         if coarse["error"] > 0 and fine["error"] > 0 and coarse["h"] > fine["h"]:
-            out.append(math.log(coarse["error"] / fine["error"]) / math.log(coarse["h"] / fine["h"]))
+            out.append(math.log(coarse["error"] / fine["error"])
+                       / math.log(coarse["h"] / fine["h"]))
         else:
             out.append(float("nan"))
     return out
@@ -402,8 +406,9 @@ def sampling_section(data, out_dir, failures):
              "Standard error of MD fields and quantities of interest against the number K of "
              "sampled cycles (expected slope -1/2 of ln se against ln K, band from the degrees "
              "of freedom of each standard error), and the bin size sigma against sigma/2.", ""]
-    fits = sorted(data["sampling-fit"], key=lambda r: (r["study"], r["quantity"],
-                                                       -1 if math.isnan(r["phase"]) else r["phase"]))
+    fits = sorted(data["sampling-fit"],
+                  key=lambda r: (r["study"], r["quantity"],
+                                 -1 if math.isnan(r["phase"]) else r["phase"]))
     fit_table, fit_checks = judged_table(
         "| study | quantity | f t | fitted slope (± s.e., points) | expected | band | result |",
         fits, sampling_fit_line, sampling_fit_failure, failures, "no MD sampling studies found")
@@ -418,6 +423,7 @@ def sampling_section(data, out_dir, failures):
         lines += [f"### {study}: standard error against K", "",
                   "| quantity | f t | " + " | ".join(f"K = {k}" for k in ks) + " |",
                   "|---|---" + "|---" * len(ks) + "|"]
+
         def key(r):  # nan (all phases) never equals itself: -1 stands for it
             return (r["quantity"], -1.0 if math.isnan(r["phase"]) else r["phase"])
         for quantity, phase in sorted({key(r) for r in rows}):
@@ -425,8 +431,8 @@ def sampling_section(data, out_dir, failures):
             # The same cycles at every K: the largest count is the number of cycles without one.
             missing = max(r["missing"] for r in rows if key(r) == (quantity, phase))
             note = f" ({int(missing)} cycles without a value)" if missing else ""
-            lines.append(f"| {quantity}{note} | {phase_text(phase if phase >= 0 else math.nan)} | " +
-                         " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
+            lines.append(f"| {quantity}{note} | {phase_text(phase if phase >= 0 else math.nan)} | "
+                         + " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
         name = plot_sampling(study, rows, out_dir)
         lines += ["", f"![{study}: se against K]({name})", ""]
 

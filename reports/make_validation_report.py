@@ -24,7 +24,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from make_convergence_report import GCI_HEADER, read_csv  # noqa: E402  (one reader of the tables)
+# One reader of the tables.
+if __package__:
+    from .make_convergence_report import GCI_HEADER, read_csv
+else:  # run as a script: its folder, reports/, is first on sys.path
+    from make_convergence_report import GCI_HEADER, read_csv
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 STYLE = {"md": dict(marker="o", ms=3, ls="none"), "continuum": dict(ls="-", lw=1.2)}
@@ -244,7 +248,8 @@ def figure3(results, out_dir, link):
     if not runs:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
     fig, ax = plt.subplots(figsize=(6, 6))
-    rows = ["| solver | f t | shock location | maximum Ma in the layer |", "| --- | --- | --- | --- |"]
+    rows = ["| solver | f t | shock location | maximum Ma in the layer |",
+            "| --- | --- | --- | --- |"]
     has_profile = False
     for solver, (prof, table) in runs.items():
         k = nearest(prof["phase"], 0.22)
@@ -639,8 +644,8 @@ def metrics_section(results):
 def header(results, counts):
     d = results.data
     lines = ["# Validation: MD against continuum against the paper", "",
-             "Bougie, Moon, Swift and Swinney, Phys. Rev. E 66, 051301 (2002); its claims as data in "
-             "reference-data/claims.toml. Written by reports/make_validation_report.py from "
+             "Bougie, Moon, Swift and Swinney, Phys. Rev. E 66, 051301 (2002); its claims as data "
+             "in reference-data/claims.toml. Written by reports/make_validation_report.py from "
              "validation/run_validation.py.", "",
              f"- commit: {d['commit']}{' (with uncommitted changes)' if d['dirty'] else ''}",
              f"- date: {d['date']}", f"- program: {d['shaker_version']}",

@@ -40,7 +40,8 @@ def machine_description():
                     break
     except OSError:
         pass
-    return f"{platform.node()} ({cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()})"
+    return (f"{platform.node()} ({cpu}, {os.cpu_count()} cores, "
+            f"{platform.system()} {platform.release()})")
 
 
 def build_type_of(build_dir):

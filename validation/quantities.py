@@ -429,4 +429,3 @@ def verdict(inside):
     if inside > DECISION_ERRORS:
         return "pass"
     return "fail" if inside < -DECISION_ERRORS else "unresolved"
-

@@ -42,8 +42,10 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-import quantities  # noqa: E402
+if __package__:
+    from . import quantities
+else:  # run as a script: its folder, validation/, is first on sys.path
+    import quantities
 
 SOLVERS = ("md", "continuum")
 SOLVER_UNAVAILABLE = 3  # exit code of a solver that is not built yet (README)
@@ -378,7 +380,6 @@ def _with_rounding(error, value, resolution):
         errors = error if isinstance(error, list) else [None] * len(value)
         return [one(e, v, r) for e, v, r in zip(errors, value, resolution)]
     return one(error, value, resolution)
-
 
 
 def measure(quantity, params, cases, solver, views, comparer, partial_cases_ok):

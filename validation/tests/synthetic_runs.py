@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """Writes synthetic run files (docs/output-schema.md, solver attribute "synthetic") for the
 runs that validation/run_validation.py plans, under the names it reuses, so that the whole
 validation pipeline (shaker analyze, shaker compare, pooling, claims, report) can be tested
@@ -9,25 +8,26 @@ ballistically above the plate, lands at f t = 0.12 and carries a temperature sho
 drop of T) from the plate to the top of the layer between f t = 0.12 and about 0.33. Depth,
 restitution and solver shift it a little so that the claims get definite, varied values.
 
-    synthetic_runs.py --shaker SHAKER --workdir DIR [--cases a,b] [--quick]
+    python3 -m validation.tests.synthetic_runs --shaker SHAKER --workdir DIR [--cases a,b]
+        [--quick]
 """
 import argparse
 import json
 import math
 import os
-import sys
 import tomllib
 
 import h5py
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-import run_validation  # noqa: E402
+from validation import run_validation
+
+VALIDATION = os.path.dirname(os.path.abspath(run_validation.__file__))
 
 
 # Collisions each synthetic MD run records in its running totals (see write_run).
 SYNTHETIC_COLLISIONS = 200000.0
+
 
 def plate(config, t):
     gamma, f = config["shaker"]["gamma"], config["shaker"]["frequency"]
@@ -80,7 +80,8 @@ def write_cycle_samples(h, config, out, rng):
     """Per-cycle sums (docs/output-schema.md, cycle_samples) that pool to the profiles within
     1 % noise per cycle: count n V, momentum count u_z, energy count (3 T + u_z^2)."""
     # One sample per sampled cycle of each replica (md.replicas, docs/parallel.md).
-    per_replica = 1 if config["run"]["protocol"] == "single_shock" else config["run"]["sampled_cycles"]
+    per_replica = (1 if config["run"]["protocol"] == "single_shock"
+                   else config["run"]["sampled_cycles"])
     cycles = per_replica * config["md"]["replicas"]
     volume = config["md"]["box_width"] ** 2 * config["md"]["bin_height"]
     n, uz, T = (np.array(out[k], dtype=float) for k in ("n", "uz", "T"))
@@ -154,31 +155,27 @@ def write_run(path, config_text, solver, seed):
             data["collisions"] = 240000.0 * (times - times[0]) * f
             # Running totals as a continued run has them (not starting at 0): SYNTHETIC_COLLISIONS
             # collisions in the run, pair + plate.
-            data["pair_collisions"] = np.linspace(5000.0, 5000.0 + SYNTHETIC_COLLISIONS - 20000.0, len(times))
+            data["pair_collisions"] = np.linspace(5000.0, 5000.0 + SYNTHETIC_COLLISIONS - 20000.0,
+                                                  len(times))
             data["plate_collisions"] = np.linspace(700.0, 700.0 + 20000.0, len(times))
             data["ceiling_collisions"] = np.full(len(times), 3.0)
-            columns += ["crossings_z80", "particles_z80", "collisions", "pair_collisions", "plate_collisions",
-                        "ceiling_collisions"]
+            columns += ["crossings_z80", "particles_z80", "collisions", "pair_collisions",
+                        "plate_collisions", "ceiling_collisions"]
         s.attrs["columns"] = ",".join(columns)
         for name in columns:
             s.create_dataset(name, data=np.asarray(data[name], dtype=float))
     os.replace(tmp, path)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--shaker", required=True)
-    parser.add_argument("--workdir", required=True)
-    parser.add_argument("--cases", required=True)
-    parser.add_argument("--quick", action="store_true")
-    args = parser.parse_args()
-    shaker = os.path.abspath(args.shaker)
-    studies = run_validation.load_studies(os.path.join(os.path.dirname(HERE), "studies.toml"))
-    plan = run_validation.plan_runs(shaker, studies, args.cases.split(","), args.quick)
-    os.makedirs(os.path.join(args.workdir, "runs"), exist_ok=True)
+def write_runs(shaker, workdir, cases, quick):
+    """The synthetic run files of `cases` (comma-separated) under workdir/runs."""
+    shaker = os.path.abspath(shaker)
+    studies = run_validation.load_studies(os.path.join(VALIDATION, "studies.toml"))
+    plan = run_validation.plan_runs(shaker, studies, cases.split(","), quick)
+    os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
     for i, run in enumerate(plan):
         text, key = run_validation.run_key(shaker, run)
-        stem = os.path.join(args.workdir, "runs", f"{run['solver']}-{key[:20]}")
+        stem = os.path.join(workdir, "runs", f"{run['solver']}-{key[:20]}")
         record = dict(key=key, config=text, seconds=1.0 + i, returncode=0, command="synthetic",
                       stdout="", stderr="")
         if run["expect_failure"]:
@@ -189,7 +186,17 @@ def main():
             record.update(status="ok", path=stem + ".h5")
         with open(stem + ".json", "w") as f:
             json.dump(record, f)
-    print(f"wrote {len(plan)} synthetic runs into {args.workdir}/runs")
+    print(f"wrote {len(plan)} synthetic runs into {workdir}/runs")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--shaker", required=True)
+    parser.add_argument("--workdir", required=True)
+    parser.add_argument("--cases", required=True)
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    write_runs(args.shaker, args.workdir, args.cases, args.quick)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """ctest validation.report_pipeline: the whole validation pipeline on synthetic run files,
 without the solvers.
 
@@ -12,21 +11,20 @@ the collapse detected from the recorded exit status) come out exactly, the conti
 synthetic grid-study table reaches the claims table (C6) or its absence is said (C5), and
 --require sets the exit status (0 for a passing claim, 1 for a failing one).
 
-    test_report_pipeline.py --shaker SHAKER
+    python3 -m pytest validation/tests/test_report_pipeline.py --shaker SHAKER
 """
-import argparse
 import json
 import os
 import re
-import shutil
 import subprocess
 import sys
-import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-VALIDATION = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-import synthetic_runs  # noqa: E402  (the cartoon's collision count)
+import pytest
+
+from validation import run_validation as runner
+from validation.tests import synthetic_runs
+
+VALIDATION = os.path.dirname(os.path.abspath(runner.__file__))
 CASES = ("base,single_shock_e0p99,single_shock_e0p90,single_shock_e0p85,velocity_dependent,"
          "depth_h4p5,depth_h13p5,collapse_e0p70")
 FIGURES = ("fig1-profiles.png", "fig2-single-shock.png", "fig3-mach.png", "fig4-mach-width.png",
@@ -56,49 +54,35 @@ def run_validation(shaker, workdir, report, require, gci):
     return result.returncode, result.stdout + result.stderr
 
 
-def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--shaker", required=True)
-    shaker = os.path.abspath(parser.parse_args().shaker)
-    tmp = tempfile.mkdtemp(prefix="validation-report-pipeline-")
-    problems = []
-
-    def expect(condition, message):
-        print(("ok:      " if condition else "PROBLEM: ") + message)
-        if not condition:
-            problems.append(message)
-
+def test_report_pipeline(shaker, work_dir):
+    tmp = work_dir
     workdir, report = os.path.join(tmp, "work"), os.path.join(tmp, "validation.md")
-    made = subprocess.run([sys.executable, os.path.join(HERE, "synthetic_runs.py"), "--shaker",
-                           shaker, "--workdir", workdir, "--cases", CASES, "--quick"],
-                          capture_output=True, text=True)
-    expect(made.returncode == 0, f"synthetic run files written ({made.stderr.strip()[-300:]})")
+    synthetic_runs.write_runs(shaker, workdir, CASES, quick=True)
 
     gci = os.path.join(tmp, "real-1d-base.gci.csv")
     write_gci_table(gci)
     rc, output = run_validation(shaker, workdir, report, "C18", gci)
-    expect(rc == 0, f"--require C18 (a passing claim) exits 0 (got {rc})")
-    if rc not in (0, 1):
-        print(output)
+    assert rc == 0, f"--require C18 (a passing claim) exits 0 (got {rc})" + (
+        f"\n{output}" if rc not in (0, 1) else "")
     text = open(report).read() if os.path.exists(report) else ""
     rows = {m.group(1): m.group(0) for m in re.finditer(r"^\| (C\d+) \|.*$", text, re.M)}
-    expect(sorted(rows, key=lambda i: int(i[1:])) == [f"C{n}" for n in range(1, 21)],
-           f"claims table has rows C1..C20 (found {sorted(rows)})")
-    expect(any(r.endswith("| pass |") for r in rows.values()), "some claim is marked pass")
-    expect(any(r.endswith("| **FAIL** |") for r in rows.values()), "some claim is marked FAIL")
-    expect("not measured" in rows.get("C15", ""),
-           "C15 (its continuum_ceiling200 runs absent) is reported as not measured")
+    assert sorted(rows, key=lambda i: int(i[1:])) == [f"C{n}" for n in range(1, 21)], \
+        f"claims table has rows C1..C20 (found {sorted(rows)})"
+    assert any(r.endswith("| pass |") for r in rows.values()), "some claim is marked pass"
+    assert any(r.endswith("| **FAIL** |") for r in rows.values()), "some claim is marked FAIL"
+    assert "not measured" in rows.get("C15", ""), \
+        "C15 (its continuum_ceiling200 runs absent) is reported as not measured"
     for name in FIGURES:
         path = os.path.join(tmp, "validation", name)
-        expect(os.path.exists(path) and os.path.getsize(path) > 10000,
-               f"{name} exists ({os.path.getsize(path) if os.path.exists(path) else 0} bytes)")
+        assert os.path.exists(path) and os.path.getsize(path) > 10000, \
+            f"{name} exists ({os.path.getsize(path) if os.path.exists(path) else 0} bytes)"
     for n in range(1, 8):
-        expect(f"## Fig. {n}:" in text, f"section for Fig. {n}")
-    expect("## Agreement metrics" in text and "center_of_mass_fractional_rms" in text,
-           "agreement metrics table")
+        assert f"## Fig. {n}:" in text, f"section for Fig. {n}"
+    assert "## Agreement metrics" in text and "center_of_mass_fractional_rms" in text, \
+        "agreement metrics table"
 
     results = json.load(open(os.path.join(workdir, "results.json")))
-    expect(all(r["reused"] for r in results["runs"]), "every run reused, none re-simulated")
+    assert all(r["reused"] for r in results["runs"]), "every run reused, none re-simulated"
     claims = {c["id"]: c for c in results["claims"]}
 
     def value(claim, solver, check=0):
@@ -109,16 +93,16 @@ def main():
         for check, expected, what in ((0, 0.8 * crossings, "distinct particles"),
                                       (1, crossings, "upward crossings")):
             got = value(claim, "md", check)
-            expect(abs(got - expected) < 1e-9,
-                   f"{claim} {what} per cycle above 80 = {got} (cartoon: {expected:g})")
-    expect(claims["C18"]["status"] == "pass" and value("C18", "md") == 1.0,
-           "C18: collapse detected from the recorded exit status")
+            assert abs(got - expected) < 1e-9, \
+                f"{claim} {what} per cycle above 80 = {got} (cartoon: {expected:g})"
+    assert claims["C18"]["status"] == "pass" and value("C18", "md") == 1.0, \
+        "C18: collapse detected from the recorded exit status"
     c10 = value("C10", "md_vs_continuum")
-    expect(c10 is not None and 0 < c10 < 0.03, f"C10 centre-of-mass fractional RMS {c10}")
+    assert c10 is not None and 0 < c10 < 0.03, f"C10 centre-of-mass fractional RMS {c10}"
     md_c13 = claims["C13"]["per_solver"]["md"]["status"]
-    expect(md_c13 == "not measured", f"C13 without the e = 0.80 runs: {md_c13}")
-    expect(claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None,
-           "C14 has a jackknife error from the ensemble's replicas")
+    assert md_c13 == "not measured", f"C13 without the e = 0.80 runs: {md_c13}"
+    assert claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None, \
+        "C14 has a jackknife error from the ensemble's replicas"
 
     # The report's numbers are those `shaker analyze` prints: run it again, by hand, on the
     # single-shock ensemble of e = 0.9 and on the base case, and compare.
@@ -127,19 +111,18 @@ def main():
                                       ("C14", "md", "single_shock_e0p90", None)):
         view = results["views"].get(f"{case}/{solver}")
         if not view or not view.get("path"):
-            expect(False, f"{case}/{solver} has no run file")
-            continue
+            pytest.fail(f"{case}/{solver} has no run file")
         out = os.path.join(tmp, f"again-{case}.json")
         subprocess.run([shaker, "analyze", view["path"], "--json", out, "--quiet"], check=True)
         per_run = json.load(open(out))["per_run"]
         if name:
-            expect(per_run[name]["value"] == value(claim, solver),
-                   f"{claim}: report {value(claim, solver)} = shaker analyze {name} "
-                   f"{per_run[name]['value']}")
+            assert per_run[name]["value"] == value(claim, solver), (
+                f"{claim}: report {value(claim, solver)} = shaker analyze {name} "
+                f"{per_run[name]['value']}")
         else:
-            expect(per_run["shock_speed"]["value"] == view["shock_speed"],
-                   f"{case}: report shock speed {view['shock_speed']} = shaker analyze "
-                   f"{per_run['shock_speed']['value']}")
+            assert per_run["shock_speed"]["value"] == view["shock_speed"], (
+                f"{case}: report shock speed {view['shock_speed']} = shaker analyze "
+                f"{per_run['shock_speed']['value']}")
 
     md_views = [v for v in results["views"].values() if v["solver"] == "md" and v["status"] == "ok"]
     for view in md_views:
@@ -149,30 +132,20 @@ def main():
                    and r["status"] == "ok")
         expected = runs * synthetic_runs.SYNTHETIC_COLLISIONS / seconds
         rate = view["collisions_per_second"]
-        expect(rate is not None and abs(rate - expected) <= 1e-9 * expected,
-               f"{view['case']}: MD collisions per second from the run files' running totals "
-               f"{rate} (cartoon: {expected})")
-    expect(len(md_views) > 0, f"MD views with a collision rate: {len(md_views)}")
+        assert rate is not None and abs(rate - expected) <= 1e-9 * expected, (
+            f"{view['case']}: MD collisions per second from the run files' running totals "
+            f"{rate} (cartoon: {expected})")
+    assert len(md_views) > 0, f"MD views with a collision rate: {len(md_views)}"
 
     c6, c5 = rows.get("C6", "").split(" | "), rows.get("C5", "").split(" | ")
     c6_continuum = c6[4] if len(c6) > 4 else ""
     shown = re.search(r"([0-9.eE+-]+) ± ([0-9.eE+-]+) \(GCI 2 %", c6_continuum)
-    expect(shown is not None and abs(float(shown.group(2)) - 0.02 * abs(float(shown.group(1))))
-           <= 0.01 * abs(float(shown.group(1))),
-           f"C6 continuum value carries its GCI, 2 % of the value: '{c6_continuum}'")
-    expect(len(c5) > 4 and "no shock_width_ft0.22 row" in c5[4],
-           f"C5 says its GCI row is missing: '{c5[4] if len(c5) > 4 else ''}'")
-    expect("GCI" not in (c6[3] if len(c6) > 3 else "GCI"), "the MD value carries no GCI")
+    assert (shown is not None and abs(float(shown.group(2)) - 0.02 * abs(float(shown.group(1))))
+            <= 0.01 * abs(float(shown.group(1)))), \
+        f"C6 continuum value carries its GCI, 2 % of the value: '{c6_continuum}'"
+    assert len(c5) > 4 and "no shock_width_ft0.22 row" in c5[4], \
+        f"C5 says its GCI row is missing: '{c5[4] if len(c5) > 4 else ''}'"
+    assert "GCI" not in (c6[3] if len(c6) > 3 else "GCI"), "the MD value carries no GCI"
 
     rc, _ = run_validation(shaker, workdir, report, "C3", gci)
-    expect(rc == 1, f"--require C3 (failing on the cartoon) exits 1 (got {rc})")
-
-    if problems:
-        print(f"{len(problems)} problem(s); files kept in {tmp}")
-        return 1
-    shutil.rmtree(tmp)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    assert rc == 1, f"--require C3 (failing on the cartoon) exits 1 (got {rc})"

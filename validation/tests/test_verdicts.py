@@ -1,16 +1,14 @@
-#!/usr/bin/python3
 """ctest validation.verdicts: the verdict of a claim from its value and standard error
 (validation/quantities.py margin and verdict) on cases of known answer: a value well inside
 its band passes, one well outside fails, one within 2 standard errors of the band's edge is
 unresolved; a value without an error is judged on its value alone; an ordering is judged on
 its smallest step over that step's error; a per-phase list on the phases where it exists, if
-they are at least half. Exit status 0 only if every case gives the expected verdict."""
+they are at least half."""
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-import quantities  # noqa: E402
+import pytest
+
+from validation import quantities
 
 NAN = math.nan
 CASES = [
@@ -42,18 +40,9 @@ CASES = [
 ]
 
 
-def main():
-    failures = 0
-    for comparison, band, value, error, expected in CASES:
-        inside = quantities.margin(comparison, band, value, error)
-        got = quantities.verdict(inside)
-        ok = got == expected
-        failures += not ok
-        print(f"{'ok  ' if ok else 'FAIL'} {comparison} {band} {value} +- {error}: "
-              f"{inside:.3g} standard errors inside -> {got} (expected {expected})")
-    print(f"{len(CASES) - failures} of {len(CASES)} verdicts as expected")
-    return 1 if failures else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+@pytest.mark.parametrize("comparison, band, value, error, expected", CASES)
+def test_verdict(comparison, band, value, error, expected):
+    inside = quantities.margin(comparison, band, value, error)
+    got = quantities.verdict(inside)
+    assert got == expected, (f"{comparison} {band} {value} +- {error}: {inside:.3g} standard "
+                             f"errors inside -> {got} (expected {expected})")

@@ -110,13 +110,15 @@ def check_file(fields_path, run_path, shaker):
         last = (19 * 5 + 3) * 5 + 3  # corner (3, 3, 19)
         expect(hexahedra[-1][0] == last and hexahedra.shape == (nx * ny * nz, 8),
                f"last cell {hexahedra[-1]}, shape {hexahedra.shape}")
-        k, j, i = np.meshgrid(np.arange(nz + 1), np.arange(ny + 1), np.arange(nx + 1), indexing="ij")
+        k, j, i = np.meshgrid(np.arange(nz + 1), np.arange(ny + 1), np.arange(nx + 1),
+                              indexing="ij")
         for s in snapshots:
             t = s["time"]
             plate_z = amplitude * (1 - math.cos(2 * math.pi * frequency * t))
             expect(abs(s["plate_z"] - plate_z) <= 1e-12 * amplitude,
                    f"{s['name']}: plate_z {s['plate_z']} against A (1 - cos 2 pi f t) = {plate_z}")
-            expected = np.stack([i.ravel() * h, j.ravel() * h, k.ravel() * h + s["plate_z"]], axis=1)
+            expected = np.stack([i.ravel() * h, j.ravel() * h, k.ravel() * h + s["plate_z"]],
+                                axis=1)
             expect(np.array_equal(s["points"], expected), f"{s['name']}: lab-frame corners")
             row = profiles["phase"][()].tolist().index(s["phase"])
             expect(profiles["time"][row] == t and profiles["plate_v"][row] == s["plate_v"],
@@ -126,7 +128,8 @@ def check_file(fields_path, run_path, shaker):
             centres = (np.arange(nz) + 0.5) * h + s["plate_z"]
             for label, mine, theirs in (
                     ("z", centres, profiles["z"][row]), ("n", mean_n, profiles["n"][row]),
-                    ("uz", (n * s["uz"].reshape(nz, -1)).mean(axis=1) / mean_n, profiles["uz"][row]),
+                    ("uz", (n * s["uz"].reshape(nz, -1)).mean(axis=1) / mean_n,
+                     profiles["uz"][row]),
                     ("T", (n * s["T"].reshape(nz, -1)).mean(axis=1) / mean_n, profiles["T"][row])):
                 # Relative to the profile's largest value (at t = 0 the layer is at rest: uz = 0).
                 error = np.max(np.abs(mine - theirs))
@@ -195,9 +198,11 @@ def read_paraview(xdmf, hexahedra, snapshots):
             if not grid.IsA("vtkUnstructuredGrid"):
                 expect(False, f"ParaView {name}: t = {t}: {grid.GetClassName()}")
                 break
-            # Copies taken now: a fetched grid's arrays may be the reader's, reused at the next time.
+            # Copies taken now: a fetched grid's arrays may be the reader's, reused at the next
+            # time.
             types = vtk_to_numpy(grid.GetCellTypesArray())
-            expect(np.all(types == 12), f"ParaView {name}: cell types {set(types.tolist())}")  # hexahedra
+            expect(np.all(types == 12),  # hexahedra
+                   f"ParaView {name}: cell types {set(types.tolist())}")
             if cells is None:
                 cells = np.array(vtk_to_numpy(grid.GetCells().GetConnectivityArray()))
             corners.append(np.array(vtk_to_numpy(grid.GetPoints().GetData())))
@@ -224,9 +229,11 @@ def main():
         f.write(CASE)
     command = [os.path.abspath(args.shaker), "continuum", os.path.join(work, "box.toml"), "--quiet",
                "--set", f"run.output={run_path}"]
-    result = subprocess.run(command, capture_output=True, text=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
+    result = subprocess.run(command, capture_output=True, text=True,
+                            env=dict(os.environ, OMP_NUM_THREADS="1"))
     if result.returncode != 0:
-        print(f"PROBLEM: {' '.join(command)} exited {result.returncode}:\n{result.stdout}{result.stderr}")
+        print(f"PROBLEM: {' '.join(command)} exited {result.returncode}:\n"
+              f"{result.stdout}{result.stderr}")
         return 1
     fields_path = os.path.join(work, "box.fields.h5")
     hexahedra, snapshots = check_file(fields_path, run_path, args.shaker)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "continuum/time_integrator.hpp"
+#include "support/test_directory.hpp"
 
 namespace shaker::continuum::testing {
 
@@ -40,16 +41,8 @@ inline double fitted_order(const std::vector<double>& h, const std::vector<doubl
   return (m * sxy - sx * sy) / (m * sxx - sx * sx);
 }
 
-/// A fresh directory for one test and process (two ctest runs at once do not share it),
-/// removed first so reruns start clean.
 inline std::filesystem::path test_directory() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("shaker-continuum-" + std::string(info->test_suite_name()) + "-" + info->name() + "-" +
-                    std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return shaker::testing::test_directory("shaker-continuum-");
 }
 
 inline double total(const Grid& g, const State& s, int variable) {

@@ -1,7 +1,6 @@
-#!/usr/bin/python3
-"""ctest: reports/make_benchmark_report.py on synthetic Google Benchmark JSON.
+"""ctest benchmark_report: reports/make_benchmark_report.py on synthetic Google Benchmark JSON.
 
-Argument: the reports/ directory. Two runs of three benchmarks with 9 repetitions each: one
+Two runs of three benchmarks with 9 repetitions each: one
 20% slower, one 20% faster, one unchanged (seeded noise). Checks the throughput rows per
 commit, the comparison rows and verdicts, the exit code and the benchmark named on stderr,
 the threshold option, the Mann-Whitney U implementation against brute-force enumeration, and
@@ -11,25 +10,16 @@ import itertools
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 
 import numpy as np
+import pytest
 
-REPORTS = os.path.abspath(sys.argv[1])
-SCRIPT = os.path.join(REPORTS, "make_benchmark_report.py")
-sys.path.insert(0, REPORTS)
-import make_benchmark_report as mbr  # noqa: E402
+from reports import make_benchmark_report as mbr
 
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
+# The report is made as users make it: the script run by its path.
+SCRIPT = os.path.abspath(mbr.__file__)
 
 
 def google_benchmark_json(commit, benchmarks, rng):
@@ -69,7 +59,7 @@ def run(*args):
 
 
 def line_with(text, *fragments):
-    return next((l for l in text.splitlines() if all(f in l for f in fragments)), "")
+    return next((line for line in text.splitlines() if all(f in line for f in fragments)), "")
 
 
 # ---- Mann-Whitney U against enumeration and hand values ------------------------------------
@@ -81,30 +71,36 @@ def brute_force_p(x, y):
     count = total = 0
     for subset in itertools.combinations(range(len(pooled)), n1):
         chosen = set(subset)
-        u = sum((pooled[i] > pooled[j]) for i in chosen for j in range(len(pooled)) if j not in chosen)
+        u = sum((pooled[i] > pooled[j])
+                for i in chosen for j in range(len(pooled)) if j not in chosen)
         total += 1
         count += abs(u - mean) >= abs(observed - mean) - 1e-12
     return count / total
 
 
-x = [0.3, 1.2, 2.5, 4.1, 0.7]
-y = [1.0, 3.3, 2.2, 5.0, 4.4, 6.1]
-u, p, method = mbr.mann_whitney_u(x, y)
-check(method == "exact" and u == 6.0, f"U = {u} ({method}), expected 6 exact")
-check(abs(p - brute_force_p(x, y)) < 1e-12, f"exact p {p} vs enumeration {brute_force_p(x, y)}")
-check(abs(mbr.mann_whitney_u([1, 2, 3], [4, 5, 6])[1] - 0.1) < 1e-15, "3 vs 3 separated: p = 2/20")
-# 9 vs 9 fully separated, normal approximation: z = (40.5 - 0.5) / sqrt(81 * 19 / 12).
-p9 = mbr.mann_whitney_u(range(1, 10), range(10, 19))[1]
-check(abs(p9 - math.erfc(40.0 / math.sqrt(128.25) / math.sqrt(2.0))) < 1e-15 and 4.0e-4 < p9 < 4.3e-4,
-      f"9 vs 9 separated: p = {p9}")
-tied = mbr.mann_whitney_u([1, 1, 2, 5, 7, 7, 8, 9, 9], [2, 3, 3, 4, 6, 6, 10, 11, 12])
-tied_swapped = mbr.mann_whitney_u([2, 3, 3, 4, 6, 6, 10, 11, 12], [1, 1, 2, 5, 7, 7, 8, 9, 9])
-check(tied[2] == "asymptotic" and abs(tied[1] - tied_swapped[1]) < 1e-15 and 0 < tied[1] < 1,
-      f"tied samples: {tied} vs swapped {tied_swapped}")
+def test_mann_whitney_u_against_enumeration_and_hand_values():
+    x = [0.3, 1.2, 2.5, 4.1, 0.7]
+    y = [1.0, 3.3, 2.2, 5.0, 4.4, 6.1]
+    u, p, method = mbr.mann_whitney_u(x, y)
+    assert method == "exact" and u == 6.0, f"U = {u} ({method}), expected 6 exact"
+    assert abs(p - brute_force_p(x, y)) < 1e-12, \
+        f"exact p {p} vs enumeration {brute_force_p(x, y)}"
+    assert abs(mbr.mann_whitney_u([1, 2, 3], [4, 5, 6])[1] - 0.1) < 1e-15, \
+        "3 vs 3 separated: p = 2/20"
+    # 9 vs 9 fully separated, normal approximation: z = (40.5 - 0.5) / sqrt(81 * 19 / 12).
+    p9 = mbr.mann_whitney_u(range(1, 10), range(10, 19))[1]
+    assert (abs(p9 - math.erfc(40.0 / math.sqrt(128.25) / math.sqrt(2.0))) < 1e-15
+            and 4.0e-4 < p9 < 4.3e-4), \
+        f"9 vs 9 separated: p = {p9}"
+    tied = mbr.mann_whitney_u([1, 1, 2, 5, 7, 7, 8, 9, 9], [2, 3, 3, 4, 6, 6, 10, 11, 12])
+    tied_swapped = mbr.mann_whitney_u([2, 3, 3, 4, 6, 6, 10, 11, 12], [1, 1, 2, 5, 7, 7, 8, 9, 9])
+    assert tied[2] == "asymptotic" and abs(tied[1] - tied_swapped[1]) < 1e-15 and 0 < tied[1] < 1, \
+        f"tied samples: {tied} vs swapped {tied_swapped}"
+
 
 # ---- The report on a synthetic history ------------------------------------------------------
-work = tempfile.mkdtemp(prefix="shaker-benchmark-report-")
-try:
+def test_report_on_a_synthetic_history(work_dir):
+    work = work_dir
     history = os.path.join(work, "history")
     before = {"BM_md_collisions": (2.0e6, "collisions_per_second", 2000.0),
               "BM_continuum_step": (5.0e5, "cell_updates_per_second", 1.0e4),
@@ -120,25 +116,25 @@ try:
     write_run(history, "20261121T030000Z-bbbbbbbbbbbb", "b" * 40, after, seed=2)
     out = os.path.join(work, "out", "benchmarks.md")
     result = run("--history", history, "--output", out)
-    check(result.returncode == 1, f"a 20% slowdown must exit 1, got {result.returncode}")
-    check("BM_md_collisions" in result.stderr and "BM_continuum_step" not in result.stderr
-          and "BM_unchanged" not in result.stderr and "BM_memory:" not in result.stderr
-          and "BM_memory_grows: bytes_per_cell +23.9%" in result.stderr,
-          f"stderr must name the slow one and the grown one: {result.stderr}")
+    assert result.returncode == 1, f"a 20% slowdown must exit 1, got {result.returncode}"
+    assert ("BM_md_collisions" in result.stderr and "BM_continuum_step" not in result.stderr
+            and "BM_unchanged" not in result.stderr and "BM_memory:" not in result.stderr
+            and "BM_memory_grows: bytes_per_cell +23.9%" in result.stderr), \
+        f"stderr must name the slow one and the grown one: {result.stderr}"
     text = open(out).read() if os.path.exists(out) else ""
-    check("### collisions per second" in text and "### cell updates per second" in text,
-          "throughput sections missing")
+    assert "### collisions per second" in text and "### cell updates per second" in text, \
+        "throughput sections missing"
     # 2000 collisions per 2 ms = 1e6 /s before, 8.333e5 /s after (medians, 1% noise).
     row_a = line_with(text, "| 20261120T030000Z-aaaaaaaaaaaa | aaaaaaaaaa | ")
     row_b = line_with(text, "| 20261121T030000Z-bbbbbbbbbbbb | bbbbbbbbbb | ")
-    check(row_a != "" and row_b != "", "per-commit throughput rows missing")
+    assert row_a != "" and row_b != "", "per-commit throughput rows missing"
     try:
         a = float(row_a.split("|")[3])
         b = float(row_b.split("|")[3])
-        check(abs(a / 1e6 - 1) < 0.02 and abs(b / 8.3333e5 - 1) < 0.02,
-              f"collisions/s medians {a}, {b} (expected 1e6, 8.33e5)")
+        assert abs(a / 1e6 - 1) < 0.02 and abs(b / 8.3333e5 - 1) < 0.02, \
+            f"collisions/s medians {a}, {b} (expected 1e6, 8.33e5)"
     except (IndexError, ValueError):
-        check(False, f"throughput rows unreadable: '{row_a}', '{row_b}'")
+        pytest.fail(f"throughput rows unreadable: '{row_a}', '{row_b}'")
     slow = line_with(text, "| BM_md_collisions |", "%")
     fast = line_with(text, "| BM_continuum_step |", "%")
     same = line_with(text, "| BM_unchanged |", "%")
@@ -148,46 +144,45 @@ try:
             return float(row.split("|")[4].strip().rstrip("%"))
         except (IndexError, ValueError):
             return float("nan")
-    check("**SLOWDOWN**" in slow and 17 < change_of(slow) < 23, f"slowdown row: '{slow}'")
-    check("faster" in fast and -23 < change_of(fast) < -17 and "SLOWDOWN" not in fast,
-          f"faster row: '{fast}'")
-    check("SLOWDOWN" not in same and "faster" not in same, f"unchanged row: '{same}'")
-    check("- BM_md_collisions: median real_time +" in text, "slowdown list missing")
+    assert "**SLOWDOWN**" in slow and 17 < change_of(slow) < 23, f"slowdown row: '{slow}'"
+    assert "faster" in fast and -23 < change_of(fast) < -17 and "SLOWDOWN" not in fast, \
+        f"faster row: '{fast}'"
+    assert "SLOWDOWN" not in same and "faster" not in same, f"unchanged row: '{same}'"
+    assert "- BM_md_collisions: median real_time +" in text, "slowdown list missing"
     # A memory benchmark is judged by its bytes, not by the time it takes to allocate them.
     memory = line_with(text, "| BM_memory |")
     grows = line_with(text, "| BM_memory_grows |")
-    check("memory only: bytes_per_cell 565 -> 565" in memory and "SLOWDOWN" not in memory
-          and "+0.0%" in memory, f"memory row: '{memory}'")
-    check("**MEMORY GROWTH** (> 10%): bytes_per_cell 565 -> 700" in grows and "+23.9%" in grows,
-          f"memory growth row: '{grows}'")
+    assert ("memory only: bytes_per_cell 565 -> 565" in memory and "SLOWDOWN" not in memory
+            and "+0.0%" in memory), f"memory row: '{memory}'"
+    assert "**MEMORY GROWTH** (> 10%): bytes_per_cell 565 -> 700" in grows and "+23.9%" in grows, \
+        f"memory growth row: '{grows}'"
     png = os.path.join(work, "out", "benchmark-history.png")
-    check(os.path.exists(png) and open(png, "rb").read(4) == b"\x89PNG", "history plot missing")
+    assert os.path.exists(png) and open(png, "rb").read(4) == b"\x89PNG", "history plot missing"
 
     relaxed = run("--history", history, "--output", os.path.join(work, "relaxed.md"),
                   "--threshold", "0.25")
-    check(relaxed.returncode == 0, f"--threshold 0.25 must accept a 20% slowdown, got {relaxed.returncode}")
-    relaxed_row = line_with(open(os.path.join(work, "relaxed.md")).read(), "| BM_md_collisions |", "%")
-    check("significant change within 25%" in relaxed_row, f"relaxed row: '{relaxed_row}'")
+    assert relaxed.returncode == 0, \
+        f"--threshold 0.25 must accept a 20% slowdown, got {relaxed.returncode}"
+    relaxed_row = line_with(open(os.path.join(work, "relaxed.md")).read(),
+                            "| BM_md_collisions |", "%")
+    assert "significant change within 25%" in relaxed_row, f"relaxed row: '{relaxed_row}'"
 
-    cpu = run("--history", history, "--output", os.path.join(work, "cpu.md"), "--metric", "cpu_time")
-    check(cpu.returncode == 1 and "median cpu_time +" in cpu.stderr,
-          f"--metric cpu_time must judge CPU time: exit {cpu.returncode}, {cpu.stderr.strip()}")
+    cpu = run("--history", history, "--output", os.path.join(work, "cpu.md"),
+              "--metric", "cpu_time")
+    assert cpu.returncode == 1 and "median cpu_time +" in cpu.stderr, \
+        f"--metric cpu_time must judge CPU time: exit {cpu.returncode}, {cpu.stderr.strip()}"
 
     single = os.path.join(work, "single")
     write_run(single, "20261120T030000Z-aaaaaaaaaaaa", "a" * 40, before, seed=3)
     result = run("--history", single, "--output", os.path.join(work, "single.md"))
-    check(result.returncode == 0 and "nothing to compare" in open(os.path.join(work, "single.md")).read(),
-          "a single run must report nothing to compare and exit 0")
+    assert (result.returncode == 0
+            and "nothing to compare" in open(os.path.join(work, "single.md")).read()), \
+        "a single run must report nothing to compare and exit 0"
 
     broken = os.path.join(work, "broken", "20261120T030000Z-x")
     os.makedirs(broken)
     with open(os.path.join(broken, "bench.json"), "w") as f:
         f.write("{not json")
     result = run("--history", os.path.dirname(broken), "--output", os.path.join(work, "broken.md"))
-    check(result.returncode == 2 and not os.path.exists(os.path.join(work, "broken.md")),
-          f"bad JSON: exit {result.returncode}")
-finally:
-    shutil.rmtree(work, ignore_errors=True)
-
-print(f"{len(failures)} failures")
-sys.exit(1 if failures else 0)
+    assert result.returncode == 2 and not os.path.exists(os.path.join(work, "broken.md")), \
+        f"bad JSON: exit {result.returncode}"

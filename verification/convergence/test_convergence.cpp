@@ -20,6 +20,7 @@
 #include "common/units.hpp"
 #include "convergence.hpp"
 #include "error_table.hpp"
+#include "support/test_directory.hpp"
 
 namespace cv = shaker::convergence;
 
@@ -31,12 +32,7 @@ std::vector<double> halving(double h0, int levels) {
 }
 
 std::filesystem::path fresh_directory(const std::string& test_name) {
-  // The process id keeps concurrent runs from different build directories apart.
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("shaker-convergence-" + test_name + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return shaker::testing::test_directory("shaker-convergence-", test_name);
 }
 
 double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }

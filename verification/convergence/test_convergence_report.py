@@ -1,7 +1,7 @@
-#!/usr/bin/python3
-"""ctest: reports/make_convergence_report.py on a small synthetic study in a temp directory.
+"""ctest convergence_report: reports/make_convergence_report.py on a small synthetic study in a
+temporary directory.
 
-Argument: the reports/ directory. Checks the provenance header, the order and GCI rows with
+Checks the provenance header, the order and GCI rows with
 their pass/fail marks, the failure summary with measured values, the PNG plot, --strict, and
 bad input; and the MD sampling section (slope fits against K^-1/2, the se table, its plot, the
 bin-size checks) on a synthetic sampling study.
@@ -20,21 +20,16 @@ import re
 import shutil
 import subprocess
 import sys
-import tempfile
 
 import numpy as np
 
-REPORTS = os.path.abspath(sys.argv[1])
-SCRIPT = os.path.join(REPORTS, "make_convergence_report.py")
+from reports import make_convergence_report
+
+# The report is made as users make it: the script run by its path.
+SCRIPT = os.path.abspath(make_convergence_report.__file__)
+REPORTS = os.path.dirname(SCRIPT)
 ORDERS_HEADER = ("study,field,norm,fit_points,fitted_order,order_std_error,pair_order_finest,"
                  "pair_order_next,design_order,tolerance,pass")
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def write(path, header, rows):
@@ -106,7 +101,8 @@ def synthetic_sampling_study(directory):
           "study,quantity,phase,fit_points,fitted_slope,slope_std_error,expected_slope,band,pass",
           fit_rows)
     write(os.path.join(directory, "md.bin-size.csv"),
-          "study,quantity,phase,sigma_value,half_sigma_value,statistic,value,criterion,limit,pass", [
+          "study,quantity,phase,sigma_value,half_sigma_value,statistic,value,criterion,limit,"
+          "pass", [
               (study, "T", 0.22, "nan", "nan", "fraction of layer bins within 2 combined se", 0.96,
                "at_least", 0.9, 1),
               (study, "uz", 0.22, "nan", "nan", "fraction of layer bins within 2 combined se", 0.8,
@@ -216,29 +212,29 @@ def check_marks_follow_the_judge(input_dir, text, label):
         paths = sorted(glob.glob(os.path.join(input_dir, "**", f"*.{kind}.csv"), recursive=True))
         rows = [row for path in paths for row in csv_rows(path)]
         if rows:
-            check(len(shown_rows) == len(rows),
-                  f"{label}: {len(shown_rows)} rows shown under '{heading}', {len(rows)} in tables")
+            assert len(shown_rows) == len(rows), \
+                f"{label}: {len(shown_rows)} rows shown under '{heading}', {len(rows)} in tables"
         for row in rows:
             expected = mark_of_pass_column(row["pass"])
             checks += expected != "not checked"
             failed += expected == "**FAIL**"
             name = f"{label}: {kind} " + " / ".join(row[column] for column in key_columns)
             matches = [shown for shown in shown_rows if names_row(shown, row, key_columns)]
-            check(len(matches) == 1, f"{name} shown {len(matches)} times")
+            assert len(matches) == 1, f"{name} shown {len(matches)} times"
             if len(matches) == 1:
                 result = matches[0].get("result", "")
-                check(shows_mark(result, expected, kind),
-                      f"{name}: shown '{result}', its pass column says {row['pass']}")
+                assert shows_mark(result, expected, kind), \
+                    f"{name}: shown '{result}', its pass column says {row['pass']}"
                 compared += 1
-    check(f"{checks} checks: {checks - failed} pass, {failed} fail." in text,
-          f"{label}: summary does not count the pass columns ({checks} checks, {failed} fail)")
-    check(len(failure_list(text)) == failed,
-          f"{label}: {len(failure_list(text))} failing checks listed, pass columns say {failed}")
+    assert f"{checks} checks: {checks - failed} pass, {failed} fail." in text, \
+        f"{label}: summary does not count the pass columns ({checks} checks, {failed} fail)"
+    assert len(failure_list(text)) == failed, \
+        f"{label}: {len(failure_list(text))} failing checks listed, pass columns say {failed}"
     return compared
 
 
-work = tempfile.mkdtemp(prefix="shaker-convergence-report-")
-try:
+def test_report_on_a_synthetic_study(work_dir):
+    work = work_dir
     inputs = os.path.join(work, "input")
     os.makedirs(os.path.join(inputs, "nested"))
     synthetic_study(inputs)
@@ -248,85 +244,89 @@ try:
 
     result = run("--input", inputs, "--output", report, "--commit", "abc123def",
                  "--build-type", "Release")
-    check(result.returncode == 0, f"exit code {result.returncode} without --strict: {result.stderr}")
+    assert result.returncode == 0, \
+        f"exit code {result.returncode} without --strict: {result.stderr}"
     text = open(report).read() if os.path.exists(report) else ""
     for header in ("- commit: abc123def", "- date: ", "- machine: ", "- build type: Release"):
-        check(header in text, f"header line '{header}' missing")
-    check("11 checks: 7 pass, 4 fail." in text, "summary count line missing or wrong")
+        assert header in text, f"header line '{header}' missing"
+    assert "11 checks: 7 pass, 4 fail." in text, "summary count line missing or wrong"
     check_marks_follow_the_judge(inputs, text, "synthetic")
 
     judged_in_band = [(field, norm) for field in ("n", "uz") for norm in ("L1", "L2", "Linf")
                       if (field, norm) != ("uz", "Linf")]
     for field, norm in judged_in_band:
         row = line_with(text, "| synthetic-1d-space | " + field + " | " + norm + " |")
-        check(row.endswith("| PASS |"), f"{field} {norm} should pass: '{row}'")
+        assert row.endswith("| PASS |"), f"{field} {norm} should pass: '{row}'"
         fitted = re.search(r"\| (\S+) ± ", row)
-        check(fitted is not None and abs(float(fitted.group(1)) - 2.0) < 0.05,
-              f"{field} {norm} fitted order missing: '{row}'")
+        assert fitted is not None and abs(float(fitted.group(1)) - 2.0) < 0.05, \
+            f"{field} {norm} fitted order missing: '{row}'"
     t_l1 = line_with(text, "| synthetic-1d-space | T | L1 |")
-    check("**FAIL**" in t_l1 and re.search(r"\| 1(\.0+)? ± ", t_l1) is not None,
-          f"T L1 must fail showing its measured order 1: '{t_l1}'")
+    assert "**FAIL**" in t_l1 and re.search(r"\| 1(\.0+)? ± ", t_l1) is not None, \
+        f"T L1 must fail showing its measured order 1: '{t_l1}'"
     # The judge's word against the band: shown as the pass column says, both ways.
     t_l2 = line_with(text, "| synthetic-1d-space | T | L2 |")
-    check(t_l2.endswith("| PASS |") and re.search(r"\| 1(\.0+)? ± ", t_l2) is not None,
-          f"T L2 (order 1, pass column 1) must be shown as PASS with its order 1: '{t_l2}'")
-    check(line_with(text, "- order synthetic-1d-space / T / L2") == "",
-          "T L2 is listed as failing although its pass column says 1")
+    assert t_l2.endswith("| PASS |") and re.search(r"\| 1(\.0+)? ± ", t_l2) is not None, \
+        f"T L2 (order 1, pass column 1) must be shown as PASS with its order 1: '{t_l2}'"
+    assert line_with(text, "- order synthetic-1d-space / T / L2") == "", \
+        "T L2 is listed as failing although its pass column says 1"
     uz_linf = line_with(text, "| synthetic-1d-space | uz | Linf |")
     fitted = re.search(r"\| (\S+) ± ", uz_linf)
-    check(uz_linf.endswith("| **FAIL** |") and fitted is not None
-          and abs(float(fitted.group(1)) - 2.0) < 0.05,
-          f"uz Linf (order 2, pass column 0) must be shown as failing: '{uz_linf}'")
-    check(line_with(text, "- order synthetic-1d-space / uz / Linf: fitted 1.99") != "",
-          "uz Linf is missing from the failure list although its pass column says 0")
-    check(line_with(text, "- order synthetic-1d-space / T / Linf: fitted 1") != "",
-          "failure list lacks the measured value of T Linf")
+    assert (uz_linf.endswith("| **FAIL** |") and fitted is not None
+            and abs(float(fitted.group(1)) - 2.0) < 0.05), \
+        f"uz Linf (order 2, pass column 0) must be shown as failing: '{uz_linf}'"
+    assert line_with(text, "- order synthetic-1d-space / uz / Linf: fitted 1.99") != "", \
+        "uz Linf is missing from the failure list although its pass column says 0"
+    assert line_with(text, "- order synthetic-1d-space / T / Linf: fitted 1") != "", \
+        "failure list lacks the measured value of T Linf"
 
     shock = line_with(text, "| base-1d | shock_location |")
-    check("PASS" in shock and "FAIL" not in shock, f"GCI row should pass: '{shock}'")
+    assert "PASS" in shock and "FAIL" not in shock, f"GCI row should pass: '{shock}'"
     mach = line_with(text, "| base-1d | max_mach |")
-    check("**FAIL**" in mach and "oscillatory" in mach and "| 2.8 |" in mach,
-          f"GCI row should fail with ratio 2.8: '{mach}'")
-    check(line_with(text, "GCI base-1d / max_mach: asymptotic ratio 2.8") != "",
-          "GCI failure missing from the summary")
+    assert "**FAIL**" in mach and "oscillatory" in mach and "| 2.8 |" in mach, \
+        f"GCI row should fail with ratio 2.8: '{mach}'"
+    assert line_with(text, "GCI base-1d / max_mach: asymptotic ratio 2.8") != "", \
+        "GCI failure missing from the summary"
 
     two_grid = line_with(text, "| base-3d | shock_location |")
-    check("not checked (two grids" in two_grid and "FAIL" not in two_grid,
-          f"two-grid row must be shown but not checked: '{two_grid}'")
+    assert "not checked (two grids" in two_grid and "FAIL" not in two_grid, \
+        f"two-grid row must be shown but not checked: '{two_grid}'"
 
     errors_header = line_with(text, "| field | norm | h = 0.1 |")
-    check("p(0-1)" in errors_header and "p(2-3)" in errors_header, "error table lacks pair orders")
+    assert "p(0-1)" in errors_header and "p(2-3)" in errors_header, "error table lacks pair orders"
     n_row = line_with(text, "| n | L1 | 0.00505 |")
-    check(n_row != "", "error table row of n L1 missing")
+    assert n_row != "", "error table row of n L1 missing"
 
     png = os.path.join(out_dir, "convergence-synthetic-1d-space.png")
-    check(os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
-          and os.path.getsize(png) > 5000, "PNG plot missing or not a PNG")
-    check("![synthetic-1d-space](convergence-synthetic-1d-space.png)" in text, "plot not linked")
+    assert (os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+            and os.path.getsize(png) > 5000), "PNG plot missing or not a PNG"
+    assert "![synthetic-1d-space](convergence-synthetic-1d-space.png)" in text, "plot not linked"
     leftovers = [f for f in os.listdir(out_dir) if f.startswith((".partial", ".old"))]
-    check(not leftovers, f"temporary files left: {leftovers}")
+    assert not leftovers, f"temporary files left: {leftovers}"
     # Every input table is kept beside the report, flat (the nested GCI table too), byte for
     # byte; a second run replaces the set rather than mixing old and new files.
     tables = os.path.join(out_dir, "convergence-tables")
     copied = sorted(os.listdir(tables)) if os.path.isdir(tables) else []
-    expected = sorted(os.path.basename(p) for p in glob.glob(os.path.join(inputs, "**", "*.csv"),
-                                                              recursive=True))
-    check(copied == expected, f"tables copied {copied}, expected {expected}")
-    check(open(os.path.join(tables, "qoi.gci.csv")).read()
-          == open(os.path.join(inputs, "nested", "qoi.gci.csv")).read(), "GCI table altered")
+    expected = sorted(os.path.basename(p)
+                      for p in glob.glob(os.path.join(inputs, "**", "*.csv"), recursive=True))
+    assert copied == expected, f"tables copied {copied}, expected {expected}"
+    assert (open(os.path.join(tables, "qoi.gci.csv")).read()
+            == open(os.path.join(inputs, "nested", "qoi.gci.csv")).read()), "GCI table altered"
     open(os.path.join(tables, "stale.errors.csv"), "w").close()
     open(os.path.join(out_dir, "convergence-removed-study.png"), "w").close()
-    check(run("--input", inputs, "--output", report).returncode == 0, "second report run failed")
-    check(not os.path.exists(os.path.join(tables, "stale.errors.csv")),
-          "a stale table survived the second run")
-    check(not os.path.exists(os.path.join(out_dir, "convergence-removed-study.png")),
-          "the plot of a study no longer in the input survived the second run")
-    check(os.path.exists(png), "the second run removed a plot the report links")
+    assert run("--input", inputs, "--output", report).returncode == 0, "second report run failed"
+    assert not os.path.exists(os.path.join(tables, "stale.errors.csv")), \
+        "a stale table survived the second run"
+    assert not os.path.exists(os.path.join(out_dir, "convergence-removed-study.png")), \
+        "the plot of a study no longer in the input survived the second run"
+    assert os.path.exists(png), "the second run removed a plot the report links"
 
     strict = run("--input", inputs, "--output", os.path.join(work, "strict", "c.md"), "--strict")
-    check(strict.returncode == 1 and "Traceback" not in strict.stderr,
-          f"--strict with failures must exit 1, got {strict.returncode}: {strict.stderr}")
+    assert strict.returncode == 1 and "Traceback" not in strict.stderr, \
+        f"--strict with failures must exit 1, got {strict.returncode}: {strict.stderr}"
 
+
+def test_the_pass_column_not_the_band_decides_and_bad_input_is_refused(work_dir):
+    work = work_dir
     # Numbers far outside the band, pass column 1: --strict has no failing check to exit on.
     lenient = os.path.join(work, "lenient")
     os.makedirs(lenient)
@@ -334,11 +334,12 @@ try:
           [("lenient", "T", "L2", 3, "1.0", "0.001", "1.0", "1.0", "2", "0.1", 1)])
     lenient_report = os.path.join(work, "lenient-out", "c.md")
     result = run("--input", lenient, "--output", lenient_report, "--strict")
-    check(result.returncode == 0, f"--strict when the judge passed every row must exit 0, "
-                                  f"got {result.returncode}: {result.stderr}")
+    assert result.returncode == 0, (
+        f"--strict when the judge passed every row must exit 0, "
+        f"got {result.returncode}: {result.stderr}")
     text = open(lenient_report).read() if os.path.exists(lenient_report) else ""
-    check(line_with(text, "| lenient | T | L2 |").endswith("| PASS |"),
-          "an out-of-band row with pass column 1 is not shown as PASS")
+    assert line_with(text, "| lenient | T | L2 |").endswith("| PASS |"), \
+        "an out-of-band row with pass column 1 is not shown as PASS"
     check_marks_follow_the_judge(lenient, text, "lenient")
 
     # The writers put 1 or 0 in an order table's pass column; anything else is not a verdict.
@@ -349,73 +350,77 @@ try:
               [("x", "n", "L2", 3, "2", "0.001", "2", "2", "2", "0.1", cell)])
         out = os.path.join(work, f"pass-{cell}-out", "c.md")
         result = run("--input", not_a_verdict, "--output", out)
-        check(result.returncode == 2 and f"pass = '{cell}' is not 1 or 0" in result.stderr,
-              f"pass {cell}: exit {result.returncode}, stderr '{result.stderr.strip()}'")
-        check(not os.path.exists(out), f"a report was written from pass column {cell}")
+        assert result.returncode == 2 and f"pass = '{cell}' is not 1 or 0" in result.stderr, \
+            f"pass {cell}: exit {result.returncode}, stderr '{result.stderr.strip()}'"
+        assert not os.path.exists(out), f"a report was written from pass column {cell}"
 
     bad = os.path.join(work, "bad")
     os.makedirs(bad)
     write(os.path.join(bad, "x.errors.csv"), "study,field,norm,h,error", [("s", "n", "L1", 1, 1)])
     bad_report = os.path.join(work, "bad-out", "convergence.md")
     result = run("--input", bad, "--output", bad_report)
-    check(result.returncode == 2 and "first line must be" in result.stderr,
-          f"bad header: exit {result.returncode}, stderr '{result.stderr.strip()}'")
-    check(not os.path.exists(bad_report), "a report was written from bad input")
+    assert result.returncode == 2 and "first line must be" in result.stderr, \
+        f"bad header: exit {result.returncode}, stderr '{result.stderr.strip()}'"
+    assert not os.path.exists(bad_report), "a report was written from bad input"
 
-    # ---- the MD sampling section, from its own input directory ----
+
+def test_md_sampling_section(work_dir):
+    """The MD sampling section, from its own input directory."""
+    work = work_dir
     sampling_in = os.path.join(work, "sampling-input")
     os.makedirs(sampling_in)
     synthetic_sampling_study(sampling_in)
     sampling_report = os.path.join(work, "sampling-out", "convergence.md")
     result = run("--input", sampling_in, "--output", sampling_report, "--commit", "abc")
-    check(result.returncode == 0, f"sampling report: exit {result.returncode}: {result.stderr}")
+    assert result.returncode == 0, f"sampling report: exit {result.returncode}: {result.stderr}"
     text = open(sampling_report).read() if os.path.exists(sampling_report) else ""
-    check("## MD sampling convergence" in text, "MD sampling section missing")
-    check("6 checks: 4 pass, 2 fail." in text, "sampling summary count missing or wrong")
+    assert "## MD sampling convergence" in text, "MD sampling section missing"
+    assert "6 checks: 4 pass, 2 fail." in text, "sampling summary count missing or wrong"
     check_marks_follow_the_judge(sampling_in, text, "synthetic sampling")
     row = line_with(text, "| synthetic-md-sampling | T_se_layer_rms | 0.22 |")
-    check(row.endswith("| PASS |") and "-0.5 ± " in row and "-0.92–-0.08" in row,
-          f"T_se fit should pass with its band shown: '{row}'")
+    assert row.endswith("| PASS |") and "-0.5 ± " in row and "-0.92–-0.08" in row, \
+        f"T_se fit should pass with its band shown: '{row}'"
     row = line_with(text, "| synthetic-md-sampling | center_of_mass | 0.5 |")
-    check("**FAIL**" in row and "| 0.05 ± " in row, f"flat se must fail with slope 0.05: '{row}'")
-    check(line_with(text, "- sampling synthetic-md-sampling / center_of_mass / f t 0.5: slope 0.05")
-          != "", "failing slope missing from the summary")
+    assert "**FAIL**" in row and "| 0.05 ± " in row, f"flat se must fail with slope 0.05: '{row}'"
+    assert line_with(text, "- sampling synthetic-md-sampling / center_of_mass / f t 0.5: "
+                     "slope 0.05") != "", "failing slope missing from the summary"
     row = line_with(text, "| synthetic-md-sampling | n_se_layer_rms | all |")
-    check(row.endswith("| PASS |") and "| -0.95 ± " in row,
-          f"slope -0.95 with pass column 1 must be shown as PASS: '{row}'")
-    check(line_with(text, "- sampling synthetic-md-sampling / n_se_layer_rms") == "",
-          "n_se_layer_rms is listed as failing although its pass column says 1")
+    assert row.endswith("| PASS |") and "| -0.95 ± " in row, \
+        f"slope -0.95 with pass column 1 must be shown as PASS: '{row}'"
+    assert line_with(text, "- sampling synthetic-md-sampling / n_se_layer_rms") == "", \
+        "n_se_layer_rms is listed as failing although its pass column says 1"
     se_header = line_with(text, "| quantity | f t | K = 2 | K = 4 | K = 8 | K = 16 |")
-    check(se_header != "", "se table header missing")
+    assert se_header != "", "se table header missing"
     se_row = line_with(text, "| T_se_layer_rms | 0.22 | 0.2121 |")
-    check(se_row.endswith("| 0.075 |"), f"se table row wrong: '{se_row}'")
-    all_rows = [l for l in text.splitlines() if l.startswith("| n_se_layer_rms | all | ")]
-    check(len(all_rows) == 1, f"the all-phases se row must appear once, found {len(all_rows)}")
+    assert se_row.endswith("| 0.075 |"), f"se table row wrong: '{se_row}'"
+    all_rows = [line for line in text.splitlines()
+                if line.startswith("| n_se_layer_rms | all | ")]
+    assert len(all_rows) == 1, f"the all-phases se row must appear once, found {len(all_rows)}"
     bins_t = line_with(text, "| synthetic-md-sampling | T | 0.22 |")
-    check(bins_t.endswith("| PASS |") and ">= 0.9" in bins_t, f"bin-size T should pass: '{bins_t}'")
+    assert bins_t.endswith("| PASS |") and ">= 0.9" in bins_t, f"bin-size T should pass: '{bins_t}'"
     bins_uz = line_with(text, "| synthetic-md-sampling | uz | 0.22 |")
-    check("**FAIL**" in bins_uz and "| 0.8 |" in bins_uz, f"bin-size uz should fail at 0.8: '{bins_uz}'")
-    check(line_with(text, "- bin size synthetic-md-sampling / uz: fraction of layer bins within 2 "
-                          "combined se = 0.8, required >= 0.9") != "", "bin-size failure not summarised")
+    assert "**FAIL**" in bins_uz and "| 0.8 |" in bins_uz, \
+        f"bin-size uz should fail at 0.8: '{bins_uz}'"
+    assert line_with(text, "- bin size synthetic-md-sampling / uz: fraction of layer bins "
+                     "within 2 combined se = 0.8, required >= 0.9") != "", \
+        "bin-size failure not summarised"
     shock = line_with(text, "| synthetic-md-sampling | shock_location | 0.22 | 17 | 17.5 |")
-    check(shock.endswith("| PASS |") and "<= 1.1" in shock, f"bin-size shock row wrong: '{shock}'")
+    assert shock.endswith("| PASS |") and "<= 1.1" in shock, f"bin-size shock row wrong: '{shock}'"
     png = os.path.join(work, "sampling-out", "sampling-synthetic-md-sampling.png")
-    check(os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
-          and os.path.getsize(png) > 5000, "sampling PNG missing or not a PNG")
-    check("(sampling-synthetic-md-sampling.png)" in text, "sampling plot not linked")
+    assert (os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+            and os.path.getsize(png) > 5000), "sampling PNG missing or not a PNG"
+    assert "(sampling-synthetic-md-sampling.png)" in text, "sampling plot not linked"
 
-    # ---- the repository's own tables: every mark of reports/convergence.md's input ----
+
+def test_repository_tables(work_dir):
+    """The repository's own tables: every mark of reports/convergence.md's input."""
+    work = work_dir
     repository_tables = os.path.join(REPORTS, "convergence-tables")
     repository_report = os.path.join(work, "repository-out", "convergence.md")
     result = run("--input", repository_tables, "--output", repository_report, "--strict")
     text = open(repository_report).read() if os.path.exists(repository_report) else ""
     compared = check_marks_follow_the_judge(repository_tables, text, "repository")
-    check(compared > 0, "no judged row of the repository's tables was compared")
-    check(result.returncode == (1 if failure_list(text) else 0),
-          f"--strict exit {result.returncode} with {len(failure_list(text))} failing checks")
+    assert compared > 0, "no judged row of the repository's tables was compared"
+    assert result.returncode == (1 if failure_list(text) else 0), \
+        f"--strict exit {result.returncode} with {len(failure_list(text))} failing checks"
     print(f"{compared} rows of the repository's tables shown as their pass column says")
-finally:
-    shutil.rmtree(work, ignore_errors=True)
-
-print(f"{len(failures)} failures")
-sys.exit(1 if failures else 0)

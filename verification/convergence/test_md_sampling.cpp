@@ -52,6 +52,7 @@
 #include "common/run_file.hpp"
 #include "md/run_md.hpp"
 #include "md_sampling.hpp"
+#include "support/test_directory.hpp"
 
 namespace conv = shaker::convergence;
 namespace analysis = shaker::analysis;
@@ -61,11 +62,7 @@ namespace {
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 std::filesystem::path fresh_directory(const std::string& test) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("shaker-md-sampling-" + test + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return shaker::testing::test_directory("shaker-md-sampling-", test);
 }
 
 // ---- the statistics, on synthetic cycles ------------------------------------------------

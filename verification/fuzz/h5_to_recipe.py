@@ -61,7 +61,8 @@ def main():
         f.visititems(visit)
     skipped = sum(r is None for r in records)
     if skipped:
-        sys.exit(f"h5_to_recipe.py: {skipped} objects of {sys.argv[1]} cannot be written as a recipe")
+        sys.exit(f"h5_to_recipe.py: {skipped} objects of {sys.argv[1]} cannot be written as a "
+                 "recipe")
     with open(sys.argv[2], "wb") as out:
         out.write(b"".join(records))
 

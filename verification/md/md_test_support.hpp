@@ -9,18 +9,12 @@
 
 #include "md/geometry.hpp"
 #include "md/simulation.hpp"
+#include "support/test_directory.hpp"
 
 namespace shaker::md::testing {
 
-/// A fresh directory for one test and process (ctest -j safe, also with two ctest runs at once).
 inline std::filesystem::path test_directory() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const auto dir = std::filesystem::temp_directory_path() /
-                   (std::string("shaker-md-") + info->test_suite_name() + "-" + info->name() + "-" +
-                    std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return shaker::testing::test_directory("shaker-md-");
 }
 
 inline Vec3 total_momentum(const Simulation& s) {

@@ -17,6 +17,7 @@
 #include "continuum/operator.hpp"
 #include "continuum/riemann.hpp"
 #include "mms_run.hpp"
+#include "support/test_directory.hpp"
 
 namespace mms = shaker::mms;
 namespace conv = shaker::convergence;
@@ -28,17 +29,7 @@ namespace {
 constexpr double design_space_order = 2.0;  // MUSCL (unlimited) + central viscous fluxes
 constexpr double order_tolerance = 0.1;
 
-std::filesystem::path test_directory() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = std::string(info->test_suite_name()) + "-" + info->name();
-  for (char& ch : name)
-    if (ch == '/') ch = '_';
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("shaker-mms-" + name + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+std::filesystem::path test_directory() { return shaker::testing::test_directory("shaker-mms-"); }
 
 std::string study_name() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

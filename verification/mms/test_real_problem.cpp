@@ -28,6 +28,7 @@
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
 #include "error_table.hpp"
+#include "support/test_directory.hpp"
 
 namespace conv = shaker::convergence;
 namespace analysis = shaker::analysis;
@@ -84,11 +85,7 @@ std::map<std::string, double> quantities(const shaker::RunRecord& run) {
 using Quantities = std::map<std::string, double>;
 
 std::filesystem::path study_directory(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("shaker-mms-" + name + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
+  return shaker::testing::test_directory("shaker-mms-", name);
 }
 
 /// The base case at cell size h under the study's protocol (plus `extra` settings), analysed.

@@ -1,16 +1,13 @@
-#!/usr/bin/python3
 """The soak checks (soak.py) on synthetic run files: a clean series passes, and each broken
 invariant (an overlap, an open energy budget, an inconsistent queue, a mass drift, a budget
 residual, a missing row) is reported at the row where it breaks."""
 import os
-import sys
-import tempfile
 
 import h5py
 import numpy as np
+import pytest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import soak  # noqa: E402
+import soak  # beside this file: pytest puts a test's folder on sys.path (no __init__.py here)
 
 
 def write(path, columns, phases):
@@ -37,54 +34,46 @@ def continuum_series(rows):
             "center_of_mass_change_from_previous_cycle": np.full(rows, np.nan)}
 
 
-def failures_of(solver, columns, expected_rows):
-    with tempfile.TemporaryDirectory(prefix="shaker-soak-check-") as directory:
-        path = os.path.join(directory, "run.h5")
-        write(path, columns, 4)
-        return soak.check_file(path, solver, expected_rows)[0]
+def broken(series, column, row, value=None, factor=None):
+    """series with one value replaced (or scaled by factor) at a row."""
+    if factor is not None:
+        series[column][row] *= factor
+    else:
+        series[column][row] = value
+    return series
 
 
-def main():
-    problems = []
-
-    def expect(label, failures, fragment):
-        found = [f for f in failures if fragment in f] if fragment else failures
-        if fragment is None and failures:
-            problems.append(f"{label}: expected no failure, got {failures}")
-        elif fragment is not None and not found:
-            problems.append(f"{label}: expected a failure naming '{fragment}', got {failures}")
-        print(f"{label}: {failures if failures else 'passes'}")
-
-    rows = 9
-    expect("md clean", failures_of("md", md_series(rows), rows), None)
-    broken = md_series(rows)
-    broken["overlaps"][5] = 1
-    expect("md overlap", failures_of("md", broken, rows), "first at row 5")
-    broken = md_series(rows)
-    broken["energy_closure"][3] = 2e-9
-    expect("md closure", failures_of("md", broken, rows), "energy_closure (allowed <= 1e-09): 1 rows fail, the first at row 3")
-    broken = md_series(rows)
-    broken["queue_consistent"][7] = 0
-    expect("md queue", failures_of("md", broken, rows), "queue_consistent (allowed 1): 1 rows fail, the first at row 7")
-    expect("md missing row", failures_of("md", md_series(rows - 1), rows), "has 8 rows, expected 9")
-    broken = md_series(rows)
-    broken["energy_closure"][2] = np.nan
-    expect("md NaN", failures_of("md", broken, rows), "energy_closure (allowed finite)")
-
-    rows = 8
-    expect("continuum clean", failures_of("continuum", continuum_series(rows), rows), None)
-    broken = continuum_series(rows)
-    broken["total_mass"][4] *= 1 + 1e-11
-    expect("continuum mass", failures_of("continuum", broken, rows), "total_mass relative drift")
-    broken = continuum_series(rows)
-    broken["energy_budget_residual"][6] = 1e-6
-    expect("continuum budget", failures_of("continuum", broken, rows), "energy_budget_residual / throughput")
-
-    for problem in problems:
-        print(f"FAILED: {problem}", file=sys.stderr)
-    print(f"{9 - len(problems)} passed, {len(problems)} failed")
-    return 1 if problems else 0
+MD_ROWS, CONTINUUM_ROWS = 9, 8
+# label, solver, columns, expected rows, fragment of the expected failure (None: no failure)
+CASES = [
+    ("md clean", "md", md_series(MD_ROWS), MD_ROWS, None),
+    ("md overlap", "md", broken(md_series(MD_ROWS), "overlaps", 5, 1), MD_ROWS,
+     "first at row 5"),
+    ("md closure", "md", broken(md_series(MD_ROWS), "energy_closure", 3, 2e-9), MD_ROWS,
+     "energy_closure (allowed <= 1e-09): 1 rows fail, the first at row 3"),
+    ("md queue", "md", broken(md_series(MD_ROWS), "queue_consistent", 7, 0), MD_ROWS,
+     "queue_consistent (allowed 1): 1 rows fail, the first at row 7"),
+    ("md missing row", "md", md_series(MD_ROWS - 1), MD_ROWS, "has 8 rows, expected 9"),
+    ("md NaN", "md", broken(md_series(MD_ROWS), "energy_closure", 2, np.nan), MD_ROWS,
+     "energy_closure (allowed finite)"),
+    ("continuum clean", "continuum", continuum_series(CONTINUUM_ROWS), CONTINUUM_ROWS, None),
+    ("continuum mass", "continuum",
+     broken(continuum_series(CONTINUUM_ROWS), "total_mass", 4, factor=1 + 1e-11), CONTINUUM_ROWS,
+     "total_mass relative drift"),
+    ("continuum budget", "continuum",
+     broken(continuum_series(CONTINUUM_ROWS), "energy_budget_residual", 6, 1e-6), CONTINUUM_ROWS,
+     "energy_budget_residual / throughput"),
+]
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+@pytest.mark.parametrize("label, solver, columns, expected_rows, fragment", CASES,
+                         ids=[case[0] for case in CASES])
+def test_soak_checks(label, solver, columns, expected_rows, fragment, work_dir):
+    path = os.path.join(work_dir, "run.h5")
+    write(path, columns, 4)
+    failures = soak.check_file(path, solver, expected_rows)[0]
+    if fragment is None:
+        assert not failures, f"{label}: expected no failure, got {failures}"
+    else:
+        assert [f for f in failures if fragment in f], \
+            f"{label}: expected a failure naming '{fragment}', got {failures}"

@@ -31,7 +31,8 @@ def main():
     sys.stdout.writelines(difflib.unified_diff(stored.splitlines(True), generated.splitlines(True),
                                                "docs/configuration.md", "shaker config --describe"))
     print("\ndocs/configuration.md is out of date; regenerate it from the source directory with\n"
-          "    build/release/solvers/app/shaker config --describe --markdown > docs/configuration.md")
+          "    build/release/solvers/app/shaker config --describe --markdown"
+          " > docs/configuration.md")
     return 1
 
 

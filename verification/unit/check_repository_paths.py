@@ -15,6 +15,7 @@ import re
 import subprocess
 import sys
 
+
 def patterns(source_dir):
     outside = [r"\.\./shared\b",
                r"(?<![\w.~-])/(?:work|root|home|tmp)/"]  # absolute, not validation/work/

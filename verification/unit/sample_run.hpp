@@ -1,6 +1,6 @@
 #pragma once
 // A small deterministic RunRecord shared by the run-file round-trip test and the helper
-// program whose output check_run_file_h5py.py reads. Every number is a dyadic rational, so
+// program whose output test_run_file_h5py.py reads. Every number is a dyadic rational, so
 // the Python check can recompute it exactly; keep the formulas in step with that script.
 #include <string>
 

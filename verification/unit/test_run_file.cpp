@@ -1,6 +1,6 @@
 // Unit tests of the HDF5 run file (solvers/common/run_file.hpp, hdf5_file.hpp): exact round
 // trip, provenance, atomic writes and the errors a reader gives for foreign or damaged files.
-// The same file layout is read independently with h5py by check_run_file_h5py.py.
+// The same file layout is read independently with h5py by test_run_file_h5py.py.
 #include <gtest/gtest.h>
 #include <hdf5.h>
 

@@ -12,28 +12,17 @@
 #include <vector>
 
 #include "common/errors.hpp"
+#include "support/test_directory.hpp"
 
 namespace shaker::testing {
 
-/// A fresh directory named after the running test and the process; removed on destruction.
+/// A fresh directory named after the running test and the process; removed when the test
+/// passes, kept when it fails (support/test_directory.hpp).
 class TemporaryDirectory {
  public:
-  TemporaryDirectory() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string("shaker-unit-") + info->test_suite_name() + "-" + info->name() +
-                       "-" + std::to_string(::getpid());
-    for (char& c : name)
-      if (c == '/') c = '_';
-    path_ = std::filesystem::temp_directory_path() / name;
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
+  TemporaryDirectory() : path_(test_directory("shaker-unit-")) {}
   TemporaryDirectory(const TemporaryDirectory&) = delete;
   TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
-  ~TemporaryDirectory() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
   const std::filesystem::path& path() const { return path_; }
   std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
 

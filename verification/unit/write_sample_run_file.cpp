@@ -1,5 +1,5 @@
 // Writes the sample run (sample_run.hpp) to the path given on the command line, for the
-// h5py check (check_run_file_h5py.py). Exit code 0 on success.
+// h5py check (test_run_file_h5py.py). Exit code 0 on success.
 #include <cstdio>
 #include <exception>
 

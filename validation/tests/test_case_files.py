@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """ctest validation.case_files: every validation case file is accepted by `shaker config`
 (exit status 0), with every override the runner adds (quick mode, pooled single-shock runs,
 the collapse-guard fallback); validation/studies.toml and validation/cases/ list the same
@@ -6,20 +5,16 @@ cases; each file's case.name is its file name; and the study's defining values r
 effective configuration (particle numbers, ceilings, widths, e, protocol). A file with an
 unknown key must be rejected (exit status 2), so acceptance means something.
 
-    check_case_files.py --shaker SHAKER
+    python3 -m pytest validation/tests/test_case_files.py --shaker SHAKER
 """
-import argparse
 import glob
 import os
 import subprocess
-import sys
-import tempfile
 import tomllib
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-VALIDATION = os.path.dirname(HERE)
-sys.path.insert(0, VALIDATION)
-import run_validation  # noqa: E402
+from validation import run_validation
+
+VALIDATION = os.path.dirname(os.path.abspath(run_validation.__file__))
 
 # What each study of issue 6 must set (key path -> value) in the effective configuration.
 EXPECTED = {
@@ -54,59 +49,50 @@ def lookup(config, dotted):
     return config[section][key]
 
 
-def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--shaker", required=True)
-    shaker = os.path.abspath(parser.parse_args().shaker)
+STUDIES = run_validation.load_studies(os.path.join(VALIDATION, "studies.toml"))
+FILES = {os.path.splitext(os.path.basename(p))[0]
+         for p in glob.glob(os.path.join(VALIDATION, "cases", "*.toml"))}
+LISTED = set(STUDIES["by_name"])
+
+
+def test_case_files_are_the_studies():
+    assert FILES == LISTED, (f"case files {sorted(FILES - LISTED)} not in studies.toml; studies "
+                             f"without a file: {sorted(LISTED - FILES)}")
+    assert set(EXPECTED) == LISTED, f"no expectations for {sorted(LISTED - set(EXPECTED))}"
+
+
+def test_effective_configurations(shaker):
     problems = []
-    studies = run_validation.load_studies(os.path.join(VALIDATION, "studies.toml"))
-    files = {os.path.splitext(os.path.basename(p))[0]
-             for p in glob.glob(os.path.join(VALIDATION, "cases", "*.toml"))}
-    listed = set(studies["by_name"])
-    if files != listed:
-        problems.append(f"case files {sorted(files - listed)} not in studies.toml; studies "
-                        f"without a file: {sorted(listed - files)}")
-    if set(EXPECTED) != listed:
-        problems.append(f"no expectations for {sorted(listed - set(EXPECTED))}")
-    checked = 0
-    for name in sorted(files & listed):
+    for name in sorted(FILES & LISTED):
         try:
             config = tomllib.loads(run_validation.effective_config(shaker, name, []))
         except ValueError as error:
             problems.append(str(error))
             continue
-        checked += 1
         if config["case"]["name"] != name:
             problems.append(f"{name}: case.name is '{config['case']['name']}'")
         for key, value in EXPECTED.get(name, {}).items():
             if lookup(config, key) != value:
                 problems.append(f"{name}: {key} = {lookup(config, key)!r}, expected {value!r}")
-    # Every run the runner would start, full and quick, with pool and fallback overrides.
+    assert problems == []
+
+
+def test_every_planned_run_is_accepted(shaker):
+    """Every run the runner would start, full and quick, with pool and fallback overrides."""
     for quick in (False, True):
-        names = sorted(listed) if not quick else studies["quick"]["cases"]
-        try:
-            plan = run_validation.plan_runs(shaker, studies, names, quick)
-            for run in plan:
-                run_validation.run_key(shaker, run)
-                if run["fallback"]:
-                    run_validation.run_key(shaker, dict(run, overrides=run["overrides"]
-                                                        + run["fallback"]))
-                checked += 1
-        except ValueError as error:
-            problems.append(f"{'quick' if quick else 'full'} plan: {error}")
-    # The control: an unknown key must be refused.
-    with tempfile.TemporaryDirectory(prefix="validation-case-files-") as tmp:
-        bad = os.path.join(tmp, "bad.toml")
-        with open(bad, "w") as f:
-            f.write("[layer]\nparticle = 3937\n")
-        rc = subprocess.run([shaker, "config", bad], capture_output=True).returncode
-        if rc != 2:
-            problems.append(f"shaker config accepted a file with an unknown key (exit {rc})")
-    for p in problems:
-        print(f"problem: {p}")
-    print(f"{checked} effective configurations checked, {len(problems)} problems")
-    return 1 if problems else 0
+        names = sorted(LISTED) if not quick else STUDIES["quick"]["cases"]
+        plan = run_validation.plan_runs(shaker, STUDIES, names, quick)
+        for run in plan:
+            run_validation.run_key(shaker, run)
+            if run["fallback"]:
+                run_validation.run_key(shaker, dict(run, overrides=run["overrides"]
+                                                    + run["fallback"]))
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def test_unknown_key_is_refused(shaker, work_dir):
+    """The control: an unknown key must be refused."""
+    bad = os.path.join(work_dir, "bad.toml")
+    with open(bad, "w") as f:
+        f.write("[layer]\nparticle = 3937\n")
+    rc = subprocess.run([shaker, "config", bad], capture_output=True).returncode
+    assert rc == 2, f"shaker config accepted a file with an unknown key (exit {rc})"

@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """ctest validation.claims_file: reference-data/claims.toml holds C1..C20, each once, with
 every field, a quantity the runner knows (validation/quantities.py) and the parameters it
 needs, a known comparison with a band of the right shape, cases that validation/studies.toml
@@ -7,19 +6,18 @@ validation/diagnoses.toml names known claims, categories, quantities and cases.
 
 It then checks that the checker itself catches broken files (a missing field, an unknown
 quantity, a band of the wrong length, a missing id, a case nobody runs), so that a pass means
-something. Exit status 0 only if the real file is clean and every broken copy is caught.
+something.
 """
 import copy
 import os
-import sys
 import tomllib
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-VALIDATION = os.path.dirname(HERE)
+import pytest
+
+from validation import quantities, run_validation
+
+VALIDATION = os.path.dirname(os.path.abspath(quantities.__file__))
 ROOT = os.path.dirname(VALIDATION)
-sys.path.insert(0, VALIDATION)
-import quantities  # noqa: E402
-import run_validation  # noqa: E402
 
 FIELDS = {"id": str, "statement": str, "paper_value": str, "cases": list, "quantity": str,
           "parameters": dict, "comparison": str, "band": list, "solvers": str,
@@ -86,8 +84,8 @@ def validate(claims, studies):
                 elif not SOLVERS[claim["solvers"]] <= runs[case]:
                     errors.append(f"{where}: case '{case}' is not run with "
                                   f"{sorted(SOLVERS[claim['solvers']] - runs[case])}")
-        if "Sec." not in claim.get("provenance", "") and "Fig." not in claim.get("provenance",
-                                                                                   ""):
+        provenance = claim.get("provenance", "")
+        if "Sec." not in provenance and "Fig." not in provenance:
             errors.append(f"{where}: provenance names no section or figure of the paper")
         if "continuum_gci" in claim and not (
                 isinstance(claim["continuum_gci"], str) and claim["continuum_gci"]
@@ -138,42 +136,42 @@ def broken_diagnoses(diagnoses):
     ]
 
 
-def check_diagnoses(claims, studies):
-    """validation/diagnoses.toml is clean, and its checker catches broken copies."""
-    with open(os.path.join(VALIDATION, "diagnoses.toml"), "rb") as f:
-        diagnoses = tomllib.load(f)["diagnosis"]
-    errors = run_validation.validate_diagnoses(diagnoses, claims, studies)
-    for e in errors:
-        print(f"diagnoses.toml: {e}")
-    print(f"diagnoses.toml: {len(diagnoses)} diagnoses, {len(errors)} problems")
-    failures = len(errors)
-    for description, broken in broken_diagnoses(diagnoses):
-        found = run_validation.validate_diagnoses(broken, claims, studies)
-        print(f"broken diagnoses ({description}): {len(found)} problem(s) found"
-              + (f": {found[0]}" if found else " -- NOT CAUGHT"))
-        failures += 0 if found else 1
-    return failures
-
-
-def main():
+def load_claims_and_studies():
     with open(os.path.join(ROOT, "reference-data", "claims.toml"), "rb") as f:
         claims = tomllib.load(f)["claim"]
     with open(os.path.join(VALIDATION, "studies.toml"), "rb") as f:
         studies = tomllib.load(f)
-    failures = 0
-    errors = validate(claims, studies)
-    for e in errors:
-        print(f"claims.toml: {e}")
-    failures += len(errors)
-    print(f"claims.toml: {len(claims)} claims, {len(errors)} problems")
-    for description, broken in broken_copies(claims):
-        found = validate(broken, studies)
-        print(f"broken copy ({description}): {len(found)} problem(s) found"
-              + (f": {found[0]}" if found else " -- NOT CAUGHT"))
-        failures += 0 if found else 1
-    failures += check_diagnoses(claims, studies)
-    return 1 if failures else 0
+    return claims, studies
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def load_diagnoses():
+    with open(os.path.join(VALIDATION, "diagnoses.toml"), "rb") as f:
+        return tomllib.load(f)["diagnosis"]
+
+
+CLAIMS, STUDIES = load_claims_and_studies()
+DIAGNOSES = load_diagnoses()
+
+
+def test_claims_file_is_clean():
+    errors = validate(CLAIMS, STUDIES)
+    assert errors == [], f"claims.toml: {len(CLAIMS)} claims, {len(errors)} problems"
+
+
+@pytest.mark.parametrize("description, broken", broken_copies(CLAIMS),
+                         ids=[d for d, _ in broken_copies(CLAIMS)])
+def test_broken_claims_are_caught(description, broken):
+    assert validate(broken, STUDIES), f"broken copy ({description}) NOT CAUGHT"
+
+
+def test_diagnoses_file_is_clean():
+    """validation/diagnoses.toml is clean, and its checker catches broken copies."""
+    errors = run_validation.validate_diagnoses(DIAGNOSES, CLAIMS, STUDIES)
+    assert errors == [], f"diagnoses.toml: {len(DIAGNOSES)} diagnoses, {len(errors)} problems"
+
+
+@pytest.mark.parametrize("description, broken", broken_diagnoses(DIAGNOSES),
+                         ids=[d for d, _ in broken_diagnoses(DIAGNOSES)])
+def test_broken_diagnoses_are_caught(description, broken):
+    assert run_validation.validate_diagnoses(broken, CLAIMS, STUDIES), \
+        f"broken diagnoses ({description}) NOT CAUGHT"

@@ -1,0 +1,1 @@
+"""The report generators (make_*_report) and what they share (report_common)."""

@@ -1,0 +1,1 @@
+"""pytest tests of the validation package (run by ctest as validation.*)."""
