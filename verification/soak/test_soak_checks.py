@@ -27,11 +27,11 @@ def md_series(rows):
 
 def continuum_series(rows):
     work = np.linspace(0.0, 50.0, rows)
-    return {"time": np.arange(rows, dtype=float), "total_mass": np.full(rows, 9.8),
+    return {"t": np.arange(rows, dtype=float), "total_mass": np.full(rows, 9.8),
             "accumulated_body_work": work, "accumulated_collisional_loss": work * 0.9,
             # zero at the first row by definition (relative to it), round-off after
             "energy_budget_residual": np.concatenate([[0.0], np.full(rows - 1, 1e-14)]),
-            "center_of_mass_change_from_previous_cycle": np.full(rows, np.nan)}
+            "com_z_change_from_previous_cycle": np.full(rows, np.nan)}
 
 
 def broken(series, column, row, value=None, factor=None):

@@ -18,7 +18,6 @@ In a fresh temporary directory (removed when every check passes, kept and printe
      continued run ends where the straight run does.
 Exit code 0 when every check holds.
 """
-import os
 import shutil
 import signal
 import subprocess
@@ -35,7 +34,8 @@ import numpy as np
 CASES = {
     "md": dict(case="[layer]\nparticles = 200\n[md]\nbox_width = 6.0\nceiling = 60.0\n",
                cycles=(2, 38), first=(1, 1), phases=10),
-    "continuum": dict(case="[continuum]\ncell_size = 0.5\n", cycles=(2, 6), first=(1, 1), phases=10),
+    "continuum": dict(case="[continuum]\ncell_size = 0.5\n", cycles=(2, 6), first=(1, 1),
+                      phases=10),
 }
 # Time-series columns that count from the start of each run (docs/output-schema.md), or that
 # compare with rows before it: a continued run starts them afresh, so they are not compared.
@@ -65,7 +65,8 @@ class Runs:
     def arguments(self, output, cycles, settings, progress=False):
         sets = {"run.output": output, "run.transient_cycles": cycles[0],
                 "run.sampled_cycles": cycles[1], **settings}
-        args = [self.shaker, self.solver, "case.toml"] + (["--progress-interval", "0"] if progress else ["--quiet"])
+        args = [self.shaker, self.solver, "case.toml"]
+        args += ["--progress-interval", "0"] if progress else ["--quiet"]
         for key, value in sets.items():
             args += ["--set", f"{key}={value}"]
         return args
@@ -73,7 +74,8 @@ class Runs:
     def run(self, output, cycles, **settings):
         done = subprocess.run(self.arguments(output, cycles, settings), cwd=self.dir,
                               capture_output=True, text=True)
-        check(done.returncode == 0, f"{self.solver} {output}: exit {done.returncode}\n{done.stderr}")
+        check(done.returncode == 0,
+              f"{self.solver} {output}: exit {done.returncode}\n{done.stderr}")
         return done
 
     def stopped(self, output, cycles, checkpoint):
@@ -81,14 +83,16 @@ class Runs:
         periodic checkpoint of cycle 0; the run stops at that phase if the signal comes in at
         once, else at a later one); its exit status and output."""
         process = subprocess.Popen(
-            self.arguments(output, cycles, {"run.checkpoint": checkpoint, "run.checkpoint_every": 1}, True),
+            self.arguments(output, cycles,
+                           {"run.checkpoint": checkpoint, "run.checkpoint_every": 1}, True),
             cwd=self.dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         seen = []
         for line in process.stderr:
             seen.append(line)
             if sum(f": cycle 2 of {sum(cycles)}," in line for line in seen) == 2:
                 break
-        check((self.dir / checkpoint).exists(), f"{self.solver}: no periodic checkpoint before cycle 1")
+        check((self.dir / checkpoint).exists(),
+              f"{self.solver}: no periodic checkpoint before cycle 1")
         process.send_signal(signal.SIGTERM)
         out, err = process.communicate()
         return process.returncode, out + "".join(seen) + err
@@ -103,12 +107,16 @@ def position(path):
 def same_checkpoints(a, b, what):
     """Every dataset and attribute but the configuration (which names the files) equal."""
     with h5py.File(a, "r") as x, h5py.File(b, "r") as y:
-        check(sorted(x.keys()) == sorted(y.keys()), f"{what}: datasets {sorted(x.keys())} != {sorted(y.keys())}")
-        differing = [name for name in x.keys() if name in y and x[name][()].tobytes() != y[name][()].tobytes()]
+        check(sorted(x.keys()) == sorted(y.keys()),
+              f"{what}: datasets {sorted(x.keys())} != {sorted(y.keys())}")
+        differing = [name for name in x.keys()
+                     if name in y and x[name][()].tobytes() != y[name][()].tobytes()]
         check(not differing, f"{what}: datasets differ: {differing}")
         attributes = set(x.attrs) - {"configuration"}
         check(attributes == set(y.attrs) - {"configuration"}, f"{what}: attributes differ in name")
-        differing = [name for name in attributes if np.asarray(x.attrs[name]).tobytes() != np.asarray(y.attrs.get(name)).tobytes()]
+        differing = [name for name in attributes
+                     if np.asarray(x.attrs[name]).tobytes()
+                     != np.asarray(y.attrs.get(name)).tobytes()]
         check(not differing, f"{what}: attributes differ: {differing}")
         return len(x.keys()), len(attributes)
 
@@ -120,7 +128,8 @@ def same_rows_after_restart(solver, straight, continued, what):
         rows = len(b["t"])
         start = len(a["t"]) - rows
         if not check(rows > 0 and start > 0 and a["t"][start] == b["t"][0],
-                     f"{what}: the continued run's {rows} rows do not start at a row of the straight run"):
+                     f"{what}: the continued run's {rows} rows do not start at a row of the "
+                     "straight run"):
             return 0, 0
         columns = [name for name in b.keys() if name not in RUN_RELATIVE[solver]
                    and not name.startswith(RUN_RELATIVE_PREFIXES)]
@@ -131,36 +140,45 @@ def same_rows_after_restart(solver, straight, continued, what):
 
 
 def report(what, checkpoint_counts, row_counts):
-    print(f"{what}: final checkpoint equal to the straight run's in {checkpoint_counts[0]} datasets "
-          f"and {checkpoint_counts[1]} attributes; {row_counts[0]} rows x {row_counts[1]} columns equal")
+    print(f"{what}: final checkpoint equal to the straight run's in {checkpoint_counts[0]} "
+          f"datasets and {checkpoint_counts[1]} attributes; {row_counts[0]} rows x "
+          f"{row_counts[1]} columns equal")
 
 
 def kept_two(runs, cycles):
     """Check 1: exactly the final checkpoint and the one before it, both valid."""
     total = sum(cycles)
     files = sorted(p.name for p in runs.dir.glob("straight.ckpt*"))
-    check(files == ["straight.ckpt.h5", "straight.ckpt.previous.h5"], f"checkpoint files kept: {files}")
+    check(files == ["straight.ckpt.h5", "straight.ckpt.previous.h5"],
+          f"checkpoint files kept: {files}")
     with h5py.File(runs.dir / "straight.run.h5", "r") as f:
         times = f["timeseries"]["t"][:]
     end, last_phase = (times[-1], times[-2]) if runs.solver == "md" else (None, times[-1])
-    final, previous = position(runs.dir / "straight.ckpt.h5"), position(runs.dir / "straight.ckpt.previous.h5")
+    final = position(runs.dir / "straight.ckpt.h5")
+    previous = position(runs.dir / "straight.ckpt.previous.h5")
     check(final[:3] == (total, 0, runs.spec["phases"]), f"final checkpoint at {final}")
-    check(previous == (total, 0, runs.spec["phases"], last_phase), f"previous checkpoint at {previous}, "
-          f"expected after the last stored phase t = {last_phase}")
+    check(previous == (total, 0, runs.spec["phases"], last_phase),
+          f"previous checkpoint at {previous}, expected after the last stored phase "
+          f"t = {last_phase}")
     if end is not None:
         check(final[3] == end, f"final checkpoint time {final[3]} != the run's end {end}")
-    runs.run("more.run.h5", (cycles[0], cycles[1] + 1), **{"run.restart_from": "straight.ckpt.previous.h5"})
-    print(f"{runs.solver}: {files} kept after {total} cycles with run.checkpoint_every = 1; final at "
-          f"{final[:3]}, previous at t = {previous[3]}, which continues to {total + 1} cycles")
+    runs.run("more.run.h5", (cycles[0], cycles[1] + 1),
+             **{"run.restart_from": "straight.ckpt.previous.h5"})
+    print(f"{runs.solver}: {files} kept after {total} cycles with run.checkpoint_every = 1; "
+          f"final at {final[:3]}, previous at t = {previous[3]}, which continues to "
+          f"{total + 1} cycles")
 
 
 def split_run(runs, cycles):
     """Check 2: K cycles, then continued to N."""
     runs.run("first.run.h5", runs.spec["first"], **{"run.checkpoint": "first.ckpt.h5"})
-    runs.run("rest.run.h5", cycles, **{"run.restart_from": "first.ckpt.h5", "run.checkpoint": "rest.ckpt.h5"})
-    what = f"{runs.solver}: {sum(runs.spec['first'])} cycles + {sum(cycles) - sum(runs.spec['first'])} after a restart"
+    runs.run("rest.run.h5", cycles,
+             **{"run.restart_from": "first.ckpt.h5", "run.checkpoint": "rest.ckpt.h5"})
+    first = sum(runs.spec["first"])
+    what = f"{runs.solver}: {first} cycles + {sum(cycles) - first} after a restart"
     report(what, same_checkpoints(runs.dir / "straight.ckpt.h5", runs.dir / "rest.ckpt.h5", what),
-           same_rows_after_restart(runs.solver, runs.dir / "straight.run.h5", runs.dir / "rest.run.h5", what))
+           same_rows_after_restart(runs.solver, runs.dir / "straight.run.h5",
+                                   runs.dir / "rest.run.h5", what))
 
 
 def stopped_run(runs, cycles):
@@ -171,7 +189,8 @@ def stopped_run(runs, cycles):
         status, output = runs.stopped(f"stop{attempt}.run.h5", cycles, checkpoint)
         if not check(status == 143 and "stopped by signal 15 (SIGTERM)" in output
                      and f"run.restart_from={checkpoint}" in output,
-                     f"{runs.solver}: SIGTERM gave exit {status}; expected 143 and the message:\n{output}"):
+                     f"{runs.solver}: SIGTERM gave exit {status}; expected 143 and the "
+                     f"message:\n{output}"):
             return
         check(not (runs.dir / f"stop{attempt}.run.h5").exists(), "a stopped run wrote its run file")
         cycle, phase, _, t = position(runs.dir / checkpoint)
@@ -180,11 +199,14 @@ def stopped_run(runs, cycles):
             break
         print(f"{runs.solver}: attempt {attempt} stopped at a cycle's first phase; again")
     check(reached != 0, f"{runs.solver}: three stops in a row on a cycle's first phase")
-    runs.run("resumed.run.h5", cycles, **{"run.restart_from": checkpoint, "run.checkpoint": "resumed.ckpt.h5"})
+    runs.run("resumed.run.h5", cycles,
+             **{"run.restart_from": checkpoint, "run.checkpoint": "resumed.ckpt.h5"})
     what = (f"{runs.solver}: stopped by SIGTERM at t = {t!r} (stored phase {reached} of {phases}, "
             f"continued at cycle {cycle} phase {phase}), continued to {sum(cycles)} cycles")
-    report(what, same_checkpoints(runs.dir / "straight.ckpt.h5", runs.dir / "resumed.ckpt.h5", what),
-           same_rows_after_restart(runs.solver, runs.dir / "straight.run.h5", runs.dir / "resumed.run.h5", what))
+    report(what,
+           same_checkpoints(runs.dir / "straight.ckpt.h5", runs.dir / "resumed.ckpt.h5", what),
+           same_rows_after_restart(runs.solver, runs.dir / "straight.run.h5",
+                                   runs.dir / "resumed.run.h5", what))
 
 
 def main():
@@ -193,7 +215,8 @@ def main():
     runs = Runs(shaker, solver, directory)
     cycles = CASES[solver]["cycles"]
     start = time.monotonic()
-    runs.run("straight.run.h5", cycles, **{"run.checkpoint": "straight.ckpt.h5", "run.checkpoint_every": 1})
+    runs.run("straight.run.h5", cycles,
+             **{"run.checkpoint": "straight.ckpt.h5", "run.checkpoint_every": 1})
     print(f"{solver}: straight run of {sum(cycles)} cycles took {time.monotonic() - start:.2f} s")
     if not failures:
         kept_two(runs, cycles)
