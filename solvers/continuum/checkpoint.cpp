@@ -13,6 +13,9 @@ namespace shaker::continuum {
 
 namespace {
 const char* const names[variable_count] = {"density", "momentum_x", "momentum_y", "momentum_z", "energy"};
+// Conserved variables per unit volume (docs/units.md): n, n u, n (|u|^2 + 3 T) / 2.
+const char* const units[variable_count] = {"1/sigma^3", "m sqrt(g sigma) / sigma^3", "m sqrt(g sigma) / sigma^3",
+                                           "m sqrt(g sigma) / sigma^3", "m g / sigma^2"};
 }
 
 void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
@@ -29,19 +32,20 @@ void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& s
     // The e in effect (after a single-shock switch, the switched one): a restart uses it.
     h5::write_attribute(file, "e", solver.op().settings().e);
     const EnergyBudget& b = solver.budget();
-    h5::write(file, "energy_budget",
-              std::vector<double>{b.body_work, b.collisional_loss, b.floor_energy});
+    h5::write(file, "energy_budget", std::vector<double>{b.body_work, b.collisional_loss, b.floor_energy},
+              {3}, "m g / sigma");
     const Counters& k = solver.counters();
     h5::write(file, "counters",
               std::vector<std::int64_t>{k.steps, k.rejected_steps, k.temperature_floor_uses,
-                                        k.diffusion_stages});
+                                        k.diffusion_stages},
+              {4}, "1");
     for (int v = 0; v < variable_count; ++v) {
       std::vector<double> data;
       data.reserve(g.interior_cells());
       for (int kz = 0; kz < g.nz; ++kz)
         for (int j = 0; j < g.ny; ++j)
           for (int i = 0; i < g.nx; ++i) data.push_back(solver.state().q[v][g.index(i, j, kz)]);
-      h5::write(file, names[v], data);
+      h5::write(file, names[v], data, {data.size()}, units[v]);
     }
   });
 }

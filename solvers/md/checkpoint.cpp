@@ -48,28 +48,33 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
       partner_counter.push_back(d.events[i].partner_counter);
       kind.push_back(static_cast<std::int64_t>(d.events[i].kind) + 256 * d.events[i].cell_direction);
     }
-    h5::write(f, "particles", table, n, particle_columns);
-    h5::write(f, "event_time", event_time);
-    h5::write(f, "event_cell_time", cell_time);
-    h5::write(f, "event_partner", partner);
-    h5::write(f, "event_partner_counter", partner_counter);
-    h5::write(f, "event_kind", kind);
+    // The particle table mixes quantities: its units attribute names each column's.
+    h5::write(f, "particles", table, {n, std::size_t{particle_columns}},
+              "x, y, z: sigma; vx, vy, vz: sqrt(g sigma); t, last_collision: sqrt(sigma/g)");
+    h5::write(f, "event_time", event_time, {n}, "sqrt(sigma/g)");
+    h5::write(f, "event_cell_time", cell_time, {n}, "sqrt(sigma/g)");
+    h5::write(f, "event_partner", partner, {n}, "1");
+    h5::write(f, "event_partner_counter", partner_counter, {n}, "1");
+    h5::write(f, "event_kind", kind, {n}, "1");
     std::vector<std::uint32_t> counters, streaks;
     for (const Particle& p : d.particles) {
       counters.push_back(p.counter);
       streaks.push_back(p.streak);
     }
-    h5::write(f, "counters", widen(counters));
-    h5::write(f, "streaks", widen(streaks));
-    h5::write(f, "cell_head", widen(d.cell_head));
-    h5::write(f, "cell_next", widen(d.cell_next));
-    h5::write(f, "cell_prev", widen(d.cell_prev));
-    h5::write(f, "cell_of", widen(d.cell_of));
+    const auto count = [&](const char* name, const std::vector<std::int64_t>& values) {
+      h5::write(f, name, values, {values.size()}, "1");
+    };
+    count("counters", widen(counters));
+    count("streaks", widen(streaks));
+    count("cell_head", widen(d.cell_head));
+    count("cell_next", widen(d.cell_next));
+    count("cell_prev", widen(d.cell_prev));
+    count("cell_of", widen(d.cell_of));
     const Tally& t = d.tally;
-    h5::write(f, "tally_counts",
-              std::vector<std::int64_t>{widen(std::vector<std::uint64_t>{
-                  t.pair, t.plate, t.ceiling, t.cell, t.stale, t.guard_activations, t.grazes})});
-    h5::write(f, "tally_energy", std::vector<double>{t.plate_work, t.pair_loss, t.wall_loss, t.virial});
+    count("tally_counts", widen(std::vector<std::uint64_t>{t.pair, t.plate, t.ceiling, t.cell, t.stale,
+                                                           t.guard_activations, t.grazes}));
+    h5::write(f, "tally_energy", std::vector<double>{t.plate_work, t.pair_loss, t.wall_loss, t.virial},
+              {4}, "m g sigma");
   });
 }
 

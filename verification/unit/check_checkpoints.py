@@ -156,6 +156,10 @@ def kept_two(runs, cycles):
     end, last_phase = (times[-1], times[-2]) if runs.solver == "md" else (None, times[-1])
     final = position(runs.dir / "straight.ckpt.h5")
     previous = position(runs.dir / "straight.ckpt.previous.h5")
+    with h5py.File(runs.dir / "straight.ckpt.h5", "r") as f:
+        without_units = [name for name, item in f.items()
+                         if isinstance(item, h5py.Dataset) and not item.attrs.get("units")]
+    check(not without_units, f"{runs.solver} checkpoint datasets without units: {without_units}")
     check(final[:3] == (total, 0, runs.spec["phases"]), f"final checkpoint at {final}")
     check(previous == (total, 0, runs.spec["phases"], last_phase),
           f"previous checkpoint at {previous}, expected after the last stored phase "
