@@ -107,13 +107,14 @@ void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometr
 
 /// Replica r of the case (md.replicas): the periodic protocol takes seed run.seed + r, the
 /// single shock starts r cycles later from run.seed, as repeats of one single shock are pooled.
+const char* replica_key(const config::Config& config) {
+  return config.text("run.protocol") == "single_shock" ? "run.transient_cycles" : "run.seed";
+}
+
 config::Config replica_configuration(const config::Config& config, std::int64_t r) {
   config::Config replica = config;
   replica.set_value("md.replicas", std::int64_t{1});
-  if (config.text("run.protocol") == "single_shock")
-    replica.set_value("run.transient_cycles", config.integer("run.transient_cycles") + r);
-  else
-    replica.set_value("run.seed", config.integer("run.seed") + r);
+  replica.set_value(replica_key(config), config.integer(replica_key(config)) + r);
   return replica;
 }
 
@@ -125,8 +126,7 @@ void check_replicas(const config::Config& config, const CheckpointSettings& chec
                                  "run.checkpoint = \"{}\"): a checkpoint holds one replica; "
                                  "allowed: md.replicas = 1 with run.restart_from or run.checkpoint",
                                  replicas, checkpoints.restart_from.string(), checkpoints.file.string()));
-  const auto& spec = config::find_spec(config.text("run.protocol") == "single_shock"
-                                           ? "run.transient_cycles" : "run.seed");
+  const auto& spec = config::find_spec(replica_key(config));
   const double last = static_cast<double>(config.integer(spec.key) + replicas - 1);
   if (!spec.range.contains(last))
     throw InputError(fmt::format("md.replicas = {}: replica {} would need {} = {}; allowed: {} "
