@@ -11,7 +11,7 @@ namespace shaker {
 PhaseSchedule::PhaseSchedule(const RunProtocol& run, const ShakerKinematics& shaker, Clock clock,
                              double start_time, double origin)
     : clock_(clock),
-      f_(shaker.f),
+      f_(shaker.frequency()),
       period_(shaker.period()),
       start_time_(start_time),
       origin_(origin),
@@ -23,9 +23,9 @@ PhaseSchedule::PhaseSchedule(const RunProtocol& run, const ShakerKinematics& sha
 PhaseSchedule PhaseSchedule::whole_cycles(const RunProtocol& run, const ShakerKinematics& shaker,
                                           double t0) {
   // The tolerance keeps a run continued from a whole cycle (t0 f = m up to round-off) at m.
-  PhaseSchedule s(run, shaker, Clock::by_frequency, t0, std::ceil(t0 * shaker.f - 1e-9));
+  PhaseSchedule s(run, shaker, Clock::by_frequency, t0, std::ceil(t0 * shaker.frequency() - 1e-9));
   if (run.kind == RunProtocol::Kind::single_shock)
-    s.switch_time_ = (s.origin_ + static_cast<double>(run.transient_cycles) + run.switch_phase) / shaker.f;
+    s.switch_time_ = (s.origin_ + static_cast<double>(run.transient_cycles) + run.switch_phase) / shaker.frequency();
   return s;
 }
 

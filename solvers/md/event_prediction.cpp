@@ -11,7 +11,7 @@ namespace {
 /// The gap h(s) = z(s) - 1/2 - z_p(s) and its derivative, s measured from the particle's time.
 struct PlateGap {
   double z, vz, t0, g;
-  PlateMotion plate;
+  ShakerKinematics plate;
   double value(double s) const {
     return z + (vz - 0.5 * g * s) * s - 0.5 - plate.position(t0 + s);
   }

@@ -1,34 +1,22 @@
 #pragma once
 // The container: periodic in x and y; in z either an oscillating plate below and a fixed
 // ceiling above (the shaker), or periodic (the bulk-gas checks, without gravity).
-#include <cmath>
-
 #include "common/shaker_kinematics.hpp"
 
 namespace shaker::md {
-
-/// Plate height z_p(t) = A (1 - cos(omega t)); A = 0 is a fixed plate at z = 0.
-struct PlateMotion {
-  double amplitude = 0.0;
-  double omega = 1.0;
-  double position(double t) const { return amplitude * (1.0 - std::cos(omega * t)); }
-  double velocity(double t) const { return amplitude * omega * std::sin(omega * t); }
-  double acceleration(double t) const { return amplitude * omega * omega * std::cos(omega * t); }
-  static PlateMotion from(const ShakerKinematics& k) { return {k.amplitude(), k.omega()}; }
-};
 
 struct Geometry {
   double width = 20.0;     ///< periodic box edge in x and y
   double height = 200.0;   ///< ceiling (walls) or periodic length (periodic_z)
   bool periodic_z = false; ///< true: no plate and no ceiling, z periodic
   double gravity = 1.0;    ///< acceleration -gravity along z
-  PlateMotion plate;
+  ShakerKinematics plate = ShakerKinematics::fixed_plate();
 
   /// Largest |h''| of the plate gap h(t) = z(t) - 1/2 - z_p(t): g + A omega^2.
   double gap_curvature_bound() const {
-    return gravity + plate.amplitude * plate.omega * plate.omega;
+    return gravity + plate.amplitude() * plate.omega() * plate.omega();
   }
-  double plate_top() const { return 2.0 * plate.amplitude; }
+  double plate_top() const { return 2.0 * plate.amplitude(); }
 };
 
 }  // namespace shaker::md

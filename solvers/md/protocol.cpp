@@ -86,7 +86,7 @@ class SeriesObserver final : public RunObserver {
   SeriesObserver(Simulation& sim, const ShakerKinematics& shaker, const MdSettings& settings,
                  const BudgetOrigin& origin, PhaseSnapshot& snapshot)
       : sim_(sim), shaker_(shaker), origin_(origin), snapshot_(snapshot), rows_(settings.crossing_heights) {
-    sim.start_height_counts(settings.crossing_heights, shaker.f);
+    sim.start_height_counts(settings.crossing_heights, shaker.frequency());
   }
   void at_phase(const PhaseInstant& instant) override { record(instant.t); }
   void at_run_end(double t) override { record(t); }

@@ -28,13 +28,13 @@ Geometry geometry_of(const CaseParameters& c, const MdSettings& s) {
   g.width = c.md_box_width;
   g.height = s.ceiling;
   g.gravity = gravity;
-  g.plate = PlateMotion::from(c.shaker);
+  g.plate = c.shaker;
   // The ceiling must leave room for a particle above the plate at its highest point.
   if (!(s.ceiling > g.plate_top() + 1.0))
     throw InputError(fmt::format(
         "md.ceiling = {} is below the plate's top: it must exceed 2A + 1 = {:.6g} (A = {:.6g} "
         "for shaker.gamma = {} and shaker.frequency = {})",
-        s.ceiling, g.plate_top() + 1.0, g.plate.amplitude, c.shaker.Gamma, c.shaker.f));
+        s.ceiling, g.plate_top() + 1.0, g.plate.amplitude(), c.shaker.gamma(), c.shaker.frequency()));
   return g;
 }
 

@@ -38,8 +38,8 @@ std::vector<Profile> PhaseSampler::profiles(const ShakerKinematics& shaker) cons
     Profile p;
     p.time = first_time_[phase];
     p.phase = static_cast<double>(k) / phases_;
-    p.plate_z = shaker.position(p.phase / shaker.f);
-    p.plate_v = shaker.velocity(p.phase / shaker.f);
+    p.plate_z = shaker.position(p.phase / shaker.frequency());
+    p.plate_v = shaker.velocity(p.phase / shaker.frequency());
     p.bin_height = bin_height_;
     for (std::size_t j = 0; j < bins_; ++j) p.z.push_back((static_cast<double>(j) + 0.5) * bin_height_);
     samples_.pool(phase, p);

@@ -1,3 +1,7 @@
+// The engine's hot path: one event after another (step), the predictions that follow it and
+// the prefetching that hides their memory latency. Restoring from a checkpoint (restore.cpp),
+// keeping particles in cell order (cell_order.cpp) and the run's checks (diagnostics.cpp) live
+// apart, so that this file holds only what runs between two events.
 #include "md/simulation.hpp"
 
 #include <fmt/format.h>
@@ -9,32 +13,6 @@
 #include "md/prefetch.hpp"
 
 namespace shaker::md {
-
-namespace {
-
-/// What is wrong with the pending events of a checkpoint (empty if nothing).
-std::string event_inconsistency(const SimulationData& d) {
-  const auto n = static_cast<std::int32_t>(d.particles.size());
-  if (d.events.size() != d.particles.size()) return fmt::format("{} events for {} particles", d.events.size(), n);
-  for (std::int32_t i = 0; i < n; ++i) {
-    const Event& e = d.events[static_cast<std::size_t>(i)];
-    const auto kind = static_cast<int>(e.kind);
-    if (kind > static_cast<int>(EventKind::ceiling))
-      return fmt::format("particle {}: event kind {}; allowed 0 to 2 (pair, plate, ceiling)", i, kind);
-    if (e.cell_direction < 0 || e.cell_direction > 5)
-      return fmt::format("particle {}: cell crossing direction {}; allowed 0 to 5", i, e.cell_direction);
-    if (e.partner < -1 || e.partner >= n || e.partner == i)
-      return fmt::format("particle {}: partner {}; allowed -1 (none) or 0 to {} other than {}", i, e.partner, n - 1, i);
-    if (e.kind == EventKind::pair && e.time < never && e.partner < 0)
-      return fmt::format("particle {}: a pair collision at t = {} without a partner", i, e.time);
-    if (!(e.time >= d.time) || !(e.cell_time >= d.time))
-      return fmt::format("particle {}: event at t = {}, cell crossing at t = {}; allowed: not before the "
-                         "checkpoint time {}", i, e.time, e.cell_time, d.time);
-  }
-  return {};
-}
-
-}  // namespace
 
 Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, const State& initial,
                        QueueKind queue)
@@ -54,50 +32,6 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
   }
   reset_queue(n);
   for (std::size_t i = 0; i < n; ++i) predict(static_cast<std::int32_t>(i));
-}
-
-Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, SimulationData saved,
-                       QueueKind queue)
-    : geometry_(geometry), rules_(rules), data_(std::move(saved)),
-      use_calendar_(queue == QueueKind::calendar) {
-  const std::size_t n = data_.particles.size();
-  data_.last_collision.resize(n, no_collision_yet);
-  cells_.build(geometry_, n);
-  if (data_.cell_head.size() != cells_.head_.size())
-    throw InputError(fmt::format("checkpoint cell grid has {} cells, this geometry needs {} (written "
-                                 "by another version of the solver)", data_.cell_head.size(), cells_.head_.size()));
-  cells_.head_ = std::move(data_.cell_head);
-  cells_.next_ = std::move(data_.cell_next);
-  cells_.prev_ = std::move(data_.cell_prev);
-  cells_.cell_ = std::move(data_.cell_of);
-  data_.cell_head.clear();
-  data_.cell_next.clear();
-  data_.cell_prev.clear();
-  data_.cell_of.clear();
-  if (const std::string problem = cells_.inconsistency(data_.particles, 1e-6); !problem.empty())
-    throw InputError("checkpoint cell lists: " + problem + " (a damaged or edited checkpoint)");
-  if (const std::string problem = event_inconsistency(data_); !problem.empty())
-    throw InputError("checkpoint events: " + problem + " (a damaged or edited checkpoint)");
-  reset_queue(n);
-  for (std::size_t i = 0; i < n; ++i)
-    schedule(static_cast<std::int32_t>(i), data_.events[i].next());
-}
-
-void Simulation::reset_queue(std::size_t n) {
-  heap_.reset(use_calendar_ ? 0 : n);
-  calendar_.reset(use_calendar_ ? n : 0);
-  lookahead_ = n >= lookahead_min_particles;
-  lookahead_members_ = n >= lookahead_members_min_particles;
-  calendar_.set_deferred(lookahead_);
-}
-
-SimulationData Simulation::save() const {
-  SimulationData copy = data_;
-  copy.cell_head = cells_.head_;
-  copy.cell_next = cells_.next_;
-  copy.cell_prev = cells_.prev_;
-  copy.cell_of = cells_.cell_;
-  return copy;
 }
 
 void Simulation::advance_to(double t) {
@@ -253,37 +187,6 @@ void Simulation::step() {
       break;
   }
   predict(i);
-}
-
-// Particles that are close in space are stored close in memory, so that a prediction reads
-// few cache lines (the loss at large N is memory latency). The ids are renumbered in cell
-// order, every list that holds ids is renumbered with them, and the queue is rebuilt.
-void Simulation::sort_by_cell() {
-  const std::size_t n = data_.particles.size();
-  std::vector<std::int32_t> old_of_new;
-  old_of_new.reserve(n);
-  for (std::int32_t head : cells_.head_)
-    for (std::int32_t j = head; j >= 0; j = cells_.next_[j]) old_of_new.push_back(j);
-  std::vector<std::int32_t> new_of_old(n);
-  for (std::size_t k = 0; k < n; ++k) new_of_old[static_cast<std::size_t>(old_of_new[k])] = static_cast<std::int32_t>(k);
-  auto permute = [&](auto& values) {
-    auto copy = values;
-    for (std::size_t k = 0; k < n; ++k) values[k] = copy[static_cast<std::size_t>(old_of_new[k])];
-  };
-  permute(data_.particles);
-  permute(data_.events);
-  permute(data_.last_collision);
-  height_counts_.renumber(old_of_new);
-  for (Event& e : data_.events)
-    if (e.partner >= 0) e.partner = new_of_old[static_cast<std::size_t>(e.partner)];
-  std::vector<std::int32_t> cell_of(n);
-  for (std::size_t k = 0; k < n; ++k) cell_of[k] = cells_.cell_[static_cast<std::size_t>(old_of_new[k])];
-  std::fill(cells_.head_.begin(), cells_.head_.end(), -1);
-  for (std::size_t k = n; k-- > 0;)  // backwards: each cell lists its particles in id order
-    cells_.insert(static_cast<std::int32_t>(k), cell_of[k]);
-  heap_.reset(use_calendar_ ? 0 : n);
-  calendar_.reset(use_calendar_ ? n : 0);
-  for (std::size_t k = 0; k < n; ++k) schedule(static_cast<std::int32_t>(k), data_.events[k].next());
 }
 
 void Simulation::update(std::int32_t i, double now) {
@@ -504,81 +407,6 @@ void Simulation::predict_after_crossing(std::int32_t i, int direction) {
   event.cell_time = now + cell_delay;
   data_.events[i] = event;
   schedule(i, event.next());
-}
-
-void Simulation::positions_at(double t, std::vector<Vec3>& r, std::vector<Vec3>& v) const {
-  const std::size_t n = data_.particles.size();
-  r.resize(n);
-  v.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    state_at(data_.particles[i], t, geometry_.gravity, r[i], v[i]);
-    r[i].x -= geometry_.width * std::floor(r[i].x / geometry_.width);
-    r[i].y -= geometry_.width * std::floor(r[i].y / geometry_.width);
-    if (geometry_.periodic_z) r[i].z -= geometry_.height * std::floor(r[i].z / geometry_.height);
-  }
-}
-
-double Simulation::kinetic_energy(double t) const {
-  double sum = 0.0;
-  Vec3 r, v;
-  for (const Particle& p : data_.particles) {
-    state_at(p, t, geometry_.gravity, r, v);
-    sum += 0.5 * dot(v, v);
-  }
-  return sum;
-}
-
-double Simulation::potential_energy(double t) const {
-  double sum = 0.0;
-  Vec3 r, v;
-  for (const Particle& p : data_.particles) {
-    state_at(p, t, geometry_.gravity, r, v);
-    sum += geometry_.gravity * r.z;
-  }
-  return sum;
-}
-
-std::size_t Simulation::count_overlaps(double t, double tolerance) const {
-  std::vector<Vec3> r, v;
-  positions_at(t, r, v);
-  return count_overlaps(r, tolerance);
-}
-
-std::size_t Simulation::count_overlaps(const std::vector<Vec3>& r, double tolerance) const {
-  const double limit = (1.0 - tolerance) * (1.0 - tolerance);
-  std::size_t overlaps = 0;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    const auto self = static_cast<std::int32_t>(i);
-    cells_.for_each_neighbor(cells_.cell(self), [&](std::int32_t j, const Vec3&) {
-      if (j <= self) return;
-      Vec3 d = r[i] - r[static_cast<std::size_t>(j)];
-      d.x -= geometry_.width * std::round(d.x / geometry_.width);
-      d.y -= geometry_.width * std::round(d.y / geometry_.width);
-      if (geometry_.periodic_z) d.z -= geometry_.height * std::round(d.z / geometry_.height);
-      if (dot(d, d) < limit) ++overlaps;
-    });
-  }
-  return overlaps;
-}
-
-bool Simulation::queue_consistent() const {
-  const bool ok = use_calendar_ ? calendar_.consistent() && calendar_.size() == data_.particles.size()
-                                : heap_.consistent() && heap_.size() == data_.particles.size();
-  if (!ok) return false;
-  for (const Event& e : data_.events)
-    if (!(e.next() >= data_.time)) return false;
-  return true;
-}
-
-std::size_t Simulation::bytes_per_particle() const {
-  const std::size_t n = std::max<std::size_t>(1, data_.particles.size());
-  const std::size_t per_particle = sizeof(Particle) + sizeof(Event) + sizeof(double) +
-                                   3 * sizeof(std::int32_t) +
-                                   (use_calendar_ ? calendar_.bytes_per_entry() : heap_.bytes_per_entry());
-  // Grids: cell heads, and the calendar's buckets (at most two per particle).
-  const std::size_t grids = cells_.head_.size() * sizeof(std::int32_t) +
-                            (use_calendar_ ? 2 * n * sizeof(std::int32_t) : 0);
-  return per_particle + height_counts_.bytes_per_particle() + grids / n;
 }
 
 }  // namespace shaker::md

@@ -48,11 +48,11 @@ BENCHMARK(ElasticGas)
 Simulation base_case(Restitution restitution, int transient, QueueKind queue) {
   const ShakerKinematics shaker{3.0, 0.095};
   Geometry g;
-  g.plate = PlateMotion::from(shaker);
+  g.plate = shaker;
   CollisionRules rules;
   rules.restitution = restitution;
   Simulation sim(g, rules, flat_layer(g, 3937, 1), queue);
-  sim.advance_to(transient / shaker.f);
+  sim.advance_to(transient / shaker.frequency());
   return sim;
 }
 
@@ -95,7 +95,7 @@ void BaseCaseFullRun(benchmark::State& state) {
   for (auto _ : state) {
     Geometry g;
     g.height = settings.ceiling;
-    g.plate = PlateMotion::from(parameters.shaker);
+    g.plate = parameters.shaker;
     CollisionRules rules;
     rules.restitution = parameters.restitution;
     Simulation sim(g, rules, flat_layer(g, 3937, parameters.run.seed), settings.queue);

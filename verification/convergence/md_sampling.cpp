@@ -207,7 +207,7 @@ md::Simulation make_simulation(const CaseParameters& c, const md::MdSettings& s)
   g.width = c.md_box_width;
   g.height = s.ceiling;
   g.gravity = gravity;
-  g.plate = md::PlateMotion::from(c.shaker);
+  g.plate = c.shaker;
   md::CollisionRules rules;
   rules.restitution = c.restitution;
   rules.tc_guard = s.tc_guard;

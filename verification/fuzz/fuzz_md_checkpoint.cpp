@@ -30,7 +30,7 @@ struct SmallCase {
     geometry.width = parameters.md_box_width;
     geometry.height = settings.ceiling;
     geometry.gravity = shaker::gravity;
-    geometry.plate = shaker::md::PlateMotion::from(parameters.shaker);
+    geometry.plate = parameters.shaker;
     rules.restitution = parameters.restitution;
     rules.tc_guard = settings.tc_guard;
     rules.tc = settings.tc;

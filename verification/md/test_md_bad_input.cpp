@@ -63,7 +63,7 @@ TEST(MdBadInput, MissingCheckpoint) {
 /// A checkpoint of the base case after a few events, changed by `damage`.
 template <class Damage> std::string checkpoint_with(const std::filesystem::path& dir, Damage damage) {
   Geometry g;
-  g.plate = PlateMotion::from(ShakerKinematics{3.0, 0.095});
+  g.plate = ShakerKinematics{3.0, 0.095};
   CollisionRules rules;
   Simulation sim(g, rules, flat_layer(g, 3937, 1));
   for (int k = 0; k < 20000; ++k) sim.step();

@@ -118,7 +118,7 @@ Geometry plate_box(double amplitude, double omega) {
   g.width = 5.0;
   g.height = 400.0;
   g.gravity = 1.0;
-  g.plate = PlateMotion{amplitude, omega};
+  g.plate = ShakerKinematics::of_amplitude(amplitude, omega);
   return g;
 }
 

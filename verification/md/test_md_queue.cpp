@@ -95,7 +95,7 @@ const ShakerKinematics base_shaker{3.0, 0.095};
 /// The base case's layer (Gamma = 3, f = 0.095, 3937 particles, e = 0.9) at rest on the plate.
 Start vibrated_layer(std::uint64_t seed) {
   Start s;
-  s.geometry.plate = PlateMotion::from(base_shaker);
+  s.geometry.plate = base_shaker;
   s.rules.restitution = Restitution{Restitution::Kind::constant, 0.9};
   s.state = flat_layer(s.geometry, 3937, seed);
   return s;
@@ -117,8 +117,8 @@ TEST(MdEventQueue, CalendarQueueGivesTheHeapsTrajectoryInTheVibratedLayer) {
   const Start s = vibrated_layer(8);
   Simulation fast(s.geometry, s.rules, s.state, QueueKind::calendar),
       reference(s.geometry, s.rules, s.state, QueueKind::heap);
-  fast.advance_to(1.5 / base_shaker.f);
-  reference.advance_to(1.5 / base_shaker.f);
+  fast.advance_to(1.5 / base_shaker.frequency());
+  reference.advance_to(1.5 / base_shaker.frequency());
   EXPECT_GT(fast.tally().pair, 300000u);
   EXPECT_TRUE(fast.queue_consistent());
   EXPECT_TRUE(identical(fast.save(), reference.save()));
@@ -144,8 +144,8 @@ TEST(MdEventQueue, LookaheadPrefetchingLeavesTheTrajectoryUnchanged) {
   Simulation with(layer.geometry, layer.rules, layer.state),
       without(layer.geometry, layer.rules, layer.state);
   with.set_lookahead(true);
-  with.advance_to(1.0 / base_shaker.f);
-  without.advance_to(1.0 / base_shaker.f);
+  with.advance_to(1.0 / base_shaker.frequency());
+  without.advance_to(1.0 / base_shaker.frequency());
   EXPECT_GT(with.tally().pair, 100000u);
   EXPECT_TRUE(identical(with.save(), without.save()));
 }

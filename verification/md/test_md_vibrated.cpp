@@ -125,7 +125,7 @@ constexpr double base_frequency = 0.095;  // the base case's shaker.frequency
 Geometry shaken_plate(double gamma, double width) {
   Geometry g;
   g.width = width;
-  g.plate = PlateMotion::from(ShakerKinematics{gamma, base_frequency});
+  g.plate = ShakerKinematics{gamma, base_frequency};
   return g;
 }
 
@@ -341,17 +341,17 @@ TEST(MdVibrated, RestartFromCheckpointContinuesBitForBit) {
   const auto dir = testing::test_directory();
   const ShakerKinematics shaker{3.0, 0.095};
   Geometry g;
-  g.plate = PlateMotion::from(shaker);
+  g.plate = shaker;
   CollisionRules rules;
   rules.restitution = Restitution{Restitution::Kind::constant, 0.9};
   Simulation straight(g, rules, flat_layer(g, 3937, 3));
-  straight.advance_to(1.3 / shaker.f);
+  straight.advance_to(1.3 / shaker.frequency());
   write_checkpoint(dir / "stop.h5", straight.save(), g, SchedulePosition{}, "test");
-  straight.advance_to(2.0 / shaker.f);
+  straight.advance_to(2.0 / shaker.frequency());
   Checkpoint saved = read_checkpoint(dir / "stop.h5");
   validate_state(g, saved.data);
   Simulation restarted(g, rules, std::move(saved.data));
-  restarted.advance_to(2.0 / shaker.f);
+  restarted.advance_to(2.0 / shaker.frequency());
   std::printf("measured: %llu collisions after the restart point\n",
               static_cast<unsigned long long>(restarted.tally().pair));
   EXPECT_GT(straight.tally().pair, 100000u);
@@ -461,7 +461,7 @@ TEST(MdHydrostatic, ElasticGasUnderGravityIsIsothermalAndHydrostatic) {
   Geometry g;
   g.width = 10.0;
   g.height = 100.0;  // the gas never reaches the ceiling
-  g.plate = PlateMotion{0.0, 1.0};  // fixed plate
+  g.plate = ShakerKinematics::fixed_plate();
   CollisionRules rules;
   rules.restitution = Restitution{Restitution::Kind::constant, 1.0};
   const std::size_t n = 1500;

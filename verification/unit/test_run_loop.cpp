@@ -84,7 +84,7 @@ class LoggingObserver final : public shaker::RunObserver {
 
 TEST(PhaseSchedule, WholeCyclesKeepTheMdArithmetic) {
   const RunProtocol run = protocol(2, 3, 7);
-  const double f = shaker_base.f;
+  const double f = shaker_base.frequency();
   const PhaseSchedule fresh = PhaseSchedule::whole_cycles(run, shaker_base, 0.0);
   ASSERT_EQ(fresh.cycles(), 5);
   for (std::int64_t m = 0; m < 5; ++m)
@@ -143,7 +143,7 @@ TEST(PhaseSchedule, SingleShockSwitchesOnceBeforeTheFirstPhaseAfterTheSwitch) {
     ASSERT_EQ(s.cycles(), 3);
     LoggingSolver solver(0.0);
     s.run(solver, {});
-    const double switch_time = whole ? (0.0 + 2.0 - 0.3) / shaker_base.f : 0.0 + (2.0 - 0.3) * shaker_base.period();
+    const double switch_time = whole ? (0.0 + 2.0 - 0.3) / shaker_base.frequency() : 0.0 + (2.0 - 0.3) * shaker_base.period();
     // f t = 1.5 comes before the switch at f t = 1.7, and 1.75 after it.
     const std::vector<std::string> around = {"advance " + std::to_string(s.target(1, 2)),
                                              "advance " + std::to_string(switch_time),
@@ -244,7 +244,7 @@ LoggingSolver continued_run(bool whole, const RunProtocol& run, const shaker::Sc
 TEST(PhaseSchedule, ContinuedRunMeetsTheStraightRunsTargets) {
   const RunProtocol run = protocol(2, 3, 7);
   for (const bool whole : {true, false}) {
-    const double t0 = whole ? 2.5 / shaker_base.f : 1.2345;
+    const double t0 = whole ? 2.5 / shaker_base.frequency() : 1.2345;
     const PhaseSchedule straight = schedule(whole, run, t0);
     LoggingSolver all(t0);
     straight.run(all, {});
