@@ -19,8 +19,18 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+if __package__:
+    from . import report_common as rc
+else:  # run as a script: its folder, reports/, is first on sys.path
+    import report_common as rc
+
 SOLVERS = ("md", "continuum")
 FIGURE_PHASES = (0.0, 0.15, 0.22, 0.40)  # the phases of the paper's Fig. 1
+# The per-phase table: its header labels and the `shaker analyze --csv` columns they show.
+PHASE_TABLE_COLUMNS = (("f t", "phase"), ("plate", "plate_z"), ("layer bottom", "layer_bottom"),
+                       ("layer top", "layer_top"), ("centre of mass", "center_of_mass"),
+                       ("shock", "shock_location"), ("d", "shock_width"),
+                       ("d/xi", "width_over_mfp"), ("max Ma", "max_mach"))
 
 
 def read_run(path):
@@ -114,8 +124,8 @@ def main():
     lines += [f"- date: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M UTC}",
               f"- machine: {platform.node()} ({platform.machine()}, {os.cpu_count()} cores)",
               f"- commit: {commit}", ""]
-    lines += ["| solver | status | wall time (s) | model variant | resolution |",
-              "| --- | --- | --- | --- | --- |"]
+    lines += rc.table_head(["solver", "status", rc.with_units("wall time", "s"), "model variant",
+                            "resolution"])
     for solver in SOLVERS:
         state, _, ms = status.get(solver, "not run:0").partition(":")
         variant = runs[solver][0].get("model_variant", "") if solver in runs else ""
@@ -133,14 +143,12 @@ def main():
                   "## Centre of mass and shock location over a cycle", "",
                   f"![trajectories]({plot_trajectories(analyses, out_dir)})", ""]
         for solver, a in analyses.items():
-            lines += [f"## {solver}: analysis per phase (every fifth stored phase)", "",
-                      "| f t | plate | layer bottom | layer top | centre of mass | shock | d "
-                      "| d/xi | max Ma |",
-                      "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+            lines += [f"## {solver}: analysis per phase (every fifth stored phase)", ""]
+            lines += rc.table_head([rc.analysis_header(label, column)
+                                    for label, column in PHASE_TABLE_COLUMNS])
             for row in a[::5]:
-                lines.append("| " + " | ".join(fmt(row[c]) for c in (
-                    "phase", "plate_z", "layer_bottom", "layer_top", "center_of_mass",
-                    "shock_location", "shock_width", "width_over_mfp", "max_mach")) + " |")
+                lines.append("| " + " | ".join(fmt(row[column])
+                                               for _, column in PHASE_TABLE_COLUMNS) + " |")
             lines.append("")
     else:
         lines += ["No solver is available yet, so there is nothing to plot.", ""]

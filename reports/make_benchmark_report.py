@@ -13,7 +13,9 @@ JSON file is Google Benchmark output (--benchmark_format=json --benchmark_repeti
 ignored. User counters whose name contains "collision" are reported as collisions per second,
 those containing "cell_update" (or "cell update", "cellupdate") as cell updates per second
 (benchmark authors: make them rate counters, e.g. counters["collisions_per_second"] with
-benchmark::Counter::kIsRate).
+benchmark::Counter::kIsRate). Every such counter must have its units declared in
+THROUGHPUT_UNITS: one without them is unreadable input. Tables give units in their headers
+(times per iteration in ns, wall-clock rates per real second).
 
 Comparison with the previous run: for every benchmark present in both runs, the real-time
 samples (or CPU-time samples with --metric cpu_time; real time is what users wait for, CPU
@@ -52,6 +54,13 @@ STANDARD_KEYS = {"name", "family_index", "per_family_instance_index", "run_name"
                  "error_occurred", "error_message", "big_o", "rms"}
 THROUGHPUT_KINDS = (("collisions per second", re.compile(r"collision", re.I)),
                     ("cell updates per second", re.compile(r"cell[ _]?update", re.I)))
+# The units of the throughput counters the benchmarks report (verification/benchmarks):
+# rates are per second of wall-clock time, real seconds; a count per shaker cycle is a number.
+THROUGHPUT_UNITS = {
+    "collisions_per_second": "1/s",
+    "collisions_per_cycle": rc.DIMENSIONLESS,
+    "cell_updates_per_second": "1/s",
+}
 
 
 class InputProblem(Exception):
@@ -171,6 +180,12 @@ def throughput_series(runs):
     for kind, pattern in THROUGHPUT_KINDS:
         keys = sorted({(b, c) for run in runs for b, rec in run["benchmarks"].items()
                        for c in rec["counters"] if pattern.search(c)})
+        for _, counter in keys:  # refused before anything is written
+            try:
+                rc.units_of(THROUGHPUT_UNITS, counter, "benchmark counter")
+            except rc.UnknownUnits as unknown:
+                raise InputProblem(f"{unknown}: declare them in THROUGHPUT_UNITS of "
+                                   "reports/make_benchmark_report.py") from None
         if keys:
             out[kind] = {key: [float(np.median(run["benchmarks"][key[0]]["counters"][key[1]]))
                                if key[0] in run["benchmarks"]
@@ -286,6 +301,7 @@ def main(argv=None):
         return 2
     try:
         runs = read_history(args.history)
+        series = throughput_series(runs)
     except InputProblem as problem:
         print(f"make_benchmark_report: {problem}", file=sys.stderr)
         return 2
@@ -303,14 +319,14 @@ def main(argv=None):
     if not runs:
         lines += ["No benchmark runs found in the history.", ""]
     else:
-        series = throughput_series(runs)
         lines += ["## Throughput per commit (median over repetitions)", ""]
         if not series:
             lines += ["No collision or cell-update counters in these runs.", ""]
         for kind, data in series.items():
             keys = list(data)
             lines += [f"### {kind}", "",
-                      "| run | commit | " + " | ".join(f"{b} ({c})" for b, c in keys) + " |",
+                      "| run | commit | " + " | ".join(
+                          rc.with_units(f"{b} ({c})", THROUGHPUT_UNITS[c]) for b, c in keys) + " |",
                       "|---|---" + "|---" * len(keys) + "|"]
             for k, run in enumerate(runs):
                 lines.append(f"| {run['id']} | {short(run['commit'])} | " +
@@ -327,9 +343,9 @@ def main(argv=None):
                       f"({short(latest['commit'])}); {args.metric.replace('_', ' ')} per "
                       "iteration in ns (medians over repetitions) judged; the other time's "
                       "change is shown beside it.", "",
-                      f"| benchmark | previous | latest | change | "
-                      f"{'cpu' if args.metric == 'real_time' else 'real'} time change | "
-                      "p (Mann-Whitney U) | verdict |",
+                      f"| benchmark | previous [ns] | latest [ns] | change [%] | "
+                      f"{'cpu' if args.metric == 'real_time' else 'real'} time change [%] | "
+                      "p (Mann-Whitney U) [1] | verdict |",
                       "|---|---|---|---|---|---|---|"] + rows + [""]
         else:
             lines += ["Only one run in the history: nothing to compare with.", ""]

@@ -44,6 +44,11 @@ each is the header shown; numbers are decimal (nan allowed); names contain no co
       (BinSizeCheck::pass) passes criterion at_least when value >= limit, at_most when
       value <= limit.
 
+The CSV files carry no units: QUANTITY_UNITS below declares those of every field and
+quantity name they use (docs/units.md), and a name without units is unreadable input (exit 2).
+The report gives them in each table: in the header of a column that holds one quantity, in a
+`units` column where the rows hold different quantities.
+
 One judge decides pass or fail: the C++ side that writes the `pass` column (error_table.cpp,
 md_sampling.cpp), which the ctest tests assert with. This report shows that column as the
 verdict of each row (1 PASS, 0 **FAIL**, nan "not checked") and never re-decides it from the
@@ -89,9 +94,60 @@ BIN_SIZE_HEADER = ["study", "quantity", "phase", "sigma_value", "half_sigma_valu
 TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence", "statistic", "criterion"}
 NORM_ORDER = {"L1": 0, "L2": 1, "Linf": 2}
 
+# The units of every field and quantity the C++ writers name (docs/units.md): the fields of the
+# manufactured-solution and real-problem error tables (verification/mms/mms_run.hpp,
+# field_names) and of the bin-size checks; the quantities of interest of the real-problem GCI
+# tables (verification/mms/test_real_problem.cpp, defined in docs/analysis.md); and the MD
+# sampling quantities (verification/convergence/test_md_sampling.cpp, md_sampling.cpp). An
+# error norm (mean |d|, sqrt(mean d^2), max |d|) and a standard error have the units of their
+# quantity.
+QUANTITY_UNITS = {
+    "n": "1/sigma^3",
+    "nu": rc.DIMENSIONLESS,
+    "ux": "sqrt(g sigma)",
+    "uy": "sqrt(g sigma)",
+    "uz": "sqrt(g sigma)",
+    "T": "g sigma",
+    "center_of_mass": "sigma",
+    "shock_location": "sigma",
+    "shock_width": "sigma",
+    "shock_speed": "sqrt(g sigma)",  # plate frame
+    "max_mach": rc.DIMENSIONLESS,
+    "width_over_mfp": rc.DIMENSIONLESS,  # d/xi
+    "front_width_over_mfp": rc.DIMENSIONLESS,
+    # The RMS over the layer's bins of the standard error of n and of T.
+    "n_se_layer_rms": "1/sigma^3",
+    "T_se_layer_rms": "g sigma",
+}
+# A quantity taken at a phase or over a window of phases carries it in its name
+# (center_of_mass_ft0.25, max_mach_ft0.08-0.13); its units are those of the quantity.
+PHASE_SUFFIX = re.compile(r"_ft[0-9.]+(-[0-9.]+)?$")
+
 
 class InputProblem(Exception):
     pass
+
+
+def units_of(name):
+    """The units of a field or quantity named in the tables; InputProblem if it has none."""
+    try:
+        return rc.units_of(QUANTITY_UNITS, PHASE_SUFFIX.sub("", name))
+    except rc.UnknownUnits as unknown:
+        raise InputProblem(f"{unknown}: declare them in QUANTITY_UNITS of "
+                           "reports/make_convergence_report.py") from None
+
+
+def bin_size_value_units(row):
+    """The units of a bin-size check's value and limit: a fraction of bins is a number, a
+    difference or shift of the quantity has the quantity's units (the statistics of
+    verification/convergence/test_md_sampling.cpp)."""
+    statistic = row["statistic"]
+    if statistic.startswith("fraction"):
+        return rc.DIMENSIONLESS
+    if statistic.startswith(("max abs difference", "shift")):
+        return units_of(row["quantity"])
+    raise InputProblem(f"bin-size check of {row['quantity']}: no units known for the statistic "
+                       f"'{statistic}'")
 
 
 def read_csv(path, header):
@@ -171,7 +227,15 @@ def read_inputs(directory):
                          ("bin-size", BIN_SIZE_HEADER)):
         for path in sorted(glob.glob(os.path.join(directory, "**", f"*.{kind}.csv"),
                                      recursive=True)):
-            found[kind].extend(read_csv(path, header))
+            records = read_csv(path, header)
+            for record in records:  # every name must have units before anything is written
+                try:
+                    units_of(record.get("field", record.get("quantity")))
+                    if kind == "bin-size":
+                        bin_size_value_units(record)
+                except InputProblem as problem:
+                    raise InputProblem(f"{path}: {problem}") from None
+            found[kind].extend(records)
             files.append(os.path.relpath(path, directory))
     return found, files
 
@@ -325,9 +389,10 @@ def relation_of(criterion):
 
 
 def bin_size_line(r, mark):
-    return (f"| {r['study']} | {r['quantity']} | {phase_text(r['phase'])} | "
+    return (f"| {r['study']} | {r['quantity']} | {units_of(r['quantity'])} | "
+            f"{phase_text(r['phase'])} | "
             f"{rc.fmt(r['sigma_value'], 5)} | {rc.fmt(r['half_sigma_value'], 5)} | "
-            f"{r['statistic']} | {rc.fmt(r['value'], 4)} | "
+            f"{r['statistic']} | {bin_size_value_units(r)} | {rc.fmt(r['value'], 4)} | "
             f"{relation_of(r['criterion'])} {rc.fmt(r['limit'], 4)} | {mark} |")
 
 
@@ -363,7 +428,8 @@ def gci_result_text(r, mark):
 
 
 def gci_line(r, mark):
-    return (f"| {r['study']} | {r['quantity']} | {rc.fmt(r['phi1'], 6)} | "
+    return (f"| {r['study']} | {r['quantity']} | {units_of(r['quantity'])} | "
+            f"{rc.fmt(r['phi1'], 6)} | "
             f"{rc.fmt(r['phi2'], 6)} | {rc.fmt(r['phi3'], 6)} | {rc.fmt(r['order'], 4)} | "
             f"{rc.fmt(r['phi_extrapolated'], 6)} | "
             f"{rc.fmt(100 * r['relative_difference21'], 3)} | {rc.fmt(100 * r['gci21'], 3)} | "
@@ -382,9 +448,9 @@ def order_section(data, failures):
     rows = sorted(data["orders"], key=lambda r: (r["study"], r["field"],
                                                  NORM_ORDER.get(r["norm"], 9)))
     table, checks = judged_table(
-        "| study | field | norm | fitted p (± s.e., points) | p finest pair | p next pair | "
-        "design | band | result |", rows, order_line, order_failure, failures,
-        "no order checks found")
+        "| study | field | norm | fitted p (± s.e., points) [1] | p finest pair [1] | "
+        "p next pair [1] | design [1] | band [1] | result |", rows, order_line, order_failure,
+        failures, "no order checks found")
     return ["## Observed orders against the design order", ""] + table, checks
 
 
@@ -392,12 +458,13 @@ def gci_section(data, failures):
     """The GCI of the quantities of interest; returns (lines, checks)."""
     rows = sorted(data["gci"], key=lambda r: (r["study"], r["quantity"]))
     table, checks = judged_table(
-        "| study | quantity | phi1 (fine) | phi2 | phi3 | p | phi extrapolated | e21 % | "
-        "GCI21 % | GCI32 % | ratio | convergence | result |", rows, gci_line, gci_failure,
-        failures, "no GCI studies found")
+        "| study | quantity | units | phi1 (fine) | phi2 | phi3 | p [1] | phi extrapolated | "
+        "e21 [%] | GCI21 [%] | GCI32 [%] | ratio [1] | convergence | result |", rows, gci_line,
+        gci_failure, failures, "no GCI studies found")
     return ["## Grid convergence index of the quantities of interest", "",
             "GCI in percent of the fine-grid value (Fs = 1.25); asymptotic ratio = "
-            "GCI32 / (r21^p GCI21), close to 1 in the asymptotic range.", ""] + table, checks
+            "GCI32 / (r21^p GCI21), close to 1 in the asymptotic range; phi in the units "
+            "of its row.", ""] + table, checks
 
 
 def sampling_section(data, out_dir, failures):
@@ -410,7 +477,8 @@ def sampling_section(data, out_dir, failures):
                   key=lambda r: (r["study"], r["quantity"],
                                  -1 if math.isnan(r["phase"]) else r["phase"]))
     fit_table, fit_checks = judged_table(
-        "| study | quantity | f t | fitted slope (± s.e., points) | expected | band | result |",
+        "| study | quantity | f t [1] | fitted slope (± s.e., points) [1] | expected [1] | "
+        "band [1] | result |",
         fits, sampling_fit_line, sampling_fit_failure, failures, "no MD sampling studies found")
     lines += fit_table
 
@@ -421,8 +489,8 @@ def sampling_section(data, out_dir, failures):
         rows = by_study[study]
         ks = sorted({int(r["K"]) for r in rows})
         lines += [f"### {study}: standard error against K", "",
-                  "| quantity | f t | " + " | ".join(f"K = {k}" for k in ks) + " |",
-                  "|---|---" + "|---" * len(ks) + "|"]
+                  "| quantity | units | f t [1] | " + " | ".join(f"K = {k}" for k in ks) + " |",
+                  "|---|---|---" + "|---" * len(ks) + "|"]
 
         def key(r):  # nan (all phases) never equals itself: -1 stands for it
             return (r["quantity"], -1.0 if math.isnan(r["phase"]) else r["phase"])
@@ -431,27 +499,33 @@ def sampling_section(data, out_dir, failures):
             # The same cycles at every K: the largest count is the number of cycles without one.
             missing = max(r["missing"] for r in rows if key(r) == (quantity, phase))
             note = f" ({int(missing)} cycles without a value)" if missing else ""
-            lines.append(f"| {quantity}{note} | {phase_text(phase if phase >= 0 else math.nan)} | "
+            lines.append(f"| {quantity}{note} | {units_of(quantity)} | "
+                         f"{phase_text(phase if phase >= 0 else math.nan)} | "
                          + " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
         name = plot_sampling(study, rows, out_dir)
         lines += ["", f"![{study}: se against K]({name})", ""]
 
     bins = sorted(data["bin-size"], key=lambda r: (r["study"], r["quantity"]))
     bin_table, bin_checks = judged_table(
-        "| study | quantity | f t | sigma | sigma/2 | statistic | value | criterion | result |",
+        "| study | quantity | units | f t [1] | sigma | sigma/2 | statistic | value units | "
+        "value | criterion | result |",
         bins, bin_size_line, bin_size_failure, failures, "no bin-size checks found")
-    lines += ["### Bin size: sigma against sigma/2", ""] + bin_table
+    lines += ["### Bin size: sigma against sigma/2", "",
+              "sigma and sigma/2: the quantity at the two bin sizes, in its units; value and "
+              "criterion in the value units.", ""] + bin_table
     return lines, fit_checks + bin_checks
 
 
 def error_tables(series):
-    lines = []
+    lines = ["## Errors per level", "",
+             "Error norms in the units of their field; h is the cell size [sigma] of a spatial "
+             "study, the time step [sqrt(sigma/g)] of a temporal one.", ""] if series else []
     for study in sorted(series):
         hs = sorted({r["h"] for rows in series[study].values() for r in rows}, reverse=True)
         lines += [f"### {study}: errors", "",
-                  "| field | norm | " + " | ".join(f"h = {rc.fmt(h)}" for h in hs) + " | " +
-                  " | ".join(f"p({i}-{i + 1})" for i in range(len(hs) - 1)) + " |",
-                  "|---" * (2 + 2 * len(hs) - 1) + "|"]
+                  "| field | units | norm | " + " | ".join(f"h = {rc.fmt(h)}" for h in hs) +
+                  " | " + " | ".join(f"p({i}-{i + 1}) [1]" for i in range(len(hs) - 1)) + " |",
+                  "|---" * (3 + 2 * len(hs) - 1) + "|"]
         keys = sorted(series[study], key=lambda k: (k[0], NORM_ORDER.get(k[1], 9)))
         for field, norm in keys:
             rows = series[study][(field, norm)]
@@ -459,7 +533,7 @@ def error_tables(series):
             orders = pair_orders(rows)
             cells = [rc.fmt(by_h.get(h, float("nan"))) for h in hs]
             cells += [rc.fmt(p, 3) for p in orders] + [""] * (len(hs) - 1 - len(orders))
-            lines.append(f"| {field} | {norm} | " + " | ".join(cells) + " |")
+            lines.append(f"| {field} | {units_of(field)} | {norm} | " + " | ".join(cells) + " |")
         lines.append("")
     return lines
 

@@ -9,13 +9,16 @@ runner), the HDF5 run files it names (docs/output-schema.md) and their `shaker a
 tables (RUN.h5.analysis.csv). The plots go into a folder beside the report named after it
 (reports/validation/ for reports/validation.md). One section per figure of Bougie et al.,
 PRE 66, 051301 (2002), then the claims table (reference-data/claims.toml), then the agreement
-metrics of every case run by both solvers.
+metrics of every case run by both solvers. Every table gives units (docs/units.md): in the
+header of a column holding one quantity, in a units column where rows hold different ones
+(the claims', evidence's and metrics' units come with them in results.json).
 """
 import argparse
 import csv
 import json
 import math
 import os
+import sys
 
 import h5py
 import matplotlib
@@ -26,8 +29,10 @@ import numpy as np  # noqa: E402
 
 # One reader of the tables.
 if __package__:
+    from . import report_common as rc
     from .make_convergence_report import GCI_HEADER, read_csv
 else:  # run as a script: its folder, reports/, is first on sys.path
+    import report_common as rc
     from make_convergence_report import GCI_HEADER, read_csv
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -143,8 +148,12 @@ def figure1(results, out_dir, link):
     if not runs:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
     fig, axes = plt.subplots(2, len(FIG1_PHASES), figsize=(14, 7), sharey="col")
-    rows = ["| f t | solver | plate z | layer bottom | layer top | shock location | width d |",
-            "| --- | --- | --- | --- | --- | --- | --- |"]
+    rows = rc.table_head([rc.analysis_header("f t", "phase"), "solver",
+                          rc.analysis_header("plate z", "plate_z"),
+                          rc.analysis_header("layer bottom", "layer_bottom"),
+                          rc.analysis_header("layer top", "layer_top"),
+                          rc.analysis_header("shock location", "shock_location"),
+                          rc.analysis_header("width d", "shock_width")])
     exact = True
     for col, phase in enumerate(FIG1_PHASES):
         top = 0.0
@@ -190,8 +199,9 @@ def figure2(results, out_dir, link):
     if not available:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
     fig, axes = plt.subplots(1, len(available), figsize=(5 * len(available), 5), squeeze=False)
-    rows = ["| case | solver | formation f t | shock speed | centre-of-mass apex |",
-            "| --- | --- | --- | --- | --- |"]
+    rows = rc.table_head(["case", "solver", rc.analysis_header("formation f t", "phase"),
+                          rc.analysis_header("shock speed", "shock_speed"),
+                          rc.analysis_header("centre-of-mass apex", "center_of_mass_apex")])
     for ax, (case, label) in zip(axes[0], available):
         prof = results.profiles(case, "continuum")
         if prof is not None:
@@ -248,8 +258,9 @@ def figure3(results, out_dir, link):
     if not runs:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
     fig, ax = plt.subplots(figsize=(6, 6))
-    rows = ["| solver | f t | shock location | maximum Ma in the layer |",
-            "| --- | --- | --- | --- |"]
+    rows = rc.table_head(["solver", rc.analysis_header("f t", "phase"),
+                          rc.analysis_header("shock location", "shock_location"),
+                          rc.analysis_header("maximum Ma in the layer", "max_mach")])
     has_profile = False
     for solver, (prof, table) in runs.items():
         k = nearest(prof["phase"], 0.22)
@@ -289,8 +300,9 @@ def figure4(results, out_dir, link):
     if not tables:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
     fig, ax = plt.subplots(figsize=(7, 5))
-    rows = ["| f t | " + " | ".join(f"{s} max Ma | {s} d/xi" for s in tables) + " |",
-            "| --- |" + " --- | --- |" * len(tables)]
+    rows = rc.table_head([rc.analysis_header("f t", "phase")] + [
+        header for s in tables for header in (rc.analysis_header(f"{s} max Ma", "max_mach"),
+                                              rc.analysis_header(f"{s} d/xi", "width_over_mfp"))])
     for solver, t in tables.items():
         marker = dict(ls="none", marker="^") if solver == "md" else dict(ls="--")
         ax.plot(t["phase"], t["max_mach"], label=f"{solver} max Ma", **marker)
@@ -326,7 +338,9 @@ def figure5(results, out_dir, link):
     if not any(points.values()):
         return text + ["No plot: no single-shock run is available.", ""]
     fig, ax = plt.subplots(figsize=(6, 5))
-    rows = ["| e | MD v_shock | continuum v_shock |", "| --- | --- | --- |"]
+    rows = rc.table_head([rc.with_units("e", rc.DIMENSIONLESS),
+                          rc.analysis_header("MD v_shock", "shock_speed"),
+                          rc.analysis_header("continuum v_shock", "shock_speed")])
     for solver, pts in points.items():
         pts = sorted((e, v, err) for e, v, err in pts if v is not None)
         if not pts:
@@ -357,7 +371,8 @@ def figure6(results, out_dir, link):
     if not tables:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
     fig, ax = plt.subplots(figsize=(7, 5))
-    rows = ["| restitution | shock speed | centre-of-mass apex |", "| --- | --- | --- |"]
+    rows = rc.table_head(["restitution", rc.analysis_header("shock speed", "shock_speed"),
+                          rc.analysis_header("centre-of-mass apex", "center_of_mass_apex")])
     for (label, t, case), (shock, com) in zip(tables, (("r^", "bo"), ("mx", "c+"))):
         ax.plot(t["phase"], t["shock_location"], shock, label=f"shock, {label}")
         ax.plot(t["phase"], t["center_of_mass"], com, label=f"centre of mass, {label}")
@@ -381,8 +396,11 @@ def figure7(results, out_dir, link):
     if not any(results.analysis(c, s) is not None for c, s in needs):
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 9), sharex=True)
-    rows = ["| H | solver | mean centre of mass | formation f t | shock speed |",
-            "| --- | --- | --- | --- | --- |"]
+    # H: the depth of the layer at rest, in particle diameters.
+    rows = rc.table_head([rc.with_units("H", "sigma"), "solver",
+                          rc.analysis_header("mean centre of mass", "center_of_mass_mean"),
+                          rc.analysis_header("formation f t", "phase"),
+                          rc.analysis_header("shock speed", "shock_speed")])
     for (case, label), color in zip(DEPTHS, ("C0", "C1", "C2")):
         for solver in ("md", "continuum"):
             t = results.analysis(case, solver)
@@ -429,6 +447,15 @@ def band_text(check):
             f"all measured phases in {b[0]:g} to {b[1]:g}", "less_than": lambda: f"< {b[0]:g}",
             "greater_than": lambda: f"> {b[0]:g}", "strictly_increasing":
             lambda: "strictly increasing", "true": lambda: "detected"}[c]()
+
+
+def check_units(item, where):
+    """The units of a claim's check or a diagnosis' evidence, as the runner wrote them from
+    validation/quantities.py (UNITS); an error, not a blank, if they are missing."""
+    if not item.get("units"):
+        raise rc.UnknownUnits(f"{where}: no units for the quantity '{item.get('quantity')}' in "
+                              "the results (written by validation/run_validation.py)")
+    return item["units"]
 
 
 def mark(status):
@@ -506,11 +533,12 @@ def claims_section(results):
              "over phases is judged on the phases where it exists (a phase without a shock has "
              "no width), if they are at least half of them. Why each failing claim fails is "
              "in the next section.",
-             "", "| id | claim | paper | MD | continuum | band | result |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+             ""] + rc.table_head(["id", "claim", rc.UNITS_COLUMN, "paper", "MD", "continuum",
+                                  "band", "result"])
     counts = {}
     for claim in results.data["claims"]:
         bands = "; ".join(band_text(c) for c in claim["checks"])
+        units = "; ".join(check_units(c, claim["id"]) for c in claim["checks"])
         if claim["solvers"] == "md_vs_continuum":
             md = "MD vs continuum: " + solver_cell(results, claim, "md_vs_continuum")
             co = "(one value for the pair)"
@@ -518,8 +546,8 @@ def claims_section(results):
             md, co = solver_cell(results, claim, "md"), solver_cell(results, claim, "continuum")
         status = claim["status"]
         counts[status] = counts.get(status, 0) + 1
-        lines.append(f"| {claim['id']} | {claim['statement']} | {claim['paper_value']} | {md} | "
-                     f"{co} | {bands} | {mark(status)} |")
+        lines.append(f"| {claim['id']} | {claim['statement']} | {units} | "
+                     f"{claim['paper_value']} | {md} | {co} | {bands} | {mark(status)} |")
     notes = sorted({f"{claim['id']}: {n}" for claim in results.data["claims"]
                     for r in claim["per_solver"].values() for ev in r["checks"]
                     for n in ev.get("notes", [])})
@@ -579,10 +607,9 @@ def diagnoses_section(results):
         solvers = sorted({s for e in diag["evidence"] for s in e["measured"]},
                          key=["md", "continuum", "md_vs_continuum"].index)
         if diag["evidence"]:
-            lines += ["| evidence | " + " | ".join(solvers) + " |",
-                      "| --- | " + " | ".join("---" for _ in solvers) + " |"]
+            lines += rc.table_head(["evidence", rc.UNITS_COLUMN] + solvers)
             for e in diag["evidence"]:
-                lines.append(f"| {e['label']} | " + " | ".join(
+                lines.append(f"| {e['label']} | {check_units(e, diag['claim'])} | " + " | ".join(
                     measured_text(e["measured"][s]) if s in e["measured"] else ""
                     for s in solvers) + " |")
             lines.append("")
@@ -614,9 +641,11 @@ def width_section(results):
         return lines + [missing_text(results, [(c, "md") for c, _ in WIDTH_CASES]), ""]
     first = next(iter(tables.values()))[0]
     phases = [p for p in first["phase"] if WIDTH_WINDOW[0] - 1e-9 <= p <= WIDTH_WINDOW[1] + 1e-9]
-    lines += ["| f t | " + " | ".join(f"bin {b:g}: paper d/xi | bin {b:g}: fitted d/xi"
-                                      for b in tables) + " |",
-              "| --- |" + " --- | --- |" * len(tables)]
+    lines += rc.table_head([rc.analysis_header("f t", "phase")] + [
+        header for b in tables
+        for header in (rc.analysis_header(f"bin {b:g} sigma: paper d/xi", "width_over_mfp"),
+                       rc.analysis_header(f"bin {b:g} sigma: fitted d/xi",
+                                          "front_width_over_mfp"))])
     for phase in phases:
         cells = []
         for values, errors in tables.values():
@@ -634,9 +663,12 @@ def metrics_section(results):
     if not metrics:
         return lines + ["No case has finished runs of both solvers.", ""]
     names = sorted({k for m in metrics.values() for k in m})
-    lines += ["| metric | " + " | ".join(metrics) + " |", "| --- |" + " --- |" * len(metrics)]
+    declared = results.data.get("metric_units", {})
+    lines += rc.table_head(["metric", rc.UNITS_COLUMN] + list(metrics))
     for name in names:
-        lines.append(f"| {name} | " + " | ".join(fmt(m.get(name)) if not isinstance(
+        # The "error" row holds why `shaker compare` failed for a case: text, not a quantity.
+        units = "" if name == "error" else rc.units_of(declared, name, "comparison metric")
+        lines.append(f"| {name} | {units} | " + " | ".join(fmt(m.get(name)) if not isinstance(
             m.get(name), str) else m[name] for m in metrics.values()) + " |")
     return lines + [""]
 
@@ -659,8 +691,8 @@ def header(results, counts):
     lines += ["- MD collisions per second: " + (", ".join(cps) if cps else
                                                 "not available (needs a cumulative `collisions`"
                                                 " time-series column and a fresh run)"), ""]
-    lines += ["| case | solver | replicas | status | seconds | reused | program |",
-              "| --- | --- | --- | --- | --- | --- | --- |"]
+    lines += rc.table_head(["case", "solver", "replicas", "status", rc.with_units("seconds", "s"),
+                            "reused", "program"])
     for r in d["runs"]:
         status = r["status"] + (f" (with {', '.join(r['fallback'])})" if r.get("fallback")
                                 else "")
@@ -684,17 +716,22 @@ def main():
     out_dir = os.path.splitext(args.output)[0]
     link = os.path.basename(out_dir)
     body = []
-    for figure in (figure1, figure2, figure3, figure4, figure5, figure6, figure7):
-        body += figure(results, out_dir, link)
-    claims, counts = claims_section(results)
-    text = header(results, counts) + body + claims + diagnoses_section(results) \
-        + width_section(results) + metrics_section(results)
+    try:
+        for figure in (figure1, figure2, figure3, figure4, figure5, figure6, figure7):
+            body += figure(results, out_dir, link)
+        claims, counts = claims_section(results)
+        text = header(results, counts) + body + claims + diagnoses_section(results) \
+            + width_section(results) + metrics_section(results)
+    except rc.UnknownUnits as unknown:
+        print(f"make_validation_report: {unknown}", file=sys.stderr)
+        return 2
     tmp = args.output + ".partial"
     with open(tmp, "w") as f:
         f.write("\n".join(text) + "\n")
     os.replace(tmp, args.output)
     print(f"report: {args.output}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

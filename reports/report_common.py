@@ -1,4 +1,5 @@
-"""Helpers shared by the report generators: provenance header and atomic file writes.
+"""Helpers shared by the report generators: provenance header, atomic file writes and the
+units of table headers.
 
 Nothing under a final output name is ever half-written: text and figures go to a temporary
 name in the same directory and are renamed into place.
@@ -99,3 +100,60 @@ def fmt(x, digits=4):
     if x != x:
         return "n/a"
     return f"{x:.{digits}g}"
+
+
+# ---- units in tables ------------------------------------------------------------------------
+# Every number a report shows has its units in the table (docs/units.md gives the vocabulary:
+# sigma, sqrt(sigma/g), sqrt(g sigma), g sigma, 1/sigma^3, ..., "1" for a dimensionless
+# number). A column holding one quantity says them in its header, `label [units]`; a table
+# whose rows hold different quantities has a column headed UNITS_COLUMN instead.
+
+DIMENSIONLESS = "1"
+UNITS_COLUMN = "units"
+
+# The quantities of `shaker analyze` that reports show (per-phase columns of its --csv table,
+# per-run values of its --json), with the units its --json gives them (declared beside each
+# in solvers/analysis/run_analysis.cpp; validation.report_pipeline checks that they agree).
+ANALYSIS_UNITS = {
+    "phase": DIMENSIONLESS,  # f t
+    "plate_z": "sigma",
+    "layer_bottom": "sigma",
+    "layer_top": "sigma",
+    "center_of_mass": "sigma",
+    "shock_location": "sigma",
+    "shock_width": "sigma",
+    "width_over_mfp": DIMENSIONLESS,
+    "front_width_over_mfp": DIMENSIONLESS,
+    "max_mach": DIMENSIONLESS,
+    "shock_speed": "sqrt(g sigma)",  # plate frame
+    "center_of_mass_mean": "sigma",
+    "center_of_mass_apex": "sigma",
+}
+
+
+class UnknownUnits(Exception):
+    """A report was asked for the units of a name that has none declared: an error, so that a
+    new quantity cannot reach a table with a blank where its units belong."""
+
+
+def units_of(declared, name, what="quantity"):
+    """The units `declared` (a dict keyed by name) gives `name`; UnknownUnits if none."""
+    try:
+        return declared[name]
+    except KeyError:
+        raise UnknownUnits(f"no units declared for the {what} '{name}'") from None
+
+
+def with_units(label, units):
+    """The header cell of a column holding one quantity."""
+    return f"{label} [{units}]"
+
+
+def analysis_header(label, name):
+    """The header cell of a column showing the `shaker analyze` quantity `name`."""
+    return with_units(label, units_of(ANALYSIS_UNITS, name, "analysis quantity"))
+
+
+def table_head(cells):
+    """The header line and the separator line of a markdown table with these header cells."""
+    return ["| " + " | ".join(cells) + " |", "| " + " | ".join("---" for _ in cells) + " |"]

@@ -323,6 +323,45 @@ QUANTITIES = {
     "shock_curvature_difference": q_shock_curvature_difference,
 }
 
+# The units of each quantity's value (docs/units.md; definitions in docs/analysis.md), one entry
+# per key of QUANTITIES (validation/tests/test_claims_file.py fails on a missing one). The
+# validation report gives them beside the claims' values and bands and the diagnoses' evidence.
+# Phases and phase spans are f t (a lifetime is in cycles), so dimensionless; so are d/xi, Mach
+# numbers, ratios, relative changes, counts per cycle and the 1/0 of a detection.
+UNITS = {
+    "shock_formation_phase": "1",
+    "shock_exit_phase": "1",
+    "width_over_mfp_peak_phase": "1",
+    "width_over_mfp_in_window": "1",
+    "front_width_over_mfp_in_window": "1",
+    "shock_lifetime": "1",
+    "shock_width_at": "sigma",
+    "shock_location_at": "sigma",
+    "center_of_mass_at": "sigma",
+    "max_mach_in_window": "1",
+    "min_max_mach_in_window": "1",
+    "layer_temperature_fraction_at": "1",
+    # dT/dz: (g sigma) / sigma
+    "temperature_slope_above_layer_at": "g",
+    "layer_gap_at": "sigma",
+    "mass_gap_at": "sigma",
+    "com_fractional_rms_md_vs_continuum": "1",
+    "com_rms_ratio_deep_over_shallow": "1",
+    "com_mean_excess_of_shallow": "sigma",
+    "shock_formation_phase_by_case": "1",
+    "shock_speed_by_case": "sqrt(g sigma)",
+    "shock_speed_trend_deviation_at_last": "1",
+    "shock_speed_relative_change": "1",
+    "shock_location_fractional_rms": "1",
+    "crossings_per_cycle_above": "1",
+    "distinct_particles_per_cycle_above": "1",
+    "collapse_detected": "1",
+    # The apex is the largest centre of mass over the stored phases: a height.
+    "com_apex_difference": "sigma",
+    # 2 c of the parabola a + b t + c t^2 through the shock's height: sigma / (sigma/g)
+    "shock_curvature_difference": "g",
+}
+
 # Parameters each quantity needs (checked by validation/check_claims.py).
 REQUIRED_PARAMETERS = {
     "width_over_mfp_in_window": ("from", "to"),

@@ -172,6 +172,24 @@ def fill_view(view, data):
         view.replicates.append(rep)
 
 
+# The units of the metrics of `shaker compare --csv` (comparison_metrics in
+# solvers/app/commands.cpp; docs/analysis.md): RMS differences of a height over the phases
+# where both runs have it, the same over the reference's RMS, the number of those phases, and
+# the mean and largest (over phases) bin-mean |difference| of the nu and T profiles.
+COMPARISON_METRIC_UNITS = {
+    "shock_location_fractional_rms": "1",
+    "shock_location_absolute_rms": "sigma",
+    "shock_location_phases": "1",
+    "center_of_mass_fractional_rms": "1",
+    "center_of_mass_absolute_rms": "sigma",
+    "center_of_mass_phases": "1",
+    "nu_l1_mean_over_phases": "1",
+    "nu_linf_max_over_phases": "1",
+    "T_l1_mean_over_phases": "g sigma",
+    "T_linf_max_over_phases": "g sigma",
+}
+
+
 class Comparer:
     """`shaker compare --csv A B`, cached per pair of files; a replicate view gets the
     matching jackknife replicate of the comparison."""
@@ -473,6 +491,8 @@ def evaluate_claims(claims, views, comparer, partial_cases_ok):
         checks = [dict(quantity=claim["quantity"], parameters=claim.get("parameters", {}),
                        comparison=claim["comparison"], band=claim["band"])]
         checks += claim.get("also", [])
+        # The report shows each check's units beside its values and band.
+        checks = [dict(c, units=quantities.UNITS[c["quantity"]]) for c in checks]
         per_solver = {}
         for solver in solvers:
             evaluations = [evaluate(c, claim, solver, views, comparer, partial_cases_ok)
@@ -554,7 +574,8 @@ def diagnose(diagnoses, results, views, comparer, partial_cases_ok):
             measured = {s: measure(item["quantity"], item.get("parameters", {}), item["cases"], s,
                                    views, comparer, partial_cases_ok)
                         for s in evidence_solvers(item, views)}
-            evidence.append(dict(label=item["label"], measured=measured))
+            evidence.append(dict(label=item["label"], quantity=item["quantity"],
+                                 units=quantities.UNITS[item["quantity"]], measured=measured))
         claim_status = status.get(d["claim"])
         out.append(dict(d, evidence=evidence, claim_status=claim_status,
                         stale=claim_status is not None and claim_status != "fail"))
@@ -694,6 +715,9 @@ def main(argv=None):
         wall_seconds=time.monotonic() - started,
         simulated_seconds=sum(r["seconds"] for r in runs if not r["reused"]),
         runs=runs, metrics=metrics, claims=results, diagnoses=diagnosed,
+        # Only metrics with declared units: the report refuses to show one without them.
+        metric_units={name: COMPARISON_METRIC_UNITS[name] for m in metrics.values()
+                      for name in m if name in COMPARISON_METRIC_UNITS},
         undiagnosed=undiagnosed,
         views={f"{c}/{s}": dict(case=c, solver=s, status=v.status, path=v.path,
                                 analysis_json=getattr(v, "analysis_json", None),

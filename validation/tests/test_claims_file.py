@@ -4,6 +4,9 @@ needs, a known comparison with a band of the right shape, cases that validation/
 runs with the solvers the claim needs, and a provenance in the paper; and that
 validation/diagnoses.toml names known claims, categories, quantities and cases.
 
+Every quantity has its units declared (quantities.UNITS), since the report shows them beside
+the claims' values.
+
 It then checks that the checker itself catches broken files (a missing field, an unknown
 quantity, a band of the wrong length, a missing id, a case nobody runs), so that a pass means
 something.
@@ -175,3 +178,13 @@ def test_diagnoses_file_is_clean():
 def test_broken_diagnoses_are_caught(description, broken):
     assert run_validation.validate_diagnoses(broken, CLAIMS, STUDIES), \
         f"broken diagnoses ({description}) NOT CAUGHT"
+
+
+def test_every_quantity_has_units():
+    missing = sorted(set(quantities.QUANTITIES) - set(quantities.UNITS))
+    assert not missing, f"quantities without units in quantities.UNITS: {missing}"
+    stray = sorted(set(quantities.UNITS) - set(quantities.QUANTITIES))
+    assert not stray, f"quantities.UNITS names quantities that do not exist: {stray}"
+    blank = sorted(q for q, units in quantities.UNITS.items()
+                   if not isinstance(units, str) or not units.strip())
+    assert not blank, f"quantities with blank units: {blank}"

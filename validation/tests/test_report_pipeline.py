@@ -8,8 +8,10 @@ Checks: every claim id C1..C20 in the claims table, pass, FAIL and "not measured
 present, the seven figure PNGs exist and are non-empty, no run was re-simulated, values the
 cartoon fixes exactly (per cycle above z = 80: crossings 0.3 and 5, distinct particles 0.8 x those;
 the collapse detected from the recorded exit status) come out exactly, the continuum GCI of a
-synthetic grid-study table reaches the claims table (C6) or its absence is said (C5), and
---require sets the exit status (0 for a passing claim, 1 for a failing one).
+synthetic grid-study table reaches the claims table (C6) or its absence is said (C5), every
+table gives units (header or units column; those the report declares for `shaker analyze`
+quantities are the ones its --json prints), and --require sets the exit status (0 for a
+passing claim, 1 for a failing one).
 
     python3 -m pytest validation/tests/test_report_pipeline.py --shaker SHAKER
 """
@@ -21,6 +23,8 @@ import sys
 
 import pytest
 
+from reports import report_common
+from validation import quantities
 from validation import run_validation as runner
 from validation.tests import synthetic_runs
 
@@ -137,15 +141,82 @@ def test_report_pipeline(shaker, work_dir):
             f"{rate} (cartoon: {expected})")
     assert len(md_views) > 0, f"MD views with a collision rate: {len(md_views)}"
 
+    # Columns of the claims table: id, claim, units, paper, MD, continuum, band, result.
     c6, c5 = rows.get("C6", "").split(" | "), rows.get("C5", "").split(" | ")
-    c6_continuum = c6[4] if len(c6) > 4 else ""
+    c6_continuum = c6[5] if len(c6) > 5 else ""
     shown = re.search(r"([0-9.eE+-]+) ± ([0-9.eE+-]+) \(GCI 2 %", c6_continuum)
     assert (shown is not None and abs(float(shown.group(2)) - 0.02 * abs(float(shown.group(1))))
             <= 0.01 * abs(float(shown.group(1)))), \
         f"C6 continuum value carries its GCI, 2 % of the value: '{c6_continuum}'"
-    assert len(c5) > 4 and "no shock_width_ft0.22 row" in c5[4], \
-        f"C5 says its GCI row is missing: '{c5[4] if len(c5) > 4 else ''}'"
-    assert "GCI" not in (c6[3] if len(c6) > 3 else "GCI"), "the MD value carries no GCI"
+    assert len(c5) > 5 and "no shock_width_ft0.22 row" in c5[5], \
+        f"C5 says its GCI row is missing: '{c5[5] if len(c5) > 5 else ''}'"
+    assert "GCI" not in (c6[4] if len(c6) > 4 else "GCI"), "the MD value carries no GCI"
+    check_units(text, rows, claims, tmp)
+    check_missing_units_are_refused(os.path.join(workdir, "results.json"), tmp)
 
     rc, _ = run_validation(shaker, workdir, report, "C3", gci)
     assert rc == 1, f"--require C3 (failing on the cartoon) exits 1 (got {rc})"
+
+
+def check_units(text, rows, claims, tmp):
+    """Every table of the report gives units: in the header of a column that holds one
+    quantity, in a units column where the rows hold different quantities."""
+    lines = text.splitlines()
+    assert "| id | claim | units | paper | MD | continuum | band | result |" in lines, \
+        "claims table without its units column"
+    for claim_id, claim in claims.items():
+        cells = rows.get(claim_id, "").split(" | ")
+        expected = "; ".join(quantities.UNITS[c["quantity"]] for c in claim["checks"])
+        assert len(cells) > 2 and cells[2] == expected, \
+            f"{claim_id}: units '{cells[2] if len(cells) > 2 else ''}', expected '{expected}'"
+    assert rows["C5"].split(" | ")[2] == "sigma" and rows["C17"].split(" | ")[2] == "1; 1", \
+        "C5 (a width) in sigma, C17 (two counts per cycle) in 1; 1"
+    for header in ("| case | solver | replicas | status | seconds [s] | reused | program |",
+                   "| f t [1] | solver | plate z [sigma] | layer bottom [sigma] | "
+                   "layer top [sigma] | shock location [sigma] | width d [sigma] |",
+                   "| case | solver | formation f t [1] | shock speed [sqrt(g sigma)] | "
+                   "centre-of-mass apex [sigma] |",
+                   "| solver | f t [1] | shock location [sigma] | maximum Ma in the layer [1] |",
+                   "| e [1] | MD v_shock [sqrt(g sigma)] | continuum v_shock [sqrt(g sigma)] |",
+                   "| restitution | shock speed [sqrt(g sigma)] | centre-of-mass apex [sigma] |",
+                   "| H [sigma] | solver | mean centre of mass [sigma] | formation f t [1] | "
+                   "shock speed [sqrt(g sigma)] |"):
+        assert header in lines, f"table header with units missing: {header}"
+    fig4 = next((line for line in lines if line.startswith("| f t [1] | md max Ma")), "")
+    assert "| md max Ma [1] | md d/xi [1] |" in fig4, f"Fig. 4 header without units: '{fig4}'"
+    evidence = [line for line in lines if line.startswith("| evidence |")]
+    assert evidence and all(line.startswith("| evidence | units |") for line in evidence), \
+        f"evidence tables without a units column: {evidence}"
+    metric = next((line for line in lines if line.startswith("| metric |")), "")
+    assert metric.startswith("| metric | units |"), f"metrics table without units: '{metric}'"
+    for name, units in (("center_of_mass_absolute_rms", "sigma"),
+                        ("center_of_mass_fractional_rms", "1"), ("T_l1_mean_over_phases",
+                                                                 "g sigma")):
+        assert any(line.startswith(f"| {name} | {units} | ") for line in lines), \
+            f"metric {name} without its units {units}"
+    # The units the reports declare for `shaker analyze` quantities are those it prints.
+    analysis = json.load(open(os.path.join(tmp, "again-base.json")))
+    printed = {name: q["unit"] for part in ("per_phase", "per_run")
+               for name, q in analysis[part].items()}
+    for name, units in report_common.ANALYSIS_UNITS.items():
+        assert printed.get(name) == units, \
+            f"{name}: reports declare [{units}], shaker analyze --json prints {printed.get(name)}"
+
+
+def check_missing_units_are_refused(results_path, tmp):
+    """A claim's check or a metric without units in results.json is an error of the report
+    generator (exit 2, naming it), not a blank cell."""
+    script = os.path.join(os.path.dirname(VALIDATION), "reports", "make_validation_report.py")
+    for what, remove in (("claim", lambda r: r["claims"][0]["checks"][0].pop("units")),
+                         ("metric", lambda r: r["metric_units"].pop(
+                             "center_of_mass_absolute_rms"))):
+        results = json.load(open(results_path))
+        remove(results)
+        broken = os.path.join(tmp, f"results-without-{what}-units.json")
+        json.dump(results, open(broken, "w"))
+        report = os.path.join(tmp, f"without-{what}-units.md")
+        result = subprocess.run([sys.executable, script, "--results", broken, "--output", report],
+                                capture_output=True, text=True)
+        assert result.returncode == 2 and "no units" in result.stderr \
+            and not os.path.exists(report), \
+            f"{what} without units: exit {result.returncode}, {result.stderr.strip()[-300:]}"

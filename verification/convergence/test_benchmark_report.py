@@ -3,8 +3,9 @@
 Two runs of three benchmarks with 9 repetitions each: one
 20% slower, one 20% faster, one unchanged (seeded noise). Checks the throughput rows per
 commit, the comparison rows and verdicts, the exit code and the benchmark named on stderr,
-the threshold option, the Mann-Whitney U implementation against brute-force enumeration, and
-bad input.
+the threshold option, the units in the table headers (a throughput counter without declared
+units is refused), the Mann-Whitney U implementation against brute-force enumeration, and bad
+input.
 """
 import itertools
 import json
@@ -135,6 +136,15 @@ def test_report_on_a_synthetic_history(work_dir):
             f"collisions/s medians {a}, {b} (expected 1e6, 8.33e5)"
     except (IndexError, ValueError):
         pytest.fail(f"throughput rows unreadable: '{row_a}', '{row_b}'")
+    # Units in the headers: a rate per real second, times per iteration in ns.
+    assert line_with(text, "| run | commit | BM_md_collisions (collisions_per_second) [1/s] |"), \
+        "collisions-per-second header lacks its units [1/s]"
+    assert line_with(text, "| run | commit | BM_continuum_step (cell_updates_per_second) "
+                     "[1/s] |"), \
+        "cell-updates-per-second header lacks its units [1/s]"
+    assert line_with(text, "| benchmark | previous [ns] | latest [ns] | change [%] | "
+                     "cpu time change [%] | p (Mann-Whitney U) [1] | verdict |"), \
+        "comparison header lacks its units"
     slow = line_with(text, "| BM_md_collisions |", "%")
     fast = line_with(text, "| BM_continuum_step |", "%")
     same = line_with(text, "| BM_unchanged |", "%")
@@ -178,6 +188,15 @@ def test_report_on_a_synthetic_history(work_dir):
     assert (result.returncode == 0
             and "nothing to compare" in open(os.path.join(work, "single.md")).read()), \
         "a single run must report nothing to compare and exit 0"
+
+    # A throughput counter without declared units is refused, not shown with a blank.
+    undeclared = os.path.join(work, "undeclared")
+    write_run(undeclared, "20261120T030000Z-aaaaaaaaaaaa", "a" * 40,
+              {"BM_md_steps": (2.0e6, "collisions_per_step", 2000.0)}, seed=4)
+    result = run("--history", undeclared, "--output", os.path.join(work, "undeclared.md"))
+    assert (result.returncode == 2 and "'collisions_per_step'" in result.stderr
+            and not os.path.exists(os.path.join(work, "undeclared.md"))), \
+        f"a counter without units: exit {result.returncode}, {result.stderr.strip()}"
 
     broken = os.path.join(work, "broken", "20261120T030000Z-x")
     os.makedirs(broken)

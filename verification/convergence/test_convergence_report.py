@@ -2,8 +2,10 @@
 temporary directory.
 
 Checks the provenance header, the order and GCI rows with
-their pass/fail marks, the failure summary with measured values, the PNG plot, --strict, and
-bad input; and the MD sampling section (slope fits against K^-1/2, the se table, its plot, the
+their pass/fail marks, the failure summary with measured values, the units of every table
+(in a column's header, or in a units column where the rows hold different quantities; a name
+without declared units is refused), the PNG plot, --strict, and bad input; and the MD sampling
+section (slope fits against K^-1/2, the se table, its plot, the
 bin-size checks) on a synthetic sampling study.
 
 The report is tested against the one judge, the `pass` column the C++ side writes: for every
@@ -122,7 +124,7 @@ def line_with(text, *fragments):
 
 
 # Where the report shows each table that carries the judge's pass column, and the columns that
-# name one of its rows there (phase is shown as "f t").
+# name one of its rows there (phase is shown as PHASE_COLUMN).
 JUDGED_TABLES = {
     "orders": ("## Observed orders against the design order", ("study", "field", "norm")),
     "gci": ("## Grid convergence index of the quantities of interest", ("study", "quantity")),
@@ -131,6 +133,7 @@ JUDGED_TABLES = {
 }
 # Only a GCI mark carries a note: its band, or why a two-grid row is not checked.
 NOTED_TABLES = {"gci"}
+PHASE_COLUMN = "f t [1]"
 
 
 def table_cells(line):
@@ -168,7 +171,7 @@ def shown_phase_is(shown, phase_cell):
 
 
 def names_row(shown, row, key_columns):
-    return all(shown_phase_is(shown.get("f t", ""), row["phase"]) if column == "phase"
+    return all(shown_phase_is(shown.get(PHASE_COLUMN, ""), row["phase"]) if column == "phase"
                else shown.get(column) == row[column] for column in key_columns)
 
 
@@ -291,10 +294,27 @@ def test_report_on_a_synthetic_study(work_dir):
     assert "not checked (two grids" in two_grid and "FAIL" not in two_grid, \
         f"two-grid row must be shown but not checked: '{two_grid}'"
 
-    errors_header = line_with(text, "| field | norm | h = 0.1 |")
-    assert "p(0-1)" in errors_header and "p(2-3)" in errors_header, "error table lacks pair orders"
-    n_row = line_with(text, "| n | L1 | 0.00505 |")
-    assert n_row != "", "error table row of n L1 missing"
+    errors_header = line_with(text, "| field | units | norm | h = 0.1 |")
+    assert "p(0-1) [1]" in errors_header and "p(2-3) [1]" in errors_header, \
+        f"error table lacks pair orders or their units: '{errors_header}'"
+    n_row = line_with(text, "| n | 1/sigma^3 | L1 | 0.00505 |")
+    assert n_row != "", "error table row of n L1 (with the units of n) missing"
+    for field, units in (("uz", "sqrt(g sigma)"), ("T", "g sigma")):
+        assert line_with(text, f"| {field} | {units} | L2 |") != "", \
+            f"error table row of {field} lacks its units {units}"
+
+    # Units: a header that holds one quantity says them; a table of different quantities
+    # has a units column, filled from the one declaration per name.
+    orders_header = line_with(text, "| study | field | norm | fitted p")
+    assert ("fitted p (± s.e., points) [1]" in orders_header and "| design [1] |" in orders_header
+            and "| band [1] |" in orders_header), f"orders header without units: '{orders_header}'"
+    gci_header = line_with(text, "| study | quantity | units | phi1 (fine) |")
+    assert "| p [1] |" in gci_header and "| GCI21 [%] |" in gci_header, \
+        f"GCI header without its units column or units: '{gci_header}'"
+    assert line_with(text, "| base-1d | shock_location | sigma | 2.0") != "", \
+        "GCI row of shock_location lacks its units sigma"
+    assert line_with(text, "| base-1d | max_mach | 1 | 3.1 |") != "", \
+        "GCI row of max_mach lacks its units 1"
 
     png = os.path.join(out_dir, "convergence-synthetic-1d-space.png")
     assert (os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
@@ -354,6 +374,24 @@ def test_the_pass_column_not_the_band_decides_and_bad_input_is_refused(work_dir)
             f"pass {cell}: exit {result.returncode}, stderr '{result.stderr.strip()}'"
         assert not os.path.exists(out), f"a report was written from pass column {cell}"
 
+    # A name without declared units is not shown with a blank: the input is refused.
+    for kind, header, row, name in (
+            ("errors", "study,field,norm,level,h,error", ("s", "pressure", "L1", 0, 1, 1),
+             "pressure"),
+            ("orders", ORDERS_HEADER, ("s", "rho", "L2", 3, 2, 0.001, 2, 2, 2, 0.1, 1), "rho"),
+            ("bin-size", "study,quantity,phase,sigma_value,half_sigma_value,statistic,value,"
+             "criterion,limit,pass", ("s", "T", 0.22, "nan", "nan", "median ratio", 1,
+                                      "at_least", 0.9, 1), "median ratio")):
+        unknown = os.path.join(work, f"unknown-{kind}")
+        os.makedirs(unknown)
+        write(os.path.join(unknown, f"x.{kind}.csv"), header, [row])
+        out = os.path.join(work, f"unknown-{kind}-out", "c.md")
+        result = run("--input", unknown, "--output", out)
+        assert (result.returncode == 2 and f"'{name}'" in result.stderr
+                and "units" in result.stderr), \
+            f"{kind} naming {name}: exit {result.returncode}, stderr '{result.stderr.strip()}'"
+        assert not os.path.exists(out), f"a report was written with {name} lacking units"
+
     bad = os.path.join(work, "bad")
     os.makedirs(bad)
     write(os.path.join(bad, "x.errors.csv"), "study,field,norm,h,error", [("s", "n", "L1", 1, 1)])
@@ -389,22 +427,30 @@ def test_md_sampling_section(work_dir):
         f"slope -0.95 with pass column 1 must be shown as PASS: '{row}'"
     assert line_with(text, "- sampling synthetic-md-sampling / n_se_layer_rms") == "", \
         "n_se_layer_rms is listed as failing although its pass column says 1"
-    se_header = line_with(text, "| quantity | f t | K = 2 | K = 4 | K = 8 | K = 16 |")
-    assert se_header != "", "se table header missing"
-    se_row = line_with(text, "| T_se_layer_rms | 0.22 | 0.2121 |")
-    assert se_row.endswith("| 0.075 |"), f"se table row wrong: '{se_row}'"
+    se_header = line_with(text, "| quantity | units | f t [1] | K = 2 | K = 4 | K = 8 | K = 16 |")
+    assert se_header != "", "se table header (with its units column) missing"
+    se_row = line_with(text, "| T_se_layer_rms | g sigma | 0.22 | 0.2121 |")
+    assert se_row.endswith("| 0.075 |"), f"se table row wrong or without units: '{se_row}'"
+    assert line_with(text, "| center_of_mass | sigma | 0.5 |") != "", \
+        "se table row of center_of_mass lacks its units"
+    fit_header = line_with(text, "| study | quantity | f t [1] | fitted slope")
+    assert "[1] | expected [1] | band [1] |" in fit_header, \
+        f"slope-fit header without units: '{fit_header}'"
     all_rows = [line for line in text.splitlines()
-                if line.startswith("| n_se_layer_rms | all | ")]
+                if line.startswith("| n_se_layer_rms | 1/sigma^3 | all | ")]
     assert len(all_rows) == 1, f"the all-phases se row must appear once, found {len(all_rows)}"
-    bins_t = line_with(text, "| synthetic-md-sampling | T | 0.22 |")
-    assert bins_t.endswith("| PASS |") and ">= 0.9" in bins_t, f"bin-size T should pass: '{bins_t}'"
-    bins_uz = line_with(text, "| synthetic-md-sampling | uz | 0.22 |")
+    bins_t = line_with(text, "| synthetic-md-sampling | T | g sigma | 0.22 |")
+    assert (bins_t.endswith("| PASS |") and ">= 0.9" in bins_t
+            and "within 2 combined se | 1 | 0.96 |" in bins_t), \
+        f"bin-size T should pass, a fraction in units 1: '{bins_t}'"
+    bins_uz = line_with(text, "| synthetic-md-sampling | uz | sqrt(g sigma) | 0.22 |")
     assert "**FAIL**" in bins_uz and "| 0.8 |" in bins_uz, \
         f"bin-size uz should fail at 0.8: '{bins_uz}'"
     assert line_with(text, "- bin size synthetic-md-sampling / uz: fraction of layer bins "
                      "within 2 combined se = 0.8, required >= 0.9") != "", \
         "bin-size failure not summarised"
-    shock = line_with(text, "| synthetic-md-sampling | shock_location | 0.22 | 17 | 17.5 |")
+    shock = line_with(text, "| synthetic-md-sampling | shock_location | sigma | 0.22 | 17 | "
+                      "17.5 | shift | sigma | 0.5 |")
     assert shock.endswith("| PASS |") and "<= 1.1" in shock, f"bin-size shock row wrong: '{shock}'"
     png = os.path.join(work, "sampling-out", "sampling-synthetic-md-sampling.png")
     assert (os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"

@@ -95,7 +95,8 @@ rm -rf "$TMPDIR"
   echo "and the seed corpus included), from the corpus kept in $corpus and the seeds of"
   echo "make_corpus.sh (cov: coverage points of the instrumented code reached; ft: features)."
   echo
-  echo "| target | seconds | executions | exec/s | cov | ft | peak RSS (MB) | outcome |"
+  # Units in the headers (docs/units.md): seconds are wall-clock seconds; counts are numbers.
+  echo "| target | seconds [s] | executions [1] | exec/s [1/s] | cov [1] | ft [1] | peak RSS [MB] | outcome |"
   echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |"
   printf '%s\n' "${rows[@]}"
 } > "$report"
