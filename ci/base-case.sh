@@ -3,9 +3,10 @@
 # that is available, analysed by `shaker analyze`, and a markdown report with plots at
 # out/base-case/base-case.md (out/ is not tracked; BASE_CASE_DIR chooses another folder).
 # Installs missing dependencies and builds as needed.
-# Quick default resolution: the continuum column at cell 0.25 (the case file says 0.1, about a
-# minute per cycle today); the MD run is the full case. Extra arguments are passed to both
-# solvers after these, e.g. --set run.sampled_cycles=4 or --set continuum.cell_size=0.1.
+# Quick default resolution: the continuum column at cell 0.25 (the case file says 0.1, several
+# times the cost per cycle: docs/reproducing-the-paper.md gives run times); the MD run is the
+# full case. Extra arguments are passed to both solvers after these, e.g.
+# --set run.sampled_cycles=4 or --set continuum.cell_size=0.1.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash ci/install-deps.sh

@@ -6,8 +6,9 @@ Usage:
                                [--build-dir BUILD] [--build-type TYPE] [--commit SHA] [--strict]
 
 Every file under DIR (searched recursively) whose name ends in one of the suffixes below is
-read; verification/convergence/error_table.hpp writes exactly these files. The first line of
-each is the header shown; numbers are decimal (nan allowed); names contain no commas.
+read; verification/support/error_table.hpp and verification/sampling/md_sampling.cpp write
+exactly these files. The first line of each is the header shown; numbers are decimal (nan
+allowed); names contain no commas.
 
   *.errors.csv   study,field,norm,level,h,error
       One discrete error norm of one field on one level of one study. `h` is the grid spacing
@@ -30,7 +31,7 @@ each is the header shown; numbers are decimal (nan allowed); names contain no co
       shown as "not checked" and is not counted as a check.
   *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,
                       standard_error
-      MD sampling convergence (verification/convergence/md_sampling.hpp): the standard error
+      MD sampling convergence (verification/sampling/md_sampling.hpp): the standard error
       of one quantity (phase = f t, nan for all phases) from blocks of K sampled cycles;
       cycles without a value (missing) make the effective number of cycles effective_K < K.
   *.sampling-fit.csv  study,quantity,phase,fit_points,fitted_slope,slope_std_error,
@@ -98,7 +99,7 @@ NORM_ORDER = {"L1": 0, "L2": 1, "Linf": 2}
 # manufactured-solution and real-problem error tables (verification/mms/mms_run.hpp,
 # field_names) and of the bin-size checks; the quantities of interest of the real-problem GCI
 # tables (verification/mms/test_real_problem.cpp, defined in docs/analysis.md); and the MD
-# sampling quantities (verification/convergence/test_md_sampling.cpp, md_sampling.cpp). An
+# sampling quantities (verification/sampling/test_md_sampling.cpp, md_sampling.cpp). An
 # error norm (mean |d|, sqrt(mean d^2), max |d|) and a standard error have the units of their
 # quantity.
 QUANTITY_UNITS = {
@@ -140,7 +141,7 @@ def units_of(name):
 def bin_size_value_units(row):
     """The units of a bin-size check's value and limit: a fraction of bins is a number, a
     difference or shift of the quantity has the quantity's units (the statistics of
-    verification/convergence/test_md_sampling.cpp)."""
+    verification/sampling/test_md_sampling.cpp)."""
     statistic = row["statistic"]
     if statistic.startswith("fraction"):
         return rc.DIMENSIONLESS

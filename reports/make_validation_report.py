@@ -518,7 +518,7 @@ def claims_section(results):
              "`shaker compare`; a value quantised to the stored phases or to the bins also "
              "carries its rounding error, grid step / sqrt(12) (docs/analysis.md). Continuum "
              "uncertainty: that rounding error where it applies, and Roache's grid-convergence "
-             "index (Fs = 1.25) of the 1D base-case grid study (verification/mms/"
+             "index (Fs = 1.25) of the 1D base-case grid study (verification/grid-studies/"
              f"test_real_problem.cpp, tables in {gci_source}) at the validation run's cell "
              "size, for the claims whose continuum value that study computes (field "
              "continuum_gci of the claim); the study's shortened run (5 transient cycles, "

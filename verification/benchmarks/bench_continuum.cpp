@@ -75,7 +75,8 @@ BENCHMARK(BM_Continuum1D_BaseCase_PaperImplicitDiffusion)->Unit(benchmark::kSeco
 // The integrator that meets issue 4's 2 s per cycle: SSP-RK(s,2) (s right-hand sides per step,
 // a step s - 1 times Heun's at the same Courant number per stage) with the diffusive half
 // steps backward Euler, Richardson-extrapolated to second order (3 solves each). Its base-case
-// quantities against the case's own configuration: mms.NightlyRealProblem/FastIntegrators.
+// quantities against the case's own configuration:
+// grid-studies.NightlyRealProblem/FastIntegrators.
 void BM_Continuum1D_BaseCase_PaperExtrapolatedImplicitStages(benchmark::State& state) {
   run_fraction(state,
                base_case(1, 0.1, "paper", "implicit_extrapolated", static_cast<int>(state.range(0))), 1.0);
@@ -101,8 +102,8 @@ BENCHMARK(BM_Continuum1D_BaseCase_FullExtrapolatedImplicit)->Unit(benchmark::kSe
 // packed layer's sound speed sets the step until the layer first leaves the plate), so the
 // figures above overstate a cycle. The periodic state is reached once per cell size with
 // paper transport, the extrapolated implicit diffusion and SSP-RK(4,2) (the fast setting that
-// agrees with the reference, mms.NightlyRealProblem/FastIntegrators) over `transient` cycles;
-// every benchmark below starts from that state, which all integrators share to within the
+// agrees with the reference, grid-studies.NightlyRealProblem/FastIntegrators) over `transient`
+// cycles; every benchmark below starts from that state, which all integrators share to within the
 // grid uncertainty, and times one whole cycle.
 constexpr int transient_cycles = 8;
 
@@ -137,7 +138,7 @@ void run_periodic_cycle(benchmark::State& state, const continuum::ContinuumCase&
 
 // The integrators of the from-rest benchmarks above, and paper transport with explicit
 // diffusion and SSP-RK(10,2), which gives the default's answer (Heun, s = 2) within the grid
-// uncertainty (mms.NightlyRealProblem/FastIntegrators.*/paper_explicit_s10).
+// uncertainty (grid-studies.NightlyRealProblem/FastIntegrators.*/paper_explicit_s10).
 void BM_Continuum1D_PeriodicCycle_PaperStages(benchmark::State& state) {
   run_periodic_cycle(state, base_case(1, 0.1, "paper", "explicit", static_cast<int>(state.range(0))));
 }

@@ -22,13 +22,12 @@ file as what it is. The run's directory is removed when every check passes.
 import argparse
 import math
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import tomllib
 
 import h5py
+import keep_on_failure
 import numpy as np
 
 FIELDS = ("n", "ux", "uy", "uz", "T")
@@ -223,7 +222,7 @@ def main():
     parser.add_argument("--shaker", required=True)
     parser.add_argument("--reader", choices=("meshio", "paraview"), required=True)
     args = parser.parse_args()
-    work = tempfile.mkdtemp(prefix=f"shaker-continuum-fields-xdmf-{args.reader}-")
+    work = keep_on_failure.work_folder(f"shaker-continuum-fields-xdmf-{args.reader}-")
     run_path = os.path.join(work, "box.h5")
     with open(os.path.join(work, "box.toml"), "w") as f:
         f.write(CASE)
@@ -243,12 +242,9 @@ def main():
         read_meshio(xdmf, hexahedra, snapshots)
     elif not read_paraview(xdmf, hexahedra, snapshots):
         return 1
-    if problems:
-        print(f"{len(problems)} problem(s); files kept in {work}")
-        return 1
-    shutil.rmtree(work)
-    print(f"every field of {len(snapshots)} snapshots read through {args.reader} equals h5py's")
-    return 0
+    return keep_on_failure.finish(
+        work, problems,
+        f"every field of {len(snapshots)} snapshots read through {args.reader} equals h5py's")
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 #pragma once
-// Shared helpers of the continuum tests: building solvers, norms, least-squares orders.
+// Shared helpers of the continuum tests: building solvers, norms, observed orders.
 #include <gtest/gtest.h>
 #include <unistd.h>  // getpid
 
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "continuum/time_integrator.hpp"
+#include "support/convergence.hpp"
 #include "support/test_directory.hpp"
 
 namespace shaker::continuum::testing {
@@ -30,20 +31,11 @@ inline Grid column(int cells, double height, int dimension = 1, int horizontal =
   return g;
 }
 
-/// Least-squares slope of log(error) against log(h): the observed order.
-inline double fitted_order(const std::vector<double>& h, const std::vector<double>& error) {
-  const double m = static_cast<double>(h.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    const double x = std::log(h[i]), y = std::log(error[i]);
-    sx += x; sy += y; sxx += x * x; sxy += x * y;
-  }
-  return (m * sxy - sx * sy) / (m * sxx - sx * sx);
-}
+/// The observed order: fit_order(h, error, finest).order, the least-squares slope of log(error)
+/// against log(h) over the `finest` levels with the smallest h.
+using shaker::convergence::fit_order;
 
-inline std::filesystem::path test_directory() {
-  return shaker::testing::test_directory("shaker-continuum-");
-}
+using shaker::testing::test_directory;
 
 inline double total(const Grid& g, const State& s, int variable) {
   double sum = 0.0;

@@ -6,11 +6,12 @@
 #include <cmath>
 
 #include "common/granular_model.hpp"
+#include "support/convergence.hpp"
 
 namespace shaker::model {
 namespace {
 
-double relative(double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); }
+using shaker::convergence::relative_error;
 
 TEST(ConstitutiveValues, EqualTheIndividualFunctions) {
   double worst = 0.0;
@@ -35,7 +36,7 @@ TEST(ConstitutiveValues, EqualTheIndividualFunctions) {
               EXPECT_EQ(pair[0], 0.0);  // e = 1: no collisional loss
               continue;
             }
-            worst = std::max(worst, relative(pair[0], pair[1]));
+            worst = std::max(worst, relative_error(pair[0], pair[1]));
           }
         }
   std::printf("largest relative difference fused vs individual: %.3e\n", worst);

@@ -110,7 +110,7 @@ TEST(DiffusionIntegrators, TemporalOrderOfRkl2AndImplicit) {
       dts.push_back(dt);
       errors.push_back(worst);
     }
-    const double order = fitted_order({dts.end() - 3, dts.end()}, {errors.end() - 3, errors.end()});
+    const double order = fit_order(dts, errors, 3).order;
     const int design = method == DiffusionIntegrator::implicit ? 1 : 2;
     const char* name = method == DiffusionIntegrator::rkl2       ? "RKL2"
                        : method == DiffusionIntegrator::implicit ? "implicit"

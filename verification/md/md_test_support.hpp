@@ -13,9 +13,7 @@
 
 namespace shaker::md::testing {
 
-inline std::filesystem::path test_directory() {
-  return shaker::testing::test_directory("shaker-md-");
-}
+using shaker::testing::test_directory;
 
 inline Vec3 total_momentum(const Simulation& s) {
   std::vector<Vec3> r, v;

@@ -17,8 +17,8 @@
 
 #include "cell_average.hpp"
 #include "continuum/time_integrator.hpp"
-#include "convergence.hpp"
-#include "error_table.hpp"
+#include "support/convergence.hpp"
+#include "support/error_table.hpp"
 #include "mms_source.hpp"
 
 namespace shaker::mms {

@@ -29,7 +29,7 @@ namespace {
 constexpr double design_space_order = 2.0;  // MUSCL (unlimited) + central viscous fluxes
 constexpr double order_tolerance = 0.1;
 
-std::filesystem::path test_directory() { return shaker::testing::test_directory("shaker-mms-"); }
+using shaker::testing::test_directory;
 
 std::string study_name() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

@@ -16,12 +16,11 @@ removed on success.
 import argparse
 import os
 import shlex
-import shutil
 import subprocess
 import sys
-import tempfile
 
 import h5py
+import keep_on_failure
 import numpy as np
 
 CASE = """
@@ -156,7 +155,7 @@ def main():
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
-    work = tempfile.mkdtemp(prefix=f"md-ensemble-{args.check}-")
+    work = keep_on_failure.work_folder(f"md-ensemble-{args.check}-")
     with open(os.path.join(work, "case.toml"), "w") as f:
         f.write(CASE)
     if args.check == "pooling":
@@ -167,11 +166,7 @@ def main():
         failures = check_continuum_refused(args.shaker, work, args.mpirun)
     for failure in failures:
         print("FAIL:", failure)
-    if failures:
-        print(f"kept {work}")
-        return 1
-    shutil.rmtree(work)
-    return 0
+    return keep_on_failure.finish(work, failures)
 
 
 if __name__ == "__main__":

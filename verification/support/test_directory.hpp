@@ -1,6 +1,7 @@
 #pragma once
 // One temporary directory per test and process (ctest -j safe, also with two ctest runs at
-// once), shared by every GoogleTest program under verification/. A directory is removed when its
+// once), shared by every GoogleTest program under verification/ (shaker_gtest defines
+// SHAKER_TEST_FOLDER, the folder, for each). A directory is removed when its
 // test ends without a failure, so a green run leaves nothing in the system temporary folder, and
 // is kept (its path printed) when the test fails, so the failure can be inspected.
 #include <gtest/gtest.h>
@@ -50,9 +51,15 @@ inline DirectoryCleaner& cleaner() {
 
 }  // namespace detail
 
-/// A fresh, empty directory `<prefix><name>-<pid>` in the system temporary folder; `name`
-/// defaults to the running test's suite and name. Call it inside a test.
-inline std::filesystem::path test_directory(const std::string& prefix, std::string name = "") {
+#ifndef SHAKER_TEST_FOLDER
+#error "SHAKER_TEST_FOLDER: declare the test program with shaker_gtest (cmake/ShakerTests.cmake)"
+#endif
+
+/// A fresh, empty directory `shaker-<folder>-<name>-<pid>` in the system temporary folder,
+/// <folder> the test's folder under verification/; `name` defaults to the running test's suite
+/// and name. Call it inside a test.
+inline std::filesystem::path test_directory(std::string name = "") {
+  const std::string prefix = std::string("shaker-") + SHAKER_TEST_FOLDER + "-";
   if (name.empty()) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     name = std::string(info->test_suite_name()) + "-" + info->name();

@@ -18,15 +18,14 @@ In a fresh temporary directory (removed when every check passes, kept and printe
      continued run ends where the straight run does.
 Exit code 0 when every check holds.
 """
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import h5py
+import keep_on_failure
 import numpy as np
 
 # Small cases that run N cycles in about a second: long enough for the signal to arrive
@@ -215,7 +214,7 @@ def stopped_run(runs, cycles):
 
 def main():
     shaker, solver = sys.argv[1], sys.argv[2]
-    directory = Path(tempfile.mkdtemp(prefix=f"shaker-checkpoints-{solver}-"))
+    directory = Path(keep_on_failure.work_folder(f"shaker-checkpoints-{solver}-"))
     runs = Runs(shaker, solver, directory)
     cycles = CASES[solver]["cycles"]
     start = time.monotonic()
@@ -228,11 +227,7 @@ def main():
         stopped_run(runs, cycles)
     left = [p.name for p in directory.iterdir() if ".partial-" in p.name]
     check(not left, f"temporary files left: {left}")
-    if failures:
-        print(f"{len(failures)} check(s) failed; the runs are in {directory}")
-        return 1
-    shutil.rmtree(directory)
-    return 0
+    return keep_on_failure.finish(directory, failures)
 
 
 if __name__ == "__main__":

@@ -6,10 +6,10 @@ and kept (its path printed) when it fails.
     check_install.py CMAKE BUILD_DIR
 """
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
+
+import keep_on_failure
 
 DOCS = ["README.md", "LICENSE", "CITATION.cff", "docs/models.md", "docs/units.md",
         "docs/configuration.md", "docs/output-schema.md", "docs/reproducing-the-paper.md"]
@@ -17,7 +17,7 @@ DOCS = ["README.md", "LICENSE", "CITATION.cff", "docs/models.md", "docs/units.md
 
 def main():
     cmake, build_dir = sys.argv[1], sys.argv[2]
-    prefix = tempfile.mkdtemp(prefix="shaker-install-")
+    prefix = keep_on_failure.work_folder("shaker-install-")
     problems = []
     done = subprocess.run([cmake, "--install", build_dir, "--prefix", prefix],
                           capture_output=True, text=True)
@@ -32,13 +32,10 @@ def main():
         doc_dir = os.path.join(prefix, "share", "doc", "granular-shaker")
         problems += [f"missing {os.path.join(doc_dir, d)}" for d in DOCS
                      if not os.path.isfile(os.path.join(doc_dir, d))]
-    if problems:
-        print("\n".join(problems))
-        print(f"install prefix kept for inspection: {prefix}")
-        return 1
-    shutil.rmtree(prefix)
-    print(f"installed bin/shaker and {len(DOCS)} documents; prefix removed")
-    return 0
+    for problem in problems:
+        print("PROBLEM:", problem)
+    return keep_on_failure.finish(
+        prefix, problems, f"installed bin/shaker and {len(DOCS)} documents; prefix removed")
 
 
 if __name__ == "__main__":

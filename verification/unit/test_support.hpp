@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/errors.hpp"
+#include "support/convergence.hpp"
 #include "support/test_directory.hpp"
 
 namespace shaker::testing {
@@ -20,7 +21,7 @@ namespace shaker::testing {
 /// passes, kept when it fails (support/test_directory.hpp).
 class TemporaryDirectory {
  public:
-  TemporaryDirectory() : path_(test_directory("shaker-unit-")) {}
+  TemporaryDirectory() : path_(test_directory()) {}
   TemporaryDirectory(const TemporaryDirectory&) = delete;
   TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
   const std::filesystem::path& path() const { return path_; }
@@ -30,11 +31,7 @@ class TemporaryDirectory {
   std::filesystem::path path_;
 };
 
-/// |actual - expected| / |expected| (absolute difference when expected is zero).
-inline double relative_error(double actual, double expected) {
-  const double difference = std::abs(actual - expected);
-  return expected == 0.0 ? difference : difference / std::abs(expected);
-}
+using shaker::convergence::relative_error;
 
 /// Runs f, expects InputError, and checks that the message contains every fragment; with
 /// `seconds` > 0, also that the refusal took less than that.

@@ -5,6 +5,7 @@
 //
 // Conventions: level 1 is the finest grid, h its representative spacing (or time step);
 // r21 = h2 / h1 > 1. Everything here is a pure function of its arguments.
+#include <cmath>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -76,5 +77,11 @@ struct ErrorNorms {
   double l1 = 0.0, l2 = 0.0, linf = 0.0;
 };
 ErrorNorms error_norms(std::span<const double> numeric, std::span<const double> exact);
+
+/// |actual - expected| / |expected| (the absolute difference when expected is zero).
+inline double relative_error(double actual, double expected) {
+  const double difference = std::abs(actual - expected);
+  return expected == 0.0 ? difference : difference / std::abs(expected);
+}
 
 }  // namespace shaker::convergence

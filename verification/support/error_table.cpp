@@ -1,4 +1,4 @@
-#include "error_table.hpp"
+#include "support/error_table.hpp"
 
 #include <fmt/format.h>
 

@@ -1,5 +1,5 @@
-"""ctest convergence_report: reports/make_convergence_report.py on a small synthetic study in a
-temporary directory.
+"""ctest reports.convergence_report: reports/make_convergence_report.py on a small synthetic
+study in a temporary directory.
 
 Checks the provenance header, the order and GCI rows with
 their pass/fail marks, the failure summary with measured values, the units of every table

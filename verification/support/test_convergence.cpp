@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "common/units.hpp"
-#include "convergence.hpp"
-#include "error_table.hpp"
+#include "support/convergence.hpp"
+#include "support/error_table.hpp"
 #include "support/test_directory.hpp"
 
 namespace cv = shaker::convergence;
@@ -31,11 +31,8 @@ std::vector<double> halving(double h0, int levels) {
   return h;
 }
 
-std::filesystem::path fresh_directory(const std::string& test_name) {
-  return shaker::testing::test_directory("shaker-convergence-", test_name);
-}
-
-double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
+using shaker::testing::test_directory;
+using shaker::convergence::relative_error;
 }  // namespace
 
 TEST(ObservedOrder, RecoversExactPowerLaw) {
@@ -115,13 +112,13 @@ TEST(Gci, CelikMonotonicExample) {
   EXPECT_TRUE(g.order_converged);
   EXPECT_NEAR(g.r21, 1.5, 1e-12);
   EXPECT_NEAR(g.r32, 4.0 / 3.0, 1e-12);
-  EXPECT_LT(relative(g.order, 1.533969020628196), 1e-9);
-  EXPECT_LT(relative(g.phi_extrapolated, 6.168495572330159), 1e-9);
-  EXPECT_LT(relative(g.relative_difference21, 0.015009071416790254), 1e-12);
-  EXPECT_LT(relative(g.extrapolated_error21, 0.01710231791417311), 1e-8);
-  EXPECT_LT(relative(g.gci21, 0.021749870594210814), 1e-8);
-  EXPECT_LT(relative(g.gci32, 0.04112851061833544), 1e-8);
-  EXPECT_LT(relative(g.asymptotic_ratio, 1.01523777628935), 1e-8);
+  EXPECT_LT(relative_error(g.order, 1.533969020628196), 1e-9);
+  EXPECT_LT(relative_error(g.phi_extrapolated, 6.168495572330159), 1e-9);
+  EXPECT_LT(relative_error(g.relative_difference21, 0.015009071416790254), 1e-12);
+  EXPECT_LT(relative_error(g.extrapolated_error21, 0.01710231791417311), 1e-8);
+  EXPECT_LT(relative_error(g.gci21, 0.021749870594210814), 1e-8);
+  EXPECT_LT(relative_error(g.gci32, 0.04112851061833544), 1e-8);
+  EXPECT_LT(relative_error(g.asymptotic_ratio, 1.01523777628935), 1e-8);
   // The paper's rounded values.
   EXPECT_NEAR(g.order, 1.53, 0.005);
   EXPECT_NEAR(g.phi_extrapolated, 6.1685, 5e-5);
@@ -134,10 +131,10 @@ TEST(Gci, CelikOscillatoryExampleIsFlagged) {
   EXPECT_EQ(g.kind, cv::ConvergenceKind::oscillatory);
   EXPECT_EQ(cv::to_string(g.kind), "oscillatory");
   EXPECT_TRUE(g.order_converged);
-  EXPECT_LT(relative(g.order, 1.507691655935596), 1e-9);
-  EXPECT_LT(relative(g.phi_extrapolated, 6.026873682714785), 1e-9);
-  EXPECT_LT(relative(g.gci21, 0.004720379633170305), 1e-8);
-  EXPECT_LT(relative(g.asymptotic_ratio, 0.9312240836978866), 1e-8);
+  EXPECT_LT(relative_error(g.order, 1.507691655935596), 1e-9);
+  EXPECT_LT(relative_error(g.phi_extrapolated, 6.026873682714785), 1e-9);
+  EXPECT_LT(relative_error(g.gci21, 0.004720379633170305), 1e-8);
+  EXPECT_LT(relative_error(g.asymptotic_ratio, 0.9312240836978866), 1e-8);
 }
 
 TEST(Gci, UniformRatioSecondOrderIsInTheAsymptoticRange) {
@@ -191,7 +188,7 @@ TEST(ErrorNorms, ConstantAndSineOffsets) {
 }
 
 TEST(ErrorTable, RoundTripsThroughCsvExactly) {
-  const auto dir = fresh_directory("RoundTrip");
+  const auto dir = test_directory("RoundTrip");
   cv::ErrorTable table;
   table.add({"mms-1d", "n", "L1", 0, 0.1, 1.0 / 3.0});
   table.add({"mms-1d", "n", "L1", 1, 0.05, 1e-300});
@@ -250,7 +247,7 @@ TEST(OrderChecks, PassAndFailAgainstTheBand) {
   EXPECT_NE(csv.find("s,n,L2,3,"), std::string::npos);
   EXPECT_NE(csv.find(",0\n"), std::string::npos);  // the failing row says so
 
-  const auto dir = fresh_directory("OrderChecks");
+  const auto dir = test_directory("OrderChecks");
   cv::write_orders_csv(dir / "s.orders.csv", checks);
   const cv::GciRow row = cv::make_gci_row("s", "shock", 0.025, 0.05, 0.1, 1.0 + 0.025 * 0.025,
                                           1.0 + 0.05 * 0.05, 1.0 + 0.1 * 0.1);
@@ -329,7 +326,7 @@ TEST(GciRows, AsymptoticRatioMustLieWithinItsToleranceOfOne) {
 TEST(ReportPipeline, StudyWrittenHereIsReadByTheReportGenerator) {
   // A synthetic study must not reach the nightly report (each test runs in its own process).
   ::unsetenv(cv::study_directory_variable);
-  const auto dir = fresh_directory("ReportPipeline");
+  const auto dir = test_directory("ReportPipeline");
   cv::ErrorTable table;
   const auto h = halving(0.1, 4);
   for (int k = 0; k < 4; ++k) {

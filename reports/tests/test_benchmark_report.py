@@ -1,4 +1,5 @@
-"""ctest benchmark_report: reports/make_benchmark_report.py on synthetic Google Benchmark JSON.
+"""ctest reports.benchmark_report: reports/make_benchmark_report.py on synthetic Google Benchmark
+JSON.
 
 Two runs of three benchmarks with 9 repetitions each: one
 20% slower, one 20% faster, one unchanged (seeded noise). Checks the throughput rows per

@@ -22,8 +22,8 @@
 
 #include "common/config.hpp"
 #include "common/profile.hpp"
-#include "convergence.hpp"
-#include "error_table.hpp"
+#include "support/convergence.hpp"
+#include "support/error_table.hpp"
 
 namespace shaker::convergence {
 

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "convergence.hpp"
+#include "support/convergence.hpp"
 
 namespace shaker::convergence {
 

@@ -61,9 +61,7 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-std::filesystem::path fresh_directory(const std::string& test) {
-  return shaker::testing::test_directory("shaker-md-sampling-", test);
-}
+using shaker::testing::test_directory;
 
 // ---- the statistics, on synthetic cycles ------------------------------------------------
 
@@ -258,7 +256,7 @@ void expect_driver_reproduces_shaker_md(const StudyDesign& d, const conv::Sampli
 }
 
 void run_study(const StudyDesign& d, bool cross_check) {
-  const auto dir = fresh_directory(d.name);
+  const auto dir = test_directory(d.name);
   const double fine_bin = 0.5;
   const auto config = study_config(d, d.cycles, 1.0, dir / "unused.h5");
   const conv::SamplingTrajectory run = conv::run_sampling_trajectory(config, d.block_sizes, fine_bin);
@@ -345,7 +343,7 @@ TEST(MdSampling, BaseCaseStandardErrorAndBinSize) {
 // and apart from the study so that ctest -j runs the two side by side.
 TEST(MdSampling, DriverReproducesShakerMd) {
   const StudyDesign d{"md-sampling-driver", 1, 2, {2}, 13};
-  const auto dir = fresh_directory(d.name);
+  const auto dir = test_directory(d.name);
   const auto run = conv::run_sampling_trajectory(study_config(d, d.cycles, 1.0, dir / "unused.h5"),
                                                  d.block_sizes, 0.5);
   expect_driver_reproduces_shaker_md(d, run, dir);

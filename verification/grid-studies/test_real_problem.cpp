@@ -27,7 +27,7 @@
 #include "common/config.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
-#include "error_table.hpp"
+#include "support/error_table.hpp"
 #include "support/test_directory.hpp"
 
 namespace conv = shaker::convergence;
@@ -84,9 +84,7 @@ std::map<std::string, double> quantities(const shaker::RunRecord& run) {
 
 using Quantities = std::map<std::string, double>;
 
-std::filesystem::path study_directory(const std::string& name) {
-  return shaker::testing::test_directory("shaker-mms-", name);
-}
+using shaker::testing::test_directory;
 
 /// The base case at cell size h under the study's protocol (plus `extra` settings), analysed.
 Quantities run_base_case(const std::filesystem::path& dir, const std::string& label, double h,
@@ -143,7 +141,7 @@ double grid_uncertainty(const conv::GciRow& row) {
 const std::vector<double> cells_1d{0.4, 0.2, 0.1, 0.05};  // coarse to fine
 
 TEST(NightlyRealProblem, BaseCase1DGridConvergence) {
-  const auto dir = study_directory("real-problem-1d");
+  const auto dir = test_directory("real-problem-1d");
   std::vector<Quantities> values;
   for (double h : cells_1d) values.push_back(run_base_case(dir, "1d", h));
   // Fine triple (0.05, 0.1, 0.2) and coarse triple (0.1, 0.2, 0.4): h1 < h2 < h3.
@@ -175,7 +173,7 @@ class FastIntegrators : public ::testing::TestWithParam<FastIntegrator> {};
 TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
   const FastIntegrator fast = GetParam();
   const std::string label = fast.transport + "-" + fast.diffusion + "-s" + std::to_string(fast.stages);
-  const auto dir = study_directory("real-problem-integrators-" + label);
+  const auto dir = test_directory("real-problem-integrators-" + label);
   const std::vector<std::string> model{"continuum.transport=" + fast.transport};
   std::vector<std::string> reference_settings = model;
   reference_settings.push_back(fast.transport == "paper" ? "continuum.diffusion_integrator=explicit"
@@ -234,7 +232,7 @@ INSTANTIATE_TEST_SUITE_P(
 // allowed 5.0e-3) do not. The shock width (3D 3.5, 1D 3.6 on all three grids) failed then
 // only because the unchanging 1D triple has no GCI (NaN); now its uncertainty is 0.
 TEST(NightlyRealProblem, BaseCase3DTwoGridsAgreeWithThe1DColumn) {
-  const auto dir = study_directory("real-problem-3d");
+  const auto dir = test_directory("real-problem-3d");
   const std::vector<std::string> three_d{"continuum.dimension=3", "continuum.box_width=4"};
   const std::vector<double> cells_3d{1.0, 0.5};
   std::vector<Quantities> values_3d;

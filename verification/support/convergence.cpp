@@ -1,4 +1,4 @@
-#include "convergence.hpp"
+#include "support/convergence.hpp"
 
 #include <gsl/gsl_fit.h>
 

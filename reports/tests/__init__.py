@@ -1,0 +1,1 @@
+"""pytest tests of the reports package (run by ctest as reports.*)."""

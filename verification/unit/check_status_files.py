@@ -1,0 +1,80 @@
+#!/usr/bin/python3
+"""Fails when a line of a status.txt (verification/README.md) selects no test: a pattern left
+behind by a renamed or removed test would otherwise go on saying nothing, silently. Reads the
+tests the build directory declares (`ctest --show-only=json-v1`) and checks that every pattern
+of every status.txt under the source tree matches at least one of them, and that the first
+matching line's labels are the labels the test carries.
+
+    check_status_files.py CTEST SOURCE_DIR BUILD_DIR
+"""
+import fnmatch
+import json
+import os
+import re
+import subprocess
+import sys
+
+LINE = re.compile(r"^(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S.*)$")
+
+
+def status_lines(source_dir):
+    """(file, line number, pattern, labels) of every status line, in file order."""
+    lines = []
+    for root, dirs, files in os.walk(source_dir):
+        dirs[:] = [d for d in dirs if not d.startswith(".") and not d.startswith("build")]
+        if "status.txt" not in files:
+            continue
+        path = os.path.join(root, "status.txt")
+        with open(path) as f:
+            for number, text in enumerate(f, 1):
+                if not text.strip() or text.lstrip().startswith("#"):
+                    continue
+                match = LINE.match(text.rstrip("\n"))
+                if not match:
+                    lines.append((path, number, None, None))
+                    continue
+                labels = [] if match[2] == "default" else sorted(match[2].split(","))
+                lines.append((path, number, match[1], labels))
+    return lines
+
+
+def main():
+    ctest, source_dir, build_dir = sys.argv[1], sys.argv[2], sys.argv[3]
+    listed = subprocess.run([ctest, "--test-dir", build_dir, "--show-only=json-v1"],
+                            capture_output=True, text=True)
+    if listed.returncode != 0:
+        print(f"ctest --show-only failed ({listed.returncode}):\n{listed.stderr}")
+        return 1
+    labels_of = {}
+    for test in json.loads(listed.stdout)["tests"]:
+        properties = {p["name"]: p["value"] for p in test.get("properties", [])}
+        labels_of[test["name"]] = sorted(properties.get("LABELS", []))
+    lines = status_lines(source_dir)
+    problems = []
+    decided = set()
+    for path, number, pattern, labels in lines:
+        where = f"{os.path.relpath(path, source_dir)}:{number}"
+        if pattern is None:
+            problems.append(f"{where}: not PATTERN LABELS TIMEOUT ENVIRONMENT REASON")
+            continue
+        matched = [name for name in labels_of if fnmatch.fnmatchcase(name, pattern)]
+        if not matched:
+            problems.append(f"{where}: '{pattern}' matches no test")
+        for name in matched:
+            if name in decided:
+                continue
+            decided.add(name)
+            if labels_of[name] != labels:
+                problems.append(f"{where}: {name} carries labels {labels_of[name]}, "
+                                f"the line says {labels}")
+    for problem in problems:
+        print("PROBLEM:", problem)
+    if problems:
+        return 1
+    print(f"{len(lines)} status lines, each matching a test with its labels; "
+          f"{len(decided)} of {len(labels_of)} tests decided by them")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
