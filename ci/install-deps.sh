@@ -5,7 +5,8 @@
 #   ci/install-deps.sh             what ci/test.sh and ci/base-case.sh need (the default set)
 #   ci/install-deps.sh --nightly   also what only the nightly tests need (ci/nightly runs this):
 #                                  ParaView, whose XDMF readers read the 3D fields
-#                                  (ctest continuum.FieldsXdmf.ParaView)
+#                                  (ctest continuum.FieldsXdmf.ParaView), and Clang with
+#                                  libFuzzer for the fuzz targets (preset fuzz)
 set -euo pipefail
 
 packages=(
@@ -19,7 +20,7 @@ packages=(
 )
 case ${1:-} in
   "") ;;
-  --nightly) packages+=(paraview python3-paraview) ;;
+  --nightly) packages+=(paraview python3-paraview clang libfuzzer-14-dev) ;;
   *) echo "install-deps: unknown argument '$1' (allowed: --nightly)" >&2; exit 2 ;;
 esac
 
