@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Fails when docs/configuration.md is not the output of `shaker config --describe --markdown`
-(the schema in solvers/common/parameters*.cpp changed and the document was not regenerated).
+(the schema in solvers/*/parameters.cpp changed and the document was not regenerated).
 
     check_configuration_doc.py SHAKER SOURCE_DIR
 """
