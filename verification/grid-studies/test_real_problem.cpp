@@ -226,11 +226,7 @@ INSTANTIATE_TEST_SUITE_P(
 // column's value (fine triple 0.05-0.2, grid_uncertainty), i.e. both estimates of the
 // discretisation error account for the difference between the two codes. (At equal cell size
 // the 3D and 1D runs also differ by their time steps, the 3D diffusive limit being 3 times
-// smaller.) Measured at 33ca59a (50 min): 7 of 10 quantities agree; the centre of mass at
-// f t = 0.5 (3D 25.8693, 1D 25.8610: the two 3D grids agree to 2e-4 by chance, so the
-// two-grid GCI, 5e-6, misses the 3D error) and the shock speed (4.2742 against 4.2643, 0.23 %,
-// allowed 5.0e-3) do not. The shock width (3D 3.5, 1D 3.6 on all three grids) failed then
-// only because the unchanging 1D triple has no GCI (NaN); now its uncertainty is 0.
+// smaller.) The measured values and which quantities agree are in reports/convergence.md.
 TEST(NightlyRealProblem, BaseCase3DTwoGridsAgreeWithThe1DColumn) {
   const auto dir = test_directory("real-problem-3d");
   const std::vector<std::string> three_d{"continuum.dimension=3", "continuum.box_width=4"};

@@ -307,17 +307,13 @@ TEST_P(NightlyMmsSpace3D, EveryFieldAndNormAtSecondOrder) {
   c.dimension = 3;
   c.transport = GetParam();
   c.boundary = ZBoundary::walls;
-  // On 8..64 cells (t_end 0.25) the orders were still rising (n Linf pairs 1.66, 1.84; n L1
-  // 1.82, 2.13; u_z erratic): the 3 finest grids must include 128 cells. Its explicit step
-  // is diffusive (~ h^2), so a 128 level to t_end 0.25 would take ~70 min per variant. The
-  // source balances the full operator at every instant, so every term acts from the first
-  // step and the error accumulates the same way over a quarter of the time: ~15 min.
-  // Measured on 16..128 (2026-11-29): u_x, u_y, u_z, T finest pairs 1.85-1.99, each above
-  // the pair before it (approaching 2 from below); n 2.11-2.39 (from above in L1, L2).
-  // Fitted over the 3 finest, 10 of 15 series per variant are outside the band; a 256
-  // level would cost ~16x.
+  // On coarser grids the observed orders were still rising, so the three finest grids must
+  // include 128 cells. Its explicit step is diffusive (~ h^2), so the final time is a quarter
+  // of the 1D studies': the source balances the full operator at every instant, so every term
+  // acts from the first step and the error accumulates the same way. The measured orders and
+  // the series still outside the band are in reports/convergence.md.
   c.t_end = 0.0625;
-  c.source_at_centre = true;  // 27 Gauss points per cell and stage would cost an hour
+  c.source_at_centre = true;  // 27 Gauss points per cell and stage would dominate the run
   conv::ErrorTable table;
   mms::spatial_study(c, {16, 32, 64, 128}, study_name(), table);
   check_and_write(table, design_space_order);
