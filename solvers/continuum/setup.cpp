@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/errors.hpp"
+#include "continuum/halo.hpp"
 
 namespace shaker::continuum {
 
@@ -103,9 +104,19 @@ ContinuumCase continuum_case(const config::Config& config) {
   return c;
 }
 
-TimeIntegrator make_solver(const ContinuumCase& c) {
-  TimeIntegrator solver(c.grid, c.physics, c.integration);
-  flat_layer(c.grid, c.layer, solver.state());
+TimeIntegrator make_solver(const ContinuumCase& c, std::shared_ptr<const Halo> halo) {
+  if (!halo) {
+    TimeIntegrator solver(c.grid, c.physics, c.integration);
+    flat_layer(c.grid, c.layer, solver.state());
+    return solver;
+  }
+  TimeIntegrator solver(halo->local(), c.physics, c.integration, halo);
+  State box;  // the random perturbation is drawn in the box's cell order: only the root draws
+  if (halo->root()) {
+    box.resize(c.grid.size());
+    flat_layer(c.grid, c.layer, box);
+  }
+  halo->scatter(box, solver.state());
   return solver;
 }
 
