@@ -330,33 +330,48 @@ void ImplicitDiffusion::advance(Operator& op, State& U, double dt, bool closure_
 // plane (each plane's sum independent of the threads), summed over the ranks, then over the
 // planes in order.
 namespace {
-/// body(c, k) for every interior cell c of plane k; planes shared between threads.
+/// Calls plane(k) for every plane k, shared between threads on a large block (serial otherwise:
+/// even an OpenMP region whose `if` is false costs a runtime call, and CG makes many).
+template <class Plane> void for_planes(const Grid& g, Plane plane) {
+  if (g.threaded()) {
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < g.nz; ++k) plane(k);
+  } else {
+    for (int k = 0; k < g.nz; ++k) plane(k);
+  }
+}
+
+/// body(c, k) for every interior cell c of plane k.
 template <class Body> void for_interior(const Grid& g, Body body) {
-#pragma omp parallel for schedule(static) if (g.threaded())
-  for (int k = 0; k < g.nz; ++k)
+  for_planes(g, [&](int k) {
     for (int j = 0; j < g.ny; ++j) {
       const std::ptrdiff_t first = g.index(0, j, k);
       for (std::ptrdiff_t c = first; c < first + g.nx; ++c) body(c, k);
     }
+  });
 }
 
-/// Per plane k, sums[k * count + s] = sum over the plane's interior cells c of term(c, k, s)
-/// for s < count (zeroed first).
-template <class Term> void plane_sums(const Grid& g, int count, std::vector<double>& sums, Term term) {
+/// Per plane k, sums[k * count + s] = sum over the plane's interior cells c of term(c, k)[s],
+/// s < count, in storage order (the accumulators stay in registers).
+template <int count, class Term> void plane_sums(const Grid& g, std::vector<double>& sums, Term term) {
   sums.assign(static_cast<std::size_t>(g.nz) * count, 0.0);
-#pragma omp parallel for schedule(static) if (g.threaded())
-  for (int k = 0; k < g.nz; ++k)
+  for_planes(g, [&](int k) {
+    std::array<double, count> sum{};
     for (int j = 0; j < g.ny; ++j) {
       const std::ptrdiff_t first = g.index(0, j, k);
-      for (std::ptrdiff_t c = first; c < first + g.nx; ++c)
-        for (int s = 0; s < count; ++s) sums[static_cast<std::size_t>(k) * count + s] += term(c, k, s);
+      for (std::ptrdiff_t c = first; c < first + g.nx; ++c) {
+        const std::array<double, count> terms = term(c, k);
+        for (int s = 0; s < count; ++s) sum[s] += terms[s];
+      }
     }
+    std::copy(sum.begin(), sum.end(), sums.begin() + static_cast<std::ptrdiff_t>(k) * count);
+  });
 }
 }  // namespace
 
 double ImplicitDiffusion::box_sum_of_products(const std::vector<double>& a, const std::vector<double>& b) {
   std::vector<double>& sums = decomposed_.plane_sums;
-  plane_sums(grid_, 1, sums, [&](std::ptrdiff_t c, int, int) { return a[c] * b[c]; });
+  plane_sums<1>(grid_, sums, [&](std::ptrdiff_t c, int) { return std::array<double, 1>{a[c] * b[c]}; });
   halo_->sum(sums);
   double total = 0.0;
   for (const double s : sums) total += s;
@@ -377,8 +392,7 @@ void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, d
   };
   // x and y faces from the low ghost on (the face into the block), z faces between planes:
   // the wall faces' entries stay 0.
-#pragma omp parallel for schedule(static) if (g.threaded())
-  for (int k = 0; k < g.nz; ++k) {
+  for_planes(g, [&](int k) {
     for (int j = -1; j < g.ny; ++j)
       for (int i = -1; i < g.nx; ++i) {
         const std::ptrdiff_t c = g.index(i, j, k);
@@ -386,7 +400,7 @@ void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, d
         if (i >= 0) face(c, 1);
         if (i >= 0 && j >= 0 && k + 1 < g.nz) face(c, 2);
       }
-  }
+  });
   const auto wall = [&](std::ptrdiff_t c, int k) {
     const bool at_wall = component == 2 && (k == 0 || k + 1 == g.nz);
     return at_wall ? 2.0 * coefficient(cl, c, 2, 2) * inv_h2 : 0.0;
@@ -401,9 +415,9 @@ void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, d
   // The coarse system Ac = P^T A P: per plane the mass, wall and z-face terms (the horizontal
   // faces cancel) and the coupling to the plane below.
   std::vector<double>& sums = d.plane_sums;
-  plane_sums(g, 2, sums, [&](std::ptrdiff_t c, int k, int s) {
+  plane_sums<2>(g, sums, [&](std::ptrdiff_t c, int k) {
     const double below = d.face[2][c - strides[2]];
-    return s == 0 ? mass_factor * n[c] / dt + wall(c, k) + d.face[2][c] + below : -below;
+    return std::array<double, 2>{mass_factor * n[c] / dt + wall(c, k) + d.face[2][c] + below, -below};
   });
   halo_->sum(sums);
   const auto planes = static_cast<std::size_t>(g.nz);
@@ -438,8 +452,8 @@ std::pair<double, double> ImplicitDiffusion::precondition_decomposed(const std::
   // Per plane: the sum of r (the coarse right-hand side), r.r and r.D^-1.r, in one reduction;
   // r.z = r.D^-1.r + sum_k coarse_k (plane sum of r)_k follows without a second one.
   std::vector<double>& sums = d.plane_sums;
-  plane_sums(g, 3, sums, [&](std::ptrdiff_t c, int, int s) {
-    return s == 0 ? r[c] : s == 1 ? r[c] * r[c] : r[c] * r[c] * d.inverse_diagonal[c];
+  plane_sums<3>(g, sums, [&](std::ptrdiff_t c, int) {
+    return std::array<double, 3>{r[c], r[c] * r[c], r[c] * r[c] * d.inverse_diagonal[c]};
   });
   halo_->sum(sums);
   const auto planes = static_cast<std::size_t>(g.nz);
