@@ -84,6 +84,14 @@ void Halo::exchange_direction(int d, const std::vector<double*>& fields) const {
   const Grid& g = local_;
   const int G = Grid::ghosts;
   const int n = d == 0 ? g.nx : g.ny;
+  if (dims_[d] == 1) {  // periodic onto itself: each ghost layer copies the opposite edge
+    const std::ptrdiff_t across = n * g.stride(d);
+    for (double* field : fields) {
+      for_layer(g, d, n - G, [&](std::ptrdiff_t c) { field[c - across] = field[c]; });
+      for_layer(g, d, 0, [&](std::ptrdiff_t c) { field[c + across] = field[c]; });
+    }
+    return;
+  }
   const std::size_t layer = static_cast<std::size_t>(G) * g.nz * (d == 0 ? g.ny : g.nx + 2 * G);
   const std::size_t count = layer * fields.size();
   for (auto* buffer : {&send_low_, &send_high_, &receive_low_, &receive_high_}) buffer->resize(count);
@@ -97,20 +105,16 @@ void Halo::exchange_direction(int d, const std::vector<double*>& fields) const {
     for (double* field : fields)
       for_layer(g, d, first, [&](std::ptrdiff_t c) { field[c] = buffer[at++]; });
   };
+  const int size = static_cast<int>(count);
+  MPI_Request requests[4];
+  // Receives posted before the sends, so that the messages need no buffering on arrival.
+  MPI_Irecv(receive_low_.data(), size, MPI_DOUBLE, low_[d], tag_upwards, cartesian_, &requests[0]);
+  MPI_Irecv(receive_high_.data(), size, MPI_DOUBLE, high_[d], tag_downwards, cartesian_, &requests[1]);
   pack(0, send_low_);
   pack(n - G, send_high_);
-  if (dims_[d] == 1) {  // periodic onto itself: the high layers are the low ghosts
-    std::swap(send_low_, receive_high_);
-    std::swap(send_high_, receive_low_);
-  } else {
-    const int size = static_cast<int>(count);
-    MPI_Request requests[4];
-    MPI_Irecv(receive_low_.data(), size, MPI_DOUBLE, low_[d], tag_upwards, cartesian_, &requests[0]);
-    MPI_Irecv(receive_high_.data(), size, MPI_DOUBLE, high_[d], tag_downwards, cartesian_, &requests[1]);
-    MPI_Isend(send_low_.data(), size, MPI_DOUBLE, low_[d], tag_downwards, cartesian_, &requests[2]);
-    MPI_Isend(send_high_.data(), size, MPI_DOUBLE, high_[d], tag_upwards, cartesian_, &requests[3]);
-    MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
-  }
+  MPI_Isend(send_low_.data(), size, MPI_DOUBLE, low_[d], tag_downwards, cartesian_, &requests[2]);
+  MPI_Isend(send_high_.data(), size, MPI_DOUBLE, high_[d], tag_upwards, cartesian_, &requests[3]);
+  MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
   unpack(-G, receive_low_);
   unpack(n, receive_high_);
 }
