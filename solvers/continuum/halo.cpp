@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 
 #include "common/errors.hpp"
 
@@ -34,6 +35,19 @@ template <class Visit> void for_layer(const Grid& g, int direction, int first, V
 }
 
 constexpr int tag_downwards = 0, tag_upwards = 1;
+
+/// Adds the wall seconds of its lifetime to `total`.
+class Stopwatch {
+ public:
+  explicit Stopwatch(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~Stopwatch() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  Stopwatch(const Stopwatch&) = delete;
+  Stopwatch& operator=(const Stopwatch&) = delete;
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_;
+};
 
 }  // namespace
 
@@ -112,26 +126,32 @@ void Halo::exchange_direction(int d, const std::vector<double*>& fields) const {
   MPI_Irecv(receive_high_.data(), size, MPI_DOUBLE, high_[d], tag_downwards, cartesian_, &requests[1]);
   pack(0, send_low_);
   pack(n - G, send_high_);
-  MPI_Isend(send_low_.data(), size, MPI_DOUBLE, low_[d], tag_downwards, cartesian_, &requests[2]);
-  MPI_Isend(send_high_.data(), size, MPI_DOUBLE, high_[d], tag_upwards, cartesian_, &requests[3]);
-  MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
+  {
+    const Stopwatch timed(communication_seconds_);
+    MPI_Isend(send_low_.data(), size, MPI_DOUBLE, low_[d], tag_downwards, cartesian_, &requests[2]);
+    MPI_Isend(send_high_.data(), size, MPI_DOUBLE, high_[d], tag_upwards, cartesian_, &requests[3]);
+    MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
+  }
   unpack(-G, receive_low_);
   unpack(n, receive_high_);
 }
 
 double Halo::sum(double local) const {
+  const Stopwatch timed(communication_seconds_);
   double total = 0.0;
   MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, cartesian_);
   return total;
 }
 
 double Halo::max(double local) const {
+  const Stopwatch timed(communication_seconds_);
   double largest = 0.0;
   MPI_Allreduce(&local, &largest, 1, MPI_DOUBLE, MPI_MAX, cartesian_);
   return largest;
 }
 
 void Halo::sum(std::vector<double>& values) const {
+  const Stopwatch timed(communication_seconds_);
   MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM,
                 cartesian_);
 }
@@ -141,6 +161,7 @@ void Halo::broadcast(std::vector<double>& values) const {
 }
 
 bool Halo::agree(std::string& failure) const {
+  const Stopwatch timed(communication_seconds_);
   const int mine = failure.empty() ? size_ : rank_;
   int first = size_;
   MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, cartesian_);

@@ -68,6 +68,10 @@ class Halo {
   /// The root's `box_state` interior, split into every rank's block (interior cells only).
   void scatter(const State& box_state, State& local_state) const;
 
+  /// Wall seconds this rank has spent in halo messages and reductions, waiting for the other
+  /// ranks included (packing excluded): what the decomposition costs it, for benchmarks.
+  double communication_seconds() const { return communication_seconds_; }
+
  private:
   void exchange_direction(int direction, const std::vector<double*>& fields) const;
   Block block_of(int rank) const;
@@ -80,6 +84,7 @@ class Halo {
   int coords_[2] = {0, 0};
   int low_[2] = {0, 0}, high_[2] = {0, 0};  ///< neighbour ranks in x and y
   mutable std::vector<double> send_low_, send_high_, receive_low_, receive_high_;
+  mutable double communication_seconds_ = 0.0;
 };
 
 }  // namespace shaker::continuum
