@@ -6,6 +6,9 @@
       ranks as without a launcher, bit for bit, every dataset and attribute but the creation
       date; only the energy budget's accumulators, summed over the ranks' shares, may differ,
       within 1e-12 of the budget's scale.
+  check_continuum_ranks.py SHAKER hybrid [--mpirun CMD]
+      The explicit check on a box of 16 x 16 x 40 cells, on 2 ranks of 2 OpenMP threads each
+      (blocks large enough to be shared between threads) against the plain run on one thread.
   check_continuum_ranks.py SHAKER implicit P [P ...] [--mpirun CMD]
       The full transport (implicit diffusion) on P ranks, by the distributed CG whose dot
       products are sums over the ranks, against the run without a launcher (Eigen's CG): every
@@ -95,16 +98,17 @@ TOLERANCE = 1e-12
 
 def mpirun_prefix(command, ranks):
     """The launcher's words for P ranks; as root OpenMPI needs its explicit consent. Ranks
-    yield the core while they wait: the tests oversubscribe a shared machine."""
+    yield the core while they wait (the tests oversubscribe a shared machine) and get the
+    launcher's OMP_NUM_THREADS."""
     words = shlex.split(command) + ["-np", str(ranks), "--oversubscribe",
-                                    "--mca", "mpi_yield_when_idle", "1"]
+                                    "--mca", "mpi_yield_when_idle", "1", "-x", "OMP_NUM_THREADS"]
     if os.geteuid() == 0:
         words.append("--allow-run-as-root")
     return words
 
 
-def run(words, cwd, expect=0):
-    env = dict(os.environ, OMP_NUM_THREADS="1")
+def run(words, cwd, expect=0, threads=1):
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
     result = subprocess.run(words, cwd=cwd, capture_output=True, text=True, env=env)
     if result.returncode != expect:
         raise SystemExit(f"{' '.join(words)}: exit {result.returncode}, expected {expect}\n"
@@ -112,12 +116,12 @@ def run(words, cwd, expect=0):
     return result
 
 
-def shaker_run(shaker, case, output, work, launcher=None, ranks=None, settings=()):
+def shaker_run(shaker, case, output, work, launcher=None, ranks=None, settings=(), threads=1):
     prefix = mpirun_prefix(launcher, ranks) if ranks else []
     words = prefix + [shaker, "continuum", case, "--set", f"run.output={output}", "--quiet"]
     for setting in settings:
         words += ["--set", setting]
-    return run(words, work)
+    return run(words, work, threads=threads)
 
 
 def contents(path):
@@ -189,15 +193,17 @@ def differences(a, b, label, exact, scale, skip=()):
     return out
 
 
-def compare_rank_counts(shaker, work, launcher, counts, exact):
-    """Runs the case without a launcher, then on each count of ranks."""
+def compare_rank_counts(shaker, work, launcher, counts, exact, settings=(), threads=1):
+    """Runs the case without a launcher on one thread, then on each count of ranks of
+    `threads` threads each."""
     failures = []
     reference = "plain"
-    shaker_run(shaker, "case.toml", f"{reference}.h5", work)
+    shaker_run(shaker, "case.toml", f"{reference}.h5", work, settings=settings)
     files = {kind: contents(os.path.join(work, f"{reference}{kind}.h5"))
              for kind in ("", ".fields")}
     for p in counts:
-        result = shaker_run(shaker, "case.toml", f"ranks{p}.h5", work, launcher, p)
+        result = shaker_run(shaker, "case.toml", f"ranks{p}.h5", work, launcher, p, settings,
+                            threads)
         found = []
         for kind, expected in files.items():
             mine = contents(os.path.join(work, f"ranks{p}{kind}.h5"))
@@ -210,7 +216,8 @@ def compare_rank_counts(shaker, work, launcher, counts, exact):
         summaries = result.stdout.count("shaker continuum:")
         if summaries != 1:
             found.append(f"{p} ranks: {summaries} summaries printed, expected 1 (the root's)")
-        print(f"{p} rank(s) against {reference}: {sum(len(f) for f in files.values())} datasets "
+        compared = sum(len(f) for f in files.values())
+        print(f"{p} rank(s) of {threads} thread(s) against {reference}: {compared} datasets "
               f"and attributes compared ({'bit for bit' if exact else f'within {TOLERANCE}'}); "
               f"{len(found)} differences")
         failures += found
@@ -273,7 +280,7 @@ def check_refused(shaker, work, launcher):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
-    parser.add_argument("check", choices=["explicit", "implicit", "restart", "refused"])
+    parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -283,6 +290,9 @@ def main():
     if args.check in ("explicit", "implicit"):
         failures = compare_rank_counts(args.shaker, work, args.mpirun, args.ranks,
                                        args.check == "explicit")
+    elif args.check == "hybrid":
+        failures = compare_rank_counts(args.shaker, work, args.mpirun, [2], True,
+                                       ["continuum.box_width=8", "continuum.ceiling=20"], 2)
     elif args.check == "restart":
         failures = check_restart(args.shaker, work, args.mpirun)
     else:
