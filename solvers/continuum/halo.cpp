@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "common/errors.hpp"
 
@@ -160,12 +161,17 @@ void Halo::broadcast(std::vector<double>& values) const {
   MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, 0, cartesian_);
 }
 
-bool Halo::agree(std::string& failure) const {
+bool Halo::agree(std::string& failure) const { return agree(failure, 0); }
+
+bool Halo::agree(std::string& failure, std::int64_t position) const {
   const Stopwatch timed(communication_seconds_);
-  const int mine = failure.empty() ? size_ : rank_;
-  int first = size_;
-  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, cartesian_);
-  if (first == size_) return true;
+  // (position, rank) as one key, so that one reduction finds the first failure.
+  const std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  const std::int64_t mine = failure.empty() ? none : position * size_ + rank_;
+  std::int64_t earliest = none;
+  MPI_Allreduce(&mine, &earliest, 1, MPI_INT64_T, MPI_MIN, cartesian_);
+  if (earliest == none) return true;
+  const int first = static_cast<int>(earliest % size_);
   int length = static_cast<int>(failure.size());
   MPI_Bcast(&length, 1, MPI_INT, first, cartesian_);
   failure.resize(static_cast<std::size_t>(length));

@@ -59,6 +59,9 @@ class Halo {
   /// Every rank's `failure` (empty: none); returns true if none failed, else false on every
   /// rank with `failure` set to the message of the lowest failing rank.
   bool agree(std::string& failure) const;
+  /// The same, the failure chosen by its `position` (the failing cell's place in the box's
+  /// storage order, as a plain run would have met it first; ties to the lower rank).
+  bool agree(std::string& failure, std::int64_t position) const;
   /// `value` of the root, on every rank.
   void broadcast(std::vector<double>& values) const;
 

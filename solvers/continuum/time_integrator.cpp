@@ -55,17 +55,22 @@ double TimeIntegrator::total_energy() const {
 }
 
 bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double* added) {
-  const bool here = admissible_here(s, t, failure, added);
   const Halo* halo = op_.halo();
-  if (!halo) return here;
-  // Every rank must take the same branch (retry or go on), and name the same failing cell.
+  if (!halo) return admissible_here(s, t, failure, added);
+  const std::int64_t floors_before = counters_.temperature_floor_uses;
+  std::int64_t failing_cell = 0;
+  const bool here = admissible_here(s, t, failure, added, &failing_cell);
+  // Every rank must take the same branch (retry or go on), and name the cell a plain run
+  // names: the first failing one in the box's storage order.
   std::string first_failure = here ? std::string() : failure;
-  if (halo->agree(first_failure)) return true;
+  if (halo->agree(first_failure, failing_cell)) return true;
   failure = first_failure;
+  counters_.temperature_floor_uses = floors_before;  // a failed check counts no floors
   return false;
 }
 
-bool TimeIntegrator::admissible_here(State& s, double t, std::string& failure, double* added) {
+bool TimeIntegrator::admissible_here(State& s, double t, std::string& failure, double* added,
+                                     std::int64_t* failing_cell) {
   const Grid& g = op_.grid();
   const double floor = settings_.temperature_floor;
   std::int64_t floors = 0;
@@ -116,10 +121,12 @@ bool TimeIntegrator::admissible_here(State& s, double t, std::string& failure, d
         const auto j = static_cast<int>((c - g.index(0, 0, k)) / g.stride_y());
         const auto i = static_cast<int>(c - g.index(0, j, k));
         const Halo* halo = op_.halo();  // the cell's place in the whole box
+        const int box_i = halo ? halo->block().i0 + i : i, box_j = halo ? halo->block().j0 + j : j;
         failure = fmt::format("t = {:.10g}, cell (i, j, k) = ({}, {}, {}) at z = {:.6g}: n = {:.6g}, "
                               "E = {:.6g} (need 0 < nu < nu_max and finite values)",
-                              t, halo ? halo->block().i0 + i : i, halo ? halo->block().j0 + j : j, k,
-                              g.center(k), n, E[c]);
+                              t, box_i, box_j, k, g.center(k), n, E[c]);
+        if (failing_cell && halo)
+          *failing_cell = (static_cast<std::int64_t>(k) * halo->box().ny + box_j) * halo->box().nx + box_i;
         return false;
       }
       const double kinetic = 0.5 * (Mx[c] * Mx[c] + My[c] * My[c] + Mz[c] * Mz[c]) / n;

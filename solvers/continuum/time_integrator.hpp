@@ -103,7 +103,10 @@ class TimeIntegrator {
   void book(double dt, double weight, const Operator::SourcePower& p);
   /// `added` (if given) receives the energy per unit plate area the temperature floor added.
   bool admissible(State& s, double t, std::string& failure, double* added = nullptr);
-  bool admissible_here(State& s, double t, std::string& failure, double* added);  ///< this rank's cells
+  /// admissible on this rank's cells; `failing_cell` (if given) receives a failing cell's place
+  /// in the box's storage order.
+  bool admissible_here(State& s, double t, std::string& failure, double* added,
+                       std::int64_t* failing_cell = nullptr);
   void axpy(State& out, double a, const State& x, double b, const State& y, double c,
             const State& k) const;  ///< out = a x + b y + c k on interior cells
 

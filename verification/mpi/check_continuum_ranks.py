@@ -19,6 +19,10 @@
       A checkpoint written on 2 ranks after 1 of 2 cycles, continued on 1 and on 4 ranks: the
       final checkpoint and the time-series rows after the restart equal the straight run's
       (without a launcher) bit for bit; the budget within 1e-12 of its scale.
+  check_continuum_ranks.py SHAKER failure [--mpirun CMD]
+      A step that fails (unlimited slopes at Courant number 1) on 2 and 4 ranks: exit 1 with the
+      plain run's message (the same first failing cell, in box coordinates) and its last good
+      state, bit for bit but the budget.
   check_continuum_ranks.py SHAKER refused [--mpirun CMD]
       A 1D column on 2 ranks, and an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x),
       exit 2 with a message naming the sizes and the allowed range, writing nothing.
@@ -257,6 +261,31 @@ def check_restart(shaker, work, launcher):
     return failures
 
 
+def check_failure(shaker, work, launcher):
+    failures = []
+    unstable = ["continuum.limiter=none", "continuum.cfl=1.0"]
+
+    def failed(output, ranks=None):
+        words = (mpirun_prefix(launcher, ranks) if ranks else []) + [
+            shaker, "continuum", "case.toml", "--set", f"run.output={output}.h5", "--quiet"]
+        result = run(words + [w for s in unstable for w in ("--set", s)], work, expect=1)
+        return result.stderr.split("\n")[0]
+
+    message = failed("plain")
+    expected = contents(os.path.join(work, "plain.last_good.h5"))
+    for p in (2, 4):
+        found = []
+        mine = failed(f"ranks{p}", p)
+        if mine != message:
+            found.append(f"{p} ranks: message '{mine}' instead of '{message}'")
+        last_good = contents(os.path.join(work, f"ranks{p}.last_good.h5"))
+        found += differences(last_good, expected, f"{p} ranks: last good state", True,
+                             float(np.max(np.abs(expected["energy_budget"]))))
+        print(f"step failure on {p} ranks: exit 1; {len(found)} differences from the plain run")
+        failures += found
+    return failures
+
+
 def check_refused(shaker, work, launcher):
     failures = []
     for label, ranks, settings, needles in (
@@ -280,7 +309,8 @@ def check_refused(shaker, work, launcher):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
-    parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "refused"])
+    parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "failure",
+                                          "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -295,6 +325,8 @@ def main():
                                        ["continuum.box_width=8", "continuum.ceiling=20"], 2)
     elif args.check == "restart":
         failures = check_restart(args.shaker, work, args.mpirun)
+    elif args.check == "failure":
+        failures = check_failure(args.shaker, work, args.mpirun)
     else:
         failures = check_refused(args.shaker, work, args.mpirun)
     for failure in failures:
