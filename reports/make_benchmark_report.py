@@ -281,6 +281,24 @@ def plot_history(runs, series, path):
     plt.close(fig)
 
 
+HAND_MEASURED = "(measured by hand)"
+
+
+def hand_measured_sections(path):
+    """The sections of the report at `path` whose heading ends in "(measured by hand)": figures
+    no history holds (measurements under mpirun, for one), kept when the report is rewritten."""
+    if not os.path.exists(path):
+        return []
+    kept, keeping = [], False
+    with open(path) as f:
+        for line in f.read().split("\n"):
+            if line.startswith("## "):
+                keeping = line.rstrip().endswith(HAND_MEASURED)
+            if keeping:
+                kept.append(line)
+    return kept
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--history", required=True)
@@ -351,6 +369,7 @@ def main(argv=None):
             lines += ["Only one run in the history: nothing to compare with.", ""]
     if slowdowns:
         lines += ["## Slowdowns", ""] + [f"- {s}" for s in slowdowns] + [""]
+    lines += hand_measured_sections(args.output)
     rc.write_text_atomically(args.output, "\n".join(lines))
     for s in slowdowns:
         print(f"make_benchmark_report: slowdown: {s}", file=sys.stderr)

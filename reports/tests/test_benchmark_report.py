@@ -206,3 +206,17 @@ def test_report_on_a_synthetic_history(work_dir):
     result = run("--history", os.path.dirname(broken), "--output", os.path.join(work, "broken.md"))
     assert result.returncode == 2 and not os.path.exists(os.path.join(work, "broken.md")), \
         f"bad JSON: exit {result.returncode}"
+
+
+def test_report_keeps_the_sections_measured_by_hand(work_dir):
+    history = os.path.join(work_dir, "history")
+    write_run(history, "20261120T030000Z-aaaaaaaaaaaa", "a" * 40,
+              {"BM_continuum_step": (5.0e5, "cell_updates_per_second", 1.0e4)}, seed=4)
+    out = os.path.join(work_dir, "benchmarks.md")
+    hand = "## Ranks (measured by hand)\n\n| ranks | rate |\n| 2 | 7 |\n"
+    with open(out, "w") as f:
+        f.write("# Benchmark report\n\n## Old generated section\n\nstale\n\n" + hand)
+    assert run("--history", history, "--output", out).returncode == 0
+    text = open(out).read()
+    assert text.rstrip().endswith(hand.rstrip()) and "stale" not in text, \
+        f"the hand-measured section must survive, the generated one be replaced:\n{text}"

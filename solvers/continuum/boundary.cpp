@@ -4,41 +4,48 @@
 // The primitives and the closure of a ghost are those of the cell it copies (u_z reversed
 // at a wall): copied too, not re-evaluated (exactly the same values, since every closure
 // value is even in u_z).
+// On a decomposed box (halo.hpp) the x and y ghosts come from the neighbouring ranks instead
+// of the periodic copy; the z ghosts are filled locally afterwards either way.
+#include "continuum/halo.hpp"
 #include "continuum/operator.hpp"
 
 namespace shaker::continuum {
 
 namespace {
-/// Calls copy(to, from, reverse_z) for every ghost cell, in an order in which every source
-/// cell is already filled (x, then y including the x ghosts, plane by plane; then z including
-/// both). Ghosts are disjoint and each is a copy, so the threads' order does not matter.
-template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
-  const int G = Grid::ghosts;
-  const auto loop = [&](int begin, int end, auto body) {
-    if (g.threaded()) {
+template <class Body> void loop(const Grid& g, int begin, int end, Body body) {
+  if (g.threaded()) {
 #pragma omp parallel for schedule(static)
-      for (int m = begin; m < end; ++m) body(m);
-    } else {
-      for (int m = begin; m < end; ++m) body(m);
-    }
-  };
-  if (g.dimension == 3) {
-    loop(0, g.nz, [&](int k) {
-      for (int j = 0; j < g.ny; ++j)
-        for (int m = 1; m <= G; ++m) {
-          copy(g.index(-m, j, k), g.index(g.nx - m, j, k), false);
-          copy(g.index(g.nx - 1 + m, j, k), g.index(m - 1, j, k), false);
-        }
-      for (int i = -G; i < g.nx + G; ++i)
-        for (int m = 1; m <= G; ++m) {
-          copy(g.index(i, -m, k), g.index(i, g.ny - m, k), false);
-          copy(g.index(i, g.ny - 1 + m, k), g.index(i, m - 1, k), false);
-        }
-    });
+    for (int m = begin; m < end; ++m) body(m);
+  } else {
+    for (int m = begin; m < end; ++m) body(m);
   }
+}
+
+/// Calls copy(to, from, reverse_z) for every x and y ghost of the interior planes (x, then y
+/// including the x ghosts, plane by plane), so that every source cell is already filled.
+template <class Copy> void for_each_periodic_xy_ghost(const Grid& g, Copy copy) {
+  const int G = Grid::ghosts;
+  loop(g, 0, g.nz, [&](int k) {
+    for (int j = 0; j < g.ny; ++j)
+      for (int m = 1; m <= G; ++m) {
+        copy(g.index(-m, j, k), g.index(g.nx - m, j, k), false);
+        copy(g.index(g.nx - 1 + m, j, k), g.index(m - 1, j, k), false);
+      }
+    for (int i = -G; i < g.nx + G; ++i)
+      for (int m = 1; m <= G; ++m) {
+        copy(g.index(i, -m, k), g.index(i, g.ny - m, k), false);
+        copy(g.index(i, g.ny - 1 + m, k), g.index(i, m - 1, k), false);
+      }
+  });
+}
+
+/// Calls copy(to, from, reverse_z) for every z ghost, x and y ghosts included (so after them).
+/// Ghosts are disjoint and each is a copy, so the threads' order does not matter.
+template <class Copy> void for_each_z_ghost(const Grid& g, Copy copy) {
+  const int G = Grid::ghosts;
   const int gxy = g.ghosts_xy();
   const bool walls = g.z_boundary == ZBoundary::walls;
-  loop(-gxy, g.ny + gxy, [&](int j) {
+  loop(g, -gxy, g.ny + gxy, [&](int j) {
     for (int i = -gxy; i < g.nx + gxy; ++i)
       for (int m = 1; m <= G; ++m) {
         if (walls) {
@@ -51,17 +58,37 @@ template <class Copy> void for_each_ghost(const Grid& g, Copy copy) {
       }
   });
 }
+
+/// Every ghost of `fields`: x and y from the halo (or the periodic copy), then z.
+template <class Copy>
+void fill(const Grid& g, const Halo* halo, const std::vector<double*>& fields, Copy copy) {
+  if (halo)
+    halo->exchange(fields);
+  else if (g.dimension == 3)
+    for_each_periodic_xy_ghost(g, copy);
+  for_each_z_ghost(g, copy);
+}
 }  // namespace
 
 void Operator::fill_ghosts(State& U) const {
-  for_each_ghost(grid_, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
+  std::vector<double*> fields;
+  if (halo_)
+    for (auto& v : U.q) fields.push_back(v.data());
+  fill(grid_, halo_.get(), fields, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
     for (int v = 0; v < variable_count; ++v) U.q[v][to] = U.q[v][from];
     if (reverse_z) U.q[momentum_z][to] = -U.q[momentum_z][from];
   });
 }
 
 void Operator::copy_closure_to_ghosts() {
-  for_each_ghost(grid_, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
+  std::vector<double*> fields;
+  if (halo_) {
+    for (auto& v : w_) fields.push_back(v.data());
+    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda,
+                    &closure_.kappa, &closure_.loss})
+      fields.push_back(v->data());
+  }
+  fill(grid_, halo_.get(), fields, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
     for (auto& v : w_) v[to] = v[from];
     if (reverse_z) w_[3][to] = -w_[3][from];
     for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda,

@@ -18,23 +18,23 @@ const char* const units[variable_count] = {"1/sigma^3", "m sqrt(g sigma) / sigma
                                            "m sqrt(g sigma) / sigma^3", "m g / sigma^2"};
 }
 
-void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
+void write_checkpoint(const std::filesystem::path& path, const BoxView& box,
                       const SchedulePosition& position, const std::string& configuration_toml) {
-  const Grid& g = solver.op().grid();
+  const Grid& g = box.grid;
   write_hdf5_atomically(path, [&](const hid_t file) {
     write_checkpoint_header(file, checkpoint_kind, position, configuration_toml);
-    h5::write_attribute(file, "time", solver.time());
+    h5::write_attribute(file, "time", box.scalars.time);
     h5::write_attribute(file, "dimension", std::int64_t{g.dimension});
     h5::write_attribute(file, "nx", std::int64_t{g.nx});
     h5::write_attribute(file, "ny", std::int64_t{g.ny});
     h5::write_attribute(file, "nz", std::int64_t{g.nz});
     h5::write_attribute(file, "cell_size", g.h);
     // The e in effect (after a single-shock switch, the switched one): a restart uses it.
-    h5::write_attribute(file, "e", solver.op().settings().e);
-    const EnergyBudget& b = solver.budget();
+    h5::write_attribute(file, "e", box.scalars.e);
+    const EnergyBudget& b = box.scalars.budget;
     h5::write(file, "energy_budget", std::vector<double>{b.body_work, b.collisional_loss, b.floor_energy},
               {3}, "m g / sigma");
-    const Counters& k = solver.counters();
+    const Counters& k = box.scalars.counters;
     h5::write(file, "counters",
               std::vector<std::int64_t>{k.steps, k.rejected_steps, k.temperature_floor_uses,
                                         k.diffusion_stages},
@@ -44,7 +44,7 @@ void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& s
       data.reserve(g.interior_cells());
       for (int kz = 0; kz < g.nz; ++kz)
         for (int j = 0; j < g.ny; ++j)
-          for (int i = 0; i < g.nx; ++i) data.push_back(solver.state().q[v][g.index(i, j, kz)]);
+          for (int i = 0; i < g.nx; ++i) data.push_back(box.state.q[v][g.index(i, j, kz)]);
       h5::write(file, names[v], data, {data.size()}, units[v]);
     }
   });
@@ -67,8 +67,8 @@ std::vector<double> read_finite(hid_t file, const char* name, std::size_t expect
 
 /// The whole checkpoint checked before any of it is used: shapes against the grid, finite
 /// values, 0 < nu < nu_max, T >= 0 (to round-off), 0 <= e <= 1, a finite time, counters >= 0.
-void load_checked(hid_t file, const std::filesystem::path& path, TimeIntegrator& solver) {
-  const Grid& g = solver.op().grid();
+void load_checked(hid_t file, const std::filesystem::path& path, const Grid& g, State& state,
+                  RunScalars& scalars) {
   const auto check = [&](const char* key, std::int64_t expected) {
     const std::int64_t found = h5::read_integer_attribute(file, key);
     if (found != expected)
@@ -111,26 +111,35 @@ void load_checked(hid_t file, const std::filesystem::path& path, TimeIntegrator&
                                    "energy {}: a negative temperature; allowed: T >= 0",
                                    interior.q[energy][m], m, kinetic));
   }
-  // Valid: now the solver takes it over.
+  // Valid: now the state takes it over.
   for (int v = 0; v < variable_count; ++v) {
     std::size_t m = 0;
     for (int kz = 0; kz < g.nz; ++kz)
       for (int j = 0; j < g.ny; ++j)
-        for (int i = 0; i < g.nx; ++i) solver.state().q[v][g.index(i, j, kz)] = interior.q[v][m++];
+        for (int i = 0; i < g.nx; ++i) state.q[v][g.index(i, j, kz)] = interior.q[v][m++];
   }
-  solver.set_time(time);
-  solver.op().settings().e = e;
-  solver.budget() = EnergyBudget{budget[0], budget[1], budget[2]};
-  solver.counters() = Counters{counters[0], counters[1], counters[2], counters[3]};
+  scalars = RunScalars{time, e, EnergyBudget{budget[0], budget[1], budget[2]},
+                       Counters{counters[0], counters[1], counters[2], counters[3]}};
 }
 
 }  // namespace
 
 SchedulePosition read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver) {
+  RunScalars scalars;
+  const SchedulePosition position = read_checkpoint(path, solver.op().grid(), solver.state(), scalars);
+  solver.set_time(scalars.time);
+  solver.op().settings().e = scalars.e;
+  solver.budget() = scalars.budget;
+  solver.counters() = scalars.counters;
+  return position;
+}
+
+SchedulePosition read_checkpoint(const std::filesystem::path& path, const Grid& grid, State& state,
+                                 RunScalars& scalars) {
   const h5::Handle file = open_checkpoint(path, checkpoint_kind);
   try {
     const SchedulePosition position = read_schedule_position(file.id());
-    load_checked(file.id(), path, solver);
+    load_checked(file.id(), path, grid, state, scalars);
     return position;
   } catch (const std::exception& error) {
     const std::string what = error.what();

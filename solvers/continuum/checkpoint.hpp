@@ -7,18 +7,27 @@
 #include <string>
 
 #include "common/run_loop.hpp"
+#include "continuum/output.hpp"
 #include "continuum/time_integrator.hpp"
 
 namespace shaker::continuum {
 
 inline constexpr const char* checkpoint_kind = "shaker continuum checkpoint";
 
-void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
+void write_checkpoint(const std::filesystem::path& path, const BoxView& box,
                       const SchedulePosition& position, const std::string& configuration_toml);
+inline void write_checkpoint(const std::filesystem::path& path, const TimeIntegrator& solver,
+                             const SchedulePosition& position, const std::string& configuration_toml) {
+  write_checkpoint(path, view_of(solver), position, configuration_toml);
+}
 /// Loads a checkpoint into the solver and returns its schedule position; throws InputError
 /// naming run.restart_from ("not a valid checkpoint: ...") if it is not a continuum checkpoint,
 /// does not match the grid or holds a damaged value (the solver is then left unchanged).
 SchedulePosition read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver);
+/// The same into a state of `grid` (interior cells) and `scalars`: what the root of a
+/// decomposed run reads before scattering it.
+SchedulePosition read_checkpoint(const std::filesystem::path& path, const Grid& grid, State& state,
+                                 RunScalars& scalars);
 /// The effective configuration (TOML) of the run that wrote the checkpoint.
 std::string checkpoint_configuration(const std::filesystem::path& path);
 

@@ -2,10 +2,15 @@
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "common/errors.hpp"
+#include "continuum/halo.hpp"
 
 namespace shaker::continuum {
 
@@ -87,8 +92,9 @@ class PlaneAveragedColumn {
 };
 }  // namespace
 
-ImplicitDiffusion::ImplicitDiffusion(const Grid& grid)
-    : grid_(grid), column_(grid.dimension == 1 && grid.z_boundary == ZBoundary::walls) {
+ImplicitDiffusion::ImplicitDiffusion(const Grid& grid, std::shared_ptr<const Halo> halo)
+    : grid_(grid), halo_(std::move(halo)), column_(grid.dimension == 1 && grid.z_boundary == ZBoundary::walls) {
+  if (halo_) return;  // the decomposed path keeps its vectors in the block's storage
   for (int k = 0; k < grid.nz; ++k)
     for (int j = 0; j < grid.ny; ++j)
       for (int i = 0; i < grid.nx; ++i) storage_.push_back(grid.index(i, j, k));
@@ -267,6 +273,7 @@ void ImplicitDiffusion::add_dissipation(const Operator& op, int component, const
 }
 
 void ImplicitDiffusion::advance(Operator& op, State& U, double dt, bool closure_is_current) {
+  if (halo_) return advance_decomposed(op, U, dt, closure_is_current);
   if (!closure_is_current) op.prepare(U);
   const auto& w = op.primitives();
   const std::size_t cells = storage_.size();
@@ -313,6 +320,260 @@ void ImplicitDiffusion::advance(Operator& op, State& U, double dt, bool closure_
   solve(op, 3, dt, temperature_);
   for_cells([&](std::size_t m, std::ptrdiff_t c) {
     store_primitive(U, c, Primitive{n[c], velocity_[0][m], velocity_[1][m], velocity_[2][m], temperature_[m]});
+  });
+}
+
+// The decomposed box. Every vector lives in the storage of the rank's block, ghosts included:
+// the matrix-free product reads the neighbours of the block's edge cells from the x and y
+// ghosts the halo fills. The matrix and preconditioner are those of the Eigen path (the same
+// faces, the same Jacobi plus plane-averaged column); sums over the box are taken plane by
+// plane (each plane's sum independent of the threads), summed over the ranks, then over the
+// planes in order.
+namespace {
+/// Calls plane(k) for every plane k, shared between threads on a large block (serial otherwise:
+/// even an OpenMP region whose `if` is false costs a runtime call, and CG makes many).
+template <class Plane> void for_planes(const Grid& g, Plane plane) {
+  if (g.threaded()) {
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < g.nz; ++k) plane(k);
+  } else {
+    for (int k = 0; k < g.nz; ++k) plane(k);
+  }
+}
+
+/// body(c, k) for every interior cell c of plane k.
+template <class Body> void for_interior(const Grid& g, Body body) {
+  for_planes(g, [&](int k) {
+    for (int j = 0; j < g.ny; ++j) {
+      const std::ptrdiff_t first = g.index(0, j, k);
+      for (std::ptrdiff_t c = first; c < first + g.nx; ++c) body(c, k);
+    }
+  });
+}
+
+/// Per plane k, sums[k * count + s] = sum over the plane's interior cells c of term(c, k)[s],
+/// s < count, in storage order (the accumulators stay in registers).
+template <int count, class Term> void plane_sums(const Grid& g, std::vector<double>& sums, Term term) {
+  sums.assign(static_cast<std::size_t>(g.nz) * count, 0.0);
+  for_planes(g, [&](int k) {
+    std::array<double, count> sum{};
+    for (int j = 0; j < g.ny; ++j) {
+      const std::ptrdiff_t first = g.index(0, j, k);
+      for (std::ptrdiff_t c = first; c < first + g.nx; ++c) {
+        const std::array<double, count> terms = term(c, k);
+        for (int s = 0; s < count; ++s) sum[s] += terms[s];
+      }
+    }
+    std::copy(sum.begin(), sum.end(), sums.begin() + static_cast<std::ptrdiff_t>(k) * count);
+  });
+}
+}  // namespace
+
+double ImplicitDiffusion::box_sum_of_products(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double>& sums = decomposed_.plane_sums;
+  plane_sums<1>(grid_, sums, [&](std::ptrdiff_t c, int) { return std::array<double, 1>{a[c] * b[c]}; });
+  halo_->sum(sums);
+  double total = 0.0;
+  for (const double s : sums) total += s;
+  return total;
+}
+
+void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, double dt) {
+  const Grid& g = grid_;
+  Decomposed& d = decomposed_;
+  const auto& cl = op.closure();
+  const double* n = op.primitives()[0].data();
+  const double inv_h2 = 1.0 / (g.h * g.h);
+  const double mass_factor = component == 3 ? 1.5 : 1.0;
+  const std::ptrdiff_t strides[3] = {g.stride(0), g.stride(1), g.stride(2)};
+  const auto face = [&](std::ptrdiff_t c, int direction) {
+    d.face[direction][c] = harmonic_mean(coefficient(cl, c, component, direction),
+                                         coefficient(cl, c + strides[direction], component, direction)) * inv_h2;
+  };
+  // x and y faces from the low ghost on (the face into the block), z faces between planes:
+  // the wall faces' entries stay 0.
+  for_planes(g, [&](int k) {
+    for (int j = -1; j < g.ny; ++j)
+      for (int i = -1; i < g.nx; ++i) {
+        const std::ptrdiff_t c = g.index(i, j, k);
+        if (j >= 0) face(c, 0);
+        if (i >= 0) face(c, 1);
+        if (i >= 0 && j >= 0 && k + 1 < g.nz) face(c, 2);
+      }
+  });
+  const auto wall = [&](std::ptrdiff_t c, int k) {
+    const bool at_wall = component == 2 && (k == 0 || k + 1 == g.nz);
+    return at_wall ? 2.0 * coefficient(cl, c, 2, 2) * inv_h2 : 0.0;
+  };
+  for_interior(g, [&](std::ptrdiff_t c, int k) {
+    double diagonal = mass_factor * n[c] / dt + wall(c, k);
+    for (int direction = 0; direction < 3; ++direction)
+      diagonal += d.face[direction][c] + d.face[direction][c - strides[direction]];
+    d.diagonal[c] = diagonal;
+    d.inverse_diagonal[c] = 1.0 / diagonal;
+  });
+  // The coarse system Ac = P^T A P: per plane the mass, wall and z-face terms (the horizontal
+  // faces cancel) and the coupling to the plane below.
+  std::vector<double>& sums = d.plane_sums;
+  plane_sums<2>(g, sums, [&](std::ptrdiff_t c, int k) {
+    const double below = d.face[2][c - strides[2]];
+    return std::array<double, 2>{mass_factor * n[c] / dt + wall(c, k) + d.face[2][c] + below, -below};
+  });
+  halo_->sum(sums);
+  const auto planes = static_cast<std::size_t>(g.nz);
+  d.inverse_pivot.assign(planes, 1.0);
+  d.upper.assign(planes, 0.0);
+  d.coarse_lower.assign(planes, 0.0);
+  for (std::size_t k = 0; k < planes; ++k) d.coarse_lower[k] = sums[2 * k + 1];
+  for (std::size_t k = 0; k < planes; ++k) {
+    const double pivot = sums[2 * k] - (k > 0 ? d.coarse_lower[k] * d.upper[k - 1] : 0.0);
+    d.inverse_pivot[k] = 1.0 / pivot;
+    d.upper[k] = (k + 1 < planes ? d.coarse_lower[k + 1] : 0.0) * d.inverse_pivot[k];
+  }
+}
+
+void ImplicitDiffusion::apply_decomposed(const std::vector<double>& x, std::vector<double>& out) const {
+  const Grid& g = grid_;
+  const Decomposed& d = decomposed_;
+  const std::ptrdiff_t sy = g.stride(1), sz = g.stride(2);
+  const double* fx = d.face[0].data();
+  const double* fy = d.face[1].data();
+  const double* fz = d.face[2].data();
+  for_interior(g, [&](std::ptrdiff_t c, int) {
+    out[c] = d.diagonal[c] * x[c] - fx[c] * x[c + 1] - fx[c - 1] * x[c - 1] - fy[c] * x[c + sy] -
+             fy[c - sy] * x[c - sy] - fz[c] * x[c + sz] - fz[c - sz] * x[c - sz];
+  });
+}
+
+std::pair<double, double> ImplicitDiffusion::precondition_decomposed(const std::vector<double>& r,
+                                                                     std::vector<double>& z) {
+  const Grid& g = grid_;
+  Decomposed& d = decomposed_;
+  // Per plane: the sum of r (the coarse right-hand side), r.r and r.D^-1.r, in one reduction;
+  // r.z = r.D^-1.r + sum_k coarse_k (plane sum of r)_k follows without a second one.
+  std::vector<double>& sums = d.plane_sums;
+  plane_sums<3>(g, sums, [&](std::ptrdiff_t c, int) {
+    return std::array<double, 3>{r[c], r[c] * r[c], r[c] * r[c] * d.inverse_diagonal[c]};
+  });
+  halo_->sum(sums);
+  const auto planes = static_cast<std::size_t>(g.nz);
+  std::vector<double>& coarse = d.rhs_coarse;
+  coarse.resize(planes);
+  double rr = 0.0, rz = 0.0;
+  for (std::size_t k = 0; k < planes; ++k) {
+    coarse[k] = (sums[3 * k] - (k > 0 ? d.coarse_lower[k] * coarse[k - 1] : 0.0)) * d.inverse_pivot[k];
+    rr += sums[3 * k + 1];
+    rz += sums[3 * k + 2];
+  }
+  for (std::size_t k = planes - 1; k-- > 0;) coarse[k] -= d.upper[k] * coarse[k + 1];
+  for (std::size_t k = 0; k < planes; ++k) rz += coarse[k] * sums[3 * k];
+  for_interior(g, [&](std::ptrdiff_t c, int k) { z[c] = d.inverse_diagonal[c] * r[c] + coarse[static_cast<std::size_t>(k)]; });
+  return {rr, rz};
+}
+
+// Preconditioned CG as Eigen's (the same recurrences and stopping rule, |r|^2 < tol^2 |b|^2),
+// from the first guess in x.
+void ImplicitDiffusion::solve_decomposed(std::vector<double>& x) {
+  Decomposed& d = decomposed_;
+  std::vector<double>& r = d.residual;
+  std::vector<double>& z = d.preconditioned;
+  std::vector<double>& p = d.search;
+  std::vector<double>& q = d.product;
+  const double rhs_norm2 = box_sum_of_products(d.rhs, d.rhs);
+  if (rhs_norm2 == 0.0) {
+    for_interior(grid_, [&](std::ptrdiff_t c, int) { x[c] = 0.0; });
+    return;
+  }
+  constexpr double tolerance = 1e-13;
+  const double threshold = std::max(tolerance * tolerance * rhs_norm2, std::numeric_limits<double>::min());
+  halo_->exchange({x.data()});
+  apply_decomposed(x, q);
+  for_interior(grid_, [&](std::ptrdiff_t c, int) { r[c] = d.rhs[c] - q[c]; });
+  auto [rr, rz] = precondition_decomposed(r, z);
+  if (rr < threshold) return;
+  for_interior(grid_, [&](std::ptrdiff_t c, int) { p[c] = z[c]; });
+  const double most = 2.0 * static_cast<double>(halo_->box().interior_cells());  // Eigen's default
+  for (double iteration = 0; iteration < most; ++iteration) {
+    halo_->exchange({p.data()});
+    apply_decomposed(p, q);
+    const double alpha = rz / box_sum_of_products(p, q);
+    for_interior(grid_, [&](std::ptrdiff_t c, int) {
+      x[c] += alpha * p[c];
+      r[c] -= alpha * q[c];
+    });
+    const double previous = rz;
+    std::tie(rr, rz) = precondition_decomposed(r, z);
+    if (rr < threshold) return;
+    const double beta = rz / previous;
+    for_interior(grid_, [&](std::ptrdiff_t c, int) { p[c] = z[c] + beta * p[c]; });
+  }
+  throw DomainError("implicit diffusion: CG did not converge");
+}
+
+void ImplicitDiffusion::add_dissipation_decomposed(const Operator& op, int component, std::vector<double>& u) {
+  const Grid& g = grid_;
+  Decomposed& d = decomposed_;
+  const auto& cl = op.closure();
+  const double inv_h2 = 1.0 / (g.h * g.h);
+  const std::ptrdiff_t strides[3] = {g.stride(0), g.stride(1), g.stride(2)};
+  halo_->exchange({u.data()});
+  // Each cell takes half of every one of its faces' dissipation, from its own side.
+  for_interior(g, [&](std::ptrdiff_t c, int k) {
+    double sum = 0.0;
+    for (int direction = 0; direction < 3; ++direction) {
+      const std::ptrdiff_t s = strides[direction];
+      const double up = u[c] - u[c + s], down = u[c] - u[c - s];
+      sum += 0.5 * d.face[direction][c] * up * up + 0.5 * d.face[direction][c - s] * down * down;
+    }
+    if (component == 2 && (k == 0 || k + 1 == g.nz)) sum += 2.0 * coefficient(cl, c, 2, 2) * u[c] * u[c] * inv_h2;
+    d.dissipation[c] += sum;
+  });
+}
+
+void ImplicitDiffusion::advance_decomposed(Operator& op, State& U, double dt, bool closure_is_current) {
+  if (!closure_is_current) op.prepare(U);
+  const Grid& g = grid_;
+  Decomposed& d = decomposed_;
+  if (d.rhs.size() != g.size()) {
+    for (auto* v : {&d.rhs, &d.dissipation, &d.residual, &d.preconditioned, &d.search, &d.product,
+                    &d.diagonal, &d.inverse_diagonal})
+      v->assign(g.size(), 0.0);
+    for (auto& v : d.solution) v.assign(g.size(), 0.0);
+    for (auto& v : d.face) v.assign(g.size(), 0.0);
+  }
+  const auto& w = op.primitives();
+  const double* n = w[0].data();
+  std::fill(d.dissipation.begin(), d.dissipation.end(), 0.0);
+  for (int component = 0; component < 3; ++component) {
+    const double* u0 = w[1 + component].data();
+    std::vector<double>& u = d.solution[static_cast<std::size_t>(component)];
+    for_interior(g, [&](std::ptrdiff_t c, int) {
+      d.rhs[c] = n[c] * u0[c] / dt;
+      u[c] = u0[c];  // CG's first guess
+    });
+    // A component that vanishes everywhere stays zero exactly, on every rank alike.
+    if (box_sum_of_products(d.rhs, d.rhs) == 0.0) {
+      for_interior(g, [&](std::ptrdiff_t c, int) { u[c] = 0.0; });
+      continue;
+    }
+    assemble_decomposed(op, component, dt);
+    solve_decomposed(u);
+    for_interior(g, [&](std::ptrdiff_t c, int) {
+      const double change = u[c] - u0[c];
+      d.dissipation[c] += 0.5 * n[c] * change * change / dt;
+    });
+    add_dissipation_decomposed(op, component, u);
+  }
+  const double* T = w[4].data();
+  std::vector<double>& temperature = d.solution[3];
+  for_interior(g, [&](std::ptrdiff_t c, int) {
+    d.rhs[c] = 1.5 * n[c] * T[c] / dt + d.dissipation[c];
+    temperature[c] = T[c];
+  });
+  assemble_decomposed(op, 3, dt);
+  solve_decomposed(temperature);
+  for_interior(g, [&](std::ptrdiff_t c, int) {
+    store_primitive(U, c, Primitive{n[c], d.solution[0][c], d.solution[1][c], d.solution[2][c], temperature[c]});
   });
 }
 

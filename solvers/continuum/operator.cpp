@@ -5,13 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "common/errors.hpp"
+#include "continuum/halo.hpp"
 
 namespace shaker::continuum {
 
-Operator::Operator(const Grid& grid, const PhysicsSettings& settings)
-    : grid_(grid), settings_(settings) {
+Operator::Operator(const Grid& grid, const PhysicsSettings& settings, std::shared_ptr<const Halo> halo)
+    : grid_(grid), settings_(settings), halo_(std::move(halo)) {
   const std::size_t cells = grid_.size();
   for (auto& v : w_) v.assign(cells, 0.0);
   for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa, &closure_.loss})
@@ -25,7 +28,7 @@ void Operator::rhs(double t, State& U, State& dUdt, Part part) {
   const Terms& terms = settings_.terms;
   const bool diffusive = part != Part::hyperbolic_and_sources &&
                          (terms.shear_viscosity || terms.bulk_viscosity || terms.conduction);
-  update_primitives_and_closure(U, diffusive);
+  evaluate_closure(U, diffusive);
   // A large grid is zeroed plane by plane on every thread (serial, the fill of the 3D box
   // would be the largest serial part of the evaluation).
   if (grid_.threaded()) {
@@ -42,6 +45,26 @@ void Operator::rhs(double t, State& U, State& dUdt, Part part) {
   }
   if (diffusive) add_diffusive_fluxes(dUdt);
   if (part != Part::diffusive) add_sources(t, U, dUdt);
+}
+
+double Operator::plate_columns() const {
+  return halo_ ? halo_->plate_columns() : static_cast<double>(grid_.nx) * grid_.ny;
+}
+
+void Operator::evaluate_closure(const State& U, bool need_transport) {
+  if (!halo_) {
+    update_primitives_and_closure(U, need_transport);
+    return copy_closure_to_ghosts();
+  }
+  // A rank that threw alone would leave the others waiting in the next exchange.
+  std::string failure;
+  try {
+    update_primitives_and_closure(U, need_transport);
+  } catch (const std::domain_error& error) {
+    failure = error.what();
+  }
+  if (!halo_->agree(failure)) throw DomainError(failure);
+  copy_closure_to_ghosts();
 }
 
 // Both step limits scan the interior as contiguous runs (a 1D column is one run), threaded
@@ -70,11 +93,12 @@ double Operator::advective_step(double cfl) const {
   const double* u[3] = {w_[1].data(), w_[2].data(), w_[3].data()};
   const double* c_sound = closure_.c.data();
   const int first = g.first_direction();
-  const double fastest = interior_maximum(g, [&](std::ptrdiff_t c) {
+  double fastest = interior_maximum(g, [&](std::ptrdiff_t c) {
     double sum = 0.0;
     for (int d = first; d < 3; ++d) sum += std::abs(u[d][c]) + c_sound[c];
     return sum;
   });
+  if (halo_) fastest = halo_->max(fastest);  // a maximum is exact: the step of the serial run
   return fastest > 0.0 ? cfl * g.h / fastest : std::numeric_limits<double>::infinity();
 }
 
@@ -85,11 +109,12 @@ double Operator::diffusive_step() const {
   const double* mu = closure_.mu.data();
   const double* lambda = closure_.lambda.data();
   const double* kappa = closure_.kappa.data();
-  const double largest = interior_maximum(g, [&](std::ptrdiff_t c) {
+  double largest = interior_maximum(g, [&](std::ptrdiff_t c) {
     const double momentum = (lambda[c] + 4.0 / 3.0 * mu[c]);
     const double heat = kappa[c] / 1.5;
     return std::max(momentum, heat) / n[c];
   });
+  if (halo_) largest = halo_->max(largest);
   const int dims = g.dimension == 3 ? 3 : 1;
   return largest > 0.0 ? g.h * g.h / (2.0 * dims * largest) : std::numeric_limits<double>::infinity();
 }

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "common/granular_model.hpp"
@@ -59,9 +60,14 @@ using ExternalSource = std::function<void(double, double, double, double, double
 /// What the operator evaluates: everything, or the parts an operator split separates.
 enum class Part { all, hyperbolic_and_sources, diffusive };
 
+class Halo;  // halo.hpp
+
 class Operator {
  public:
-  Operator(const Grid& grid, const PhysicsSettings& settings);
+  /// `grid` is the whole domain, or with a `halo` this rank's block of the decomposed box
+  /// (halo->local()): ghosts in x and y are then exchanged with the neighbouring ranks and
+  /// step limits and energy sums are taken over the whole box.
+  Operator(const Grid& grid, const PhysicsSettings& settings, std::shared_ptr<const Halo> halo = nullptr);
 
   /// dUdt = L(U, t). Fills U's ghost cells first (so U is not const). Throws DomainError
   /// (constitutive function outside its domain) on a broken state.
@@ -76,7 +82,7 @@ class Operator {
   /// coefficients unless need_transport is false), without fluxes.
   void prepare(State& U, bool need_transport = true) {
     fill_ghosts(U);
-    update_primitives_and_closure(U, need_transport);
+    evaluate_closure(U, need_transport);
   }
 
   void fill_ghosts(State& U) const;  ///< walls (mirror) or periodic, x, y periodic
@@ -84,6 +90,11 @@ class Operator {
   double body_force(double t) const;
 
   const Grid& grid() const { return grid_; }
+  /// The decomposition, or null when this process holds the whole domain.
+  const Halo* halo() const { return halo_.get(); }
+  const std::shared_ptr<const Halo>& shared_halo() const { return halo_; }
+  /// Columns of the whole domain (1 for a column): amounts per unit plate area divide by them.
+  double plate_columns() const;
   PhysicsSettings& settings() { return settings_; }
   const PhysicsSettings& settings() const { return settings_; }
   ExternalSource external_source;  ///< empty: none
@@ -94,8 +105,8 @@ class Operator {
   };
   const Closure& closure() const { return closure_; }
 
-  /// Energy sources of the last rhs that included them, integrated over the domain per unit
-  /// plate area: power of the body force (gravity + frame force) and the collisional loss rate.
+  /// Energy sources of the last rhs that included them, integrated over the domain (with a
+  /// halo: over this rank's block, to be summed over the ranks) per unit plate area: power of the body force (gravity + frame force) and the collisional loss rate.
   struct SourcePower {
     double body = 0, loss = 0;
   };
@@ -103,6 +114,9 @@ class Operator {
   const std::array<std::vector<double>, variable_count>& primitives() const { return w_; }
 
  private:
+  /// The primitives and closure of the interior, then copied to the ghosts; with a halo every
+  /// rank fails alike (DomainError with the first failing rank's message) if any rank fails.
+  void evaluate_closure(const State& U, bool need_transport);
   void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp
   void copy_closure_to_ghosts();                                             // boundary.cpp
   void add_inviscid_fluxes(State& dUdt);                                     // riemann.cpp
@@ -111,6 +125,7 @@ class Operator {
 
   Grid grid_;
   PhysicsSettings settings_;
+  std::shared_ptr<const Halo> halo_;
   std::array<std::vector<double>, variable_count> w_;  ///< n, ux, uy, uz, T
   Closure closure_;
   bool transport_evaluated_ = false;

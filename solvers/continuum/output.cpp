@@ -11,10 +11,20 @@
 
 namespace shaker::continuum {
 
-Profile horizontal_profile(const TimeIntegrator& solver, const ShakerKinematics& shaker) {
-  const Grid& g = solver.op().grid();
-  const State& s = solver.state();
-  const double t = solver.time();
+BoxView view_of(const TimeIntegrator& solver) {
+  return BoxView{solver.op().grid(), solver.state(),
+                 RunScalars{solver.time(), solver.op().settings().e, solver.budget(), solver.counters()}};
+}
+
+double total_energy(const BoxView& box) {
+  const Grid& g = box.grid;
+  return interior_energy_sum(g, box.state) * g.h / (static_cast<double>(g.nx) * g.ny);
+}
+
+Profile horizontal_profile(const BoxView& box, const ShakerKinematics& shaker) {
+  const Grid& g = box.grid;
+  const State& s = box.state;
+  const double t = box.scalars.time;
   Profile p;
   p.time = t;
   p.phase = shaker.phase(t);
@@ -42,13 +52,13 @@ Profile horizontal_profile(const TimeIntegrator& solver, const ShakerKinematics&
   return p;
 }
 
-Diagnostics diagnostics(const TimeIntegrator& solver, const ShakerKinematics& shaker) {
-  const Grid& g = solver.op().grid();
-  const State& s = solver.state();
-  const double t = solver.time();
+Diagnostics diagnostics(const BoxView& box, const ShakerKinematics& shaker) {
+  const Grid& g = box.grid;
+  const State& s = box.state;
+  const double t = box.scalars.time;
   const double plate_z = shaker.position(t), plate_v = shaker.velocity(t);
   const double area_weight = g.dimension == 3 ? g.h * g.h * g.h / (g.nx * g.h * g.ny * g.h) : g.h;
-  const double e = solver.op().settings().e;
+  const double e = box.scalars.e;
   Diagnostics d;
   double moment = 0;
   for (int k = 0; k < g.nz; ++k)
@@ -68,17 +78,17 @@ Diagnostics diagnostics(const TimeIntegrator& solver, const ShakerKinematics& sh
   return d;
 }
 
-FieldSnapshot snapshot(const TimeIntegrator& solver, const ShakerKinematics& shaker) {
-  const Grid& g = solver.op().grid();
+FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker) {
+  const Grid& g = box.grid;
   FieldSnapshot f;
-  f.time = solver.time();
+  f.time = box.scalars.time;
   f.phase = shaker.phase(f.time);
   f.plate_z = shaker.position(f.time);
   f.plate_v = shaker.velocity(f.time);
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i) {
-        const Primitive w = to_primitive(solver.state(), g.index(i, j, k));
+        const Primitive w = to_primitive(box.state, g.index(i, j, k));
         f.n.push_back(w.n);
         f.ux.push_back(w.ux);
         f.uy.push_back(w.uy);

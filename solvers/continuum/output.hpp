@@ -10,14 +10,38 @@
 
 namespace shaker::continuum {
 
-Profile horizontal_profile(const TimeIntegrator& solver, const ShakerKinematics& shaker);
+/// The scalars of a run that its outputs and checkpoints carry beside the state.
+struct RunScalars {
+  double time = 0, e = 0;  ///< e: the restitution in effect
+  EnergyBudget budget;
+  Counters counters;
+};
+/// What the outputs read of a run at one instant: the whole box (on a decomposed run, the
+/// root's gathered copy) and its scalars.
+struct BoxView {
+  const Grid& grid;
+  const State& state;
+  RunScalars scalars;
+};
+/// The solver itself, on one process: nothing copied.
+BoxView view_of(const TimeIntegrator& solver);
+
+Profile horizontal_profile(const BoxView& box, const ShakerKinematics& shaker);
+inline Profile horizontal_profile(const TimeIntegrator& solver, const ShakerKinematics& shaker) {
+  return horizontal_profile(view_of(solver), shaker);
+}
+/// Container-frame energy per unit plate area: TimeIntegrator::total_energy of the box.
+double total_energy(const BoxView& box);
 
 struct Diagnostics {
   double mass = 0, center_of_mass = 0;  ///< per unit plate area; height in the lab frame
   double kinetic = 0, thermal = 0, potential = 0;  ///< lab frame, per unit plate area
   double loss_rate = 0;                 ///< collisional loss per unit area and time
 };
-Diagnostics diagnostics(const TimeIntegrator& solver, const ShakerKinematics& shaker);
+Diagnostics diagnostics(const BoxView& box, const ShakerKinematics& shaker);
+inline Diagnostics diagnostics(const TimeIntegrator& solver, const ShakerKinematics& shaker) {
+  return diagnostics(view_of(solver), shaker);
+}
 
 /// The full fields at one instant, in the lab frame like the profiles: the cells sit at their
 /// container-frame centres + plate_z, and u_z includes plate_v.
@@ -25,7 +49,7 @@ struct FieldSnapshot {
   double time = 0, phase = 0, plate_z = 0, plate_v = 0;
   std::vector<double> n, ux, uy, uz, T;  ///< interior cells, x fastest, lab-frame u_z
 };
-FieldSnapshot snapshot(const TimeIntegrator& solver, const ShakerKinematics& shaker);
+FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker);
 /// Root attribute `kind` of the fields file: a reader of run files refuses it by this.
 inline constexpr const char* fields_file_kind = "shaker continuum fields";
 /// Writes the fields file (h5_path) and its .xdmf sidecar atomically; the file's root carries

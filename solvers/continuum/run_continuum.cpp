@@ -6,6 +6,10 @@
 // collisional loss and floor energy, and the residual of E - E0 - W + L - F), the periodicity
 // measure of the last two cycles (each phase's centre of mass against the same phase one cycle
 // earlier; also printed in the summary) and the restitution in effect at each row.
+//
+// Under an MPI launcher the 3D box is decomposed over the ranks (halo.hpp, docs/parallel.md):
+// every rank advances its block, and at every stored phase the blocks are gathered to the root,
+// which alone records, averages and writes, with the serial code, on the gathered box.
 #include "continuum/run_continuum.hpp"
 
 #include <fmt/format.h>
@@ -18,9 +22,11 @@
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/progress.hpp"
+#include "common/ranks.hpp"
 #include "common/run_file.hpp"
 #include "common/run_loop.hpp"
 #include "continuum/checkpoint.hpp"
+#include "continuum/halo.hpp"
 #include "continuum/output.hpp"
 #include "continuum/setup.hpp"
 
@@ -28,23 +34,61 @@ namespace shaker::continuum {
 
 namespace {
 
+/// The whole box as the outputs read it. A plain run reads the solver itself; a decomposed run
+/// gathers the ranks' blocks to the root at every stored phase and at the end (every rank takes
+/// part, in the observers' order, so this observer comes first), and only the root writes.
+class Box final : public RunObserver {
+ public:
+  Box(const TimeIntegrator& solver, const Grid& box_grid)
+      : solver_(solver), halo_(solver.op().halo()), grid_(box_grid) {}
+  void at_phase(const PhaseInstant&) override { gather(); }
+  void at_run_end(double) override { gather(); }
+  /// Brings the root's copy up to the solver's state (collective on a decomposed run).
+  void gather() {
+    if (!halo_) return;
+    halo_->gather(solver_.state(), state_);
+    // The budget and the floor count are sums of the ranks' shares; the step counts are alike.
+    const EnergyBudget& b = solver_.budget();
+    Counters counters = solver_.counters();
+    std::vector<double> shares{b.body_work, b.collisional_loss, b.floor_energy,
+                               static_cast<double>(counters.temperature_floor_uses)};
+    halo_->sum(shares);
+    counters.temperature_floor_uses = static_cast<std::int64_t>(shares[3]);
+    scalars_ = RunScalars{solver_.time(), solver_.op().settings().e,
+                          EnergyBudget{shares[0], shares[1], shares[2]}, counters};
+  }
+  /// This process records and writes: the plain run, or the root.
+  bool writer() const { return !halo_ || halo_->root(); }
+  BoxView view() const { return halo_ ? BoxView{grid_, state_, scalars_} : view_of(solver_); }
+
+ private:
+  const TimeIntegrator& solver_;
+  const Halo* halo_;
+  Grid grid_;
+  State state_;  ///< the root's gathered copy
+  RunScalars scalars_;
+};
+
 /// The rows of the time series, one at every stored phase.
 struct Recorder final : RunObserver {
   std::vector<double> time, phase, plate_z, com, mass, kinetic, thermal, potential, loss_rate, com_change,
       floor_uses, steps, frame_energy, body_work, collisional_loss, floor_energy, budget_residual,
       periodicity_column, restitution;
   double initial_energy = 0, initial_body_work = 0, initial_loss = 0, initial_floor = 0;
-  const TimeIntegrator& solver;
+  const Box& box;
   const ShakerKinematics& shaker;
   std::size_t phases;
 
-  Recorder(const TimeIntegrator& s, const ShakerKinematics& k, std::size_t K) : solver(s), shaker(k), phases(K) {}
-  void at_phase(const PhaseInstant&) override { add(); }
-  void add() {
-    const Diagnostics d = diagnostics(solver, shaker);
-    time.push_back(solver.time());
-    phase.push_back(shaker.phase(solver.time()));
-    plate_z.push_back(shaker.position(solver.time()));
+  Recorder(const Box& b, const ShakerKinematics& k, std::size_t K) : box(b), shaker(k), phases(K) {}
+  void at_phase(const PhaseInstant&) override {
+    if (box.writer()) add(box.view());
+  }
+  void add(const BoxView& view) {
+    const Diagnostics d = diagnostics(view, shaker);
+    const double t = view.scalars.time;
+    time.push_back(t);
+    phase.push_back(shaker.phase(t));
+    plate_z.push_back(shaker.position(t));
     com.push_back(d.center_of_mass);
     mass.push_back(d.mass);
     kinetic.push_back(d.kinetic);
@@ -53,11 +97,11 @@ struct Recorder final : RunObserver {
     loss_rate.push_back(d.loss_rate);
     com_change.push_back(com.size() > phases ? d.center_of_mass - com[com.size() - 1 - phases]
                                              : std::numeric_limits<double>::quiet_NaN());
-    floor_uses.push_back(static_cast<double>(solver.counters().temperature_floor_uses));
-    steps.push_back(static_cast<double>(solver.counters().steps));
+    floor_uses.push_back(static_cast<double>(view.scalars.counters.temperature_floor_uses));
+    steps.push_back(static_cast<double>(view.scalars.counters.steps));
     // Energy budget relative to the first row (a restart continues the accumulated terms).
-    const EnergyBudget& b = solver.budget();
-    const double energy = solver.total_energy();
+    const EnergyBudget& b = view.scalars.budget;
+    const double energy = total_energy(view);
     if (time.size() == 1) {
       initial_energy = energy;
       initial_body_work = b.body_work;
@@ -71,7 +115,7 @@ struct Recorder final : RunObserver {
     budget_residual.push_back((energy - initial_energy) - (b.body_work - initial_body_work) +
                               (b.collisional_loss - initial_loss) - (b.floor_energy - initial_floor));
     periodicity_column.push_back(periodicity());
-    restitution.push_back(solver.op().settings().e);
+    restitution.push_back(view.scalars.e);
   }
   TimeSeries series() const {
     TimeSeries s;
@@ -113,12 +157,12 @@ struct Recorder final : RunObserver {
 /// the sampled cycles.
 class ProfileAverage final : public RunObserver {
  public:
-  ProfileAverage(const TimeIntegrator& solver, const ShakerKinematics& shaker, std::size_t phases)
-      : solver_(solver), shaker_(shaker), sums_(phases), cycles_(phases, 0) {}
+  ProfileAverage(const Box& box, const ShakerKinematics& shaker, std::size_t phases)
+      : box_(box), shaker_(shaker), sums_(phases), cycles_(phases, 0) {}
   void at_phase(const PhaseInstant& instant) override {
-    if (!instant.sampled) return;
+    if (!instant.sampled || !box_.writer()) return;
     const auto k = static_cast<std::size_t>(instant.phase);
-    add(sums_[k], horizontal_profile(solver_, shaker_), cycles_[k]++ == 0);
+    add(sums_[k], horizontal_profile(box_.view(), shaker_), cycles_[k]++ == 0);
   }
   /// Phases no sampled cycle reached (a run continued within its last cycle) are left out.
   std::vector<Profile> averages() const {
@@ -153,7 +197,7 @@ class ProfileAverage final : public RunObserver {
     }
   }
 
-  const TimeIntegrator& solver_;
+  const Box& box_;
   const ShakerKinematics& shaker_;
   std::vector<Profile> sums_;
   std::vector<int> cycles_;
@@ -162,17 +206,16 @@ class ProfileAverage final : public RunObserver {
 /// 3D fields at the stored phases of continuum.field_phases, in the last cycle.
 class FieldSnapshots final : public RunObserver {
  public:
-  FieldSnapshots(const TimeIntegrator& solver, const ShakerKinematics& shaker,
-                 std::vector<std::int64_t> phases)
-      : solver_(solver), shaker_(shaker), phases_(std::move(phases)) {}
+  FieldSnapshots(const Box& box, const ShakerKinematics& shaker, std::vector<std::int64_t> phases)
+      : box_(box), shaker_(shaker), phases_(std::move(phases)) {}
   void at_phase(const PhaseInstant& instant) override {
-    if (instant.last_cycle() && std::binary_search(phases_.begin(), phases_.end(), instant.phase))
-      snapshots.push_back(snapshot(solver_, shaker_));
+    if (box_.writer() && instant.last_cycle() && std::binary_search(phases_.begin(), phases_.end(), instant.phase))
+      snapshots.push_back(snapshot(box_.view(), shaker_));
   }
   std::vector<FieldSnapshot> snapshots;
 
  private:
-  const TimeIntegrator& solver_;
+  const Box& box_;
   const ShakerKinematics& shaker_;
   std::vector<std::int64_t> phases_;  ///< increasing
 };
@@ -211,6 +254,54 @@ void check_outputs(const ContinuumCase& c, const CheckpointSettings& checkpoints
   checkpoints.check_paths(outputs, inputs);
 }
 
+/// The decomposition of a 3D box under an MPI launcher (any number of ranks), else null.
+/// InputError before any work: a 1D column on several ranks, or a box too narrow for them.
+std::shared_ptr<const Halo> decomposition(const Grid& grid) {
+  if (!launched_by_mpi()) return nullptr;
+  const int ranks = Ranks::world().size();
+  if (grid.dimension == 3) return std::make_shared<const Halo>(grid, ranks);
+  if (ranks > 1)
+    throw InputError(fmt::format(
+        "continuum.dimension = 1: the 1D column runs on one rank, not on {}: start it without "
+        "mpirun, or spread a 3D box (continuum.dimension = 3) over the ranks", ranks));
+  return nullptr;
+}
+
+/// A checkpoint read by the root and scattered to the ranks of a decomposed run: the same
+/// checkpoint continues on any number of ranks. Every rank fails alike on a bad checkpoint.
+SchedulePosition read_decomposed_checkpoint(const std::filesystem::path& path, const Halo& halo,
+                                            TimeIntegrator& solver) {
+  State box;
+  RunScalars scalars;
+  SchedulePosition position;
+  std::string failure;
+  if (halo.root()) {
+    try {
+      box.resize(halo.box().size());
+      position = read_checkpoint(path, halo.box(), box, scalars);
+    } catch (const std::exception& error) {
+      failure = error.what();
+    }
+  }
+  if (!halo.agree(failure)) throw InputError(failure);
+  const Counters& k = scalars.counters;
+  const EnergyBudget& b = scalars.budget;
+  // Counts travel as doubles, exact below 2^53.
+  std::vector<double> values{scalars.time, scalars.e, static_cast<double>(k.steps),
+                             static_cast<double>(k.rejected_steps), static_cast<double>(k.diffusion_stages),
+                             position.start_time, static_cast<double>(position.cycle),
+                             static_cast<double>(position.phase), static_cast<double>(position.phases)};
+  halo.broadcast(values);
+  halo.scatter(box, solver.state());
+  solver.set_time(values[0]);
+  solver.op().settings().e = values[1];
+  const auto count = [&](std::size_t m) { return static_cast<std::int64_t>(values[m]); };
+  // The root carries the whole box's budget and floor count; the other ranks' shares start at 0.
+  solver.counters() = Counters{count(2), count(3), halo.root() ? k.temperature_floor_uses : 0, count(4)};
+  solver.budget() = halo.root() ? b : EnergyBudget{};
+  return SchedulePosition{values[5], count(6), count(7), count(8)};
+}
+
 /// The continuum's schedule: a new one from t = 0, or the checkpoint's, continued with the
 /// checkpoint's state loaded into the solver.
 PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& config, const std::filesystem::path& restart_from,
@@ -221,7 +312,9 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
   config::require_same_keys(config, checkpoint_configuration(restart_from),
                             {"material.restitution", "material.e", "layer.particles", "md.box_width", "shaker.frequency"},
                             source);
-  const SchedulePosition position = read_checkpoint(restart_from, solver);
+  const Halo* halo = solver.op().halo();
+  const SchedulePosition position = halo ? read_decomposed_checkpoint(restart_from, *halo, solver)
+                                         : read_checkpoint(restart_from, solver);
   PhaseSchedule schedule = PhaseSchedule::from_start(run, c.parameters.shaker, position.start_time);
   schedule.resume_at(position, solver.time(), source);
   return schedule;
@@ -233,38 +326,49 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   const ContinuumCase c = continuum_case(config);
   const CheckpointSettings checkpoints = CheckpointSettings::from(config);
   check_outputs(c, checkpoints, inputs);
+  const std::shared_ptr<const Halo> halo = decomposition(c.grid);
   const RunProtocol& run = c.parameters.run;
   const ShakerKinematics& shaker = c.parameters.shaker;
-  TimeIntegrator solver = make_solver(c);
+  TimeIntegrator solver = make_solver(c, halo);
   const PhaseSchedule schedule = starting_schedule(c, config, checkpoints.restart_from, solver);
   const std::string configuration = config.to_toml();
   const std::filesystem::path output = run.output;
   const auto K = static_cast<std::size_t>(schedule.phases());
 
-  Recorder recorder(solver, shaker, K);
-  ProfileAverage profiles(solver, shaker, K);
-  FieldSnapshots fields(solver, shaker, c.field_phases);
+  Box box(solver, c.grid);
+  Recorder recorder(box, shaker, K);
+  ProfileAverage profiles(box, shaker, K);
+  FieldSnapshots fields(box, shaker, c.field_phases);
   const double cells = static_cast<double>(c.grid.interior_cells());
+  ProgressSettings progress_of_rank = progress_settings;
+  progress_of_rank.quiet = progress_settings.quiet || !box.writer();
   ProgressReport progress("shaker continuum", "cell updates/s",
                           [&] { return cells * static_cast<double>(solver.counters().steps); },
-                          progress_settings);
+                          progress_of_rank);
+  // The root writes every checkpoint, of the box gathered at the phase (the Box observer runs
+  // first); a decomposed run's other ranks take no part (so they hold stop signals back, and
+  // the root's checkpoint is the run's).
   const auto write = [&](const std::filesystem::path& path, const SchedulePosition& position) {
-    write_checkpoint(path, solver, position, configuration);
+    if (box.writer()) write_checkpoint(path, box.view(), position, configuration);
   };
   CheckpointObserver checkpointing(checkpoints, schedule, write, "shaker continuum");
-  std::vector<RunObserver*> observers{&recorder, &profiles, &progress};
+  std::vector<RunObserver*> observers{&box, &recorder, &profiles, &progress};
   if (!c.field_phases.empty()) observers.push_back(&fields);
-  observers.push_back(&checkpointing);
+  if (box.writer()) observers.push_back(&checkpointing);
   DrivenIntegrator driven(solver);
   try {
     schedule.run(driven, observers);
   } catch (const StepFailure& failure) {
+    // Every rank fails alike (the step's decisions are agreed), so all take part in the gather.
+    box.gather();
+    if (!box.writer()) return 1;
     const std::filesystem::path last_good = last_good_path(output);
     write(last_good, checkpointing.next());
     fmt::print(stderr, "shaker continuum: {}\nThe last good state is in {}\n", failure.what(),
                last_good.string());
     return 1;
   }
+  if (!box.writer()) return 0;
 
   RunRecord record;
   record.solver = "continuum";
@@ -280,7 +384,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
     write_fields(fields_path, c.grid, fields.snapshots, record);
   }
   write_run_file(output, record);
-  const Counters& counters = solver.counters();
+  const Counters counters = box.view().scalars.counters;
   fmt::print("shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
              "temperature floor used {} times; mass drift {:.3e}; periodicity (centre of mass, last "
              "two cycles) {:.3e} (series column periodicity_last_two_cycles); energy budget residual "

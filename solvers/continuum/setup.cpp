@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/errors.hpp"
+#include "continuum/halo.hpp"
 
 namespace shaker::continuum {
 
@@ -96,16 +97,31 @@ ContinuumCase continuum_case(const config::Config& config) {
   l.perturbation = config.real("continuum.perturbation");
   l.seed = c.parameters.run.seed;
   c.field_phases = field_phase_indices(config, c.grid.dimension, c.parameters.run.phases_per_cycle);
-  // The layer must fit under the ceiling: checked now, before anything runs or is written.
+  // The layer must fit under the ceiling: checked now, before anything runs or is written, on
+  // one column of the grid (the check depends on the height alone; a whole 3D box would cost
+  // every rank of a decomposed run the memory of the box's state).
+  Grid column = c.grid;
+  column.dimension = 1;
+  column.nx = column.ny = 1;
   State probe;
-  probe.resize(c.grid.size());
-  flat_layer(c.grid, c.layer, probe);
+  probe.resize(column.size());
+  flat_layer(column, c.layer, probe);
   return c;
 }
 
-TimeIntegrator make_solver(const ContinuumCase& c) {
-  TimeIntegrator solver(c.grid, c.physics, c.integration);
-  flat_layer(c.grid, c.layer, solver.state());
+TimeIntegrator make_solver(const ContinuumCase& c, std::shared_ptr<const Halo> halo) {
+  if (!halo) {
+    TimeIntegrator solver(c.grid, c.physics, c.integration);
+    flat_layer(c.grid, c.layer, solver.state());
+    return solver;
+  }
+  TimeIntegrator solver(halo->local(), c.physics, c.integration, halo);
+  State box;  // the random perturbation is drawn in the box's cell order: only the root draws
+  if (halo->root()) {
+    box.resize(c.grid.size());
+    flat_layer(c.grid, c.layer, box);
+  }
+  halo->scatter(box, solver.state());
   return solver;
 }
 

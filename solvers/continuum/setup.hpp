@@ -2,6 +2,7 @@
 // The typed, validated continuum configuration of a case (continuum.* keys and the shared
 // case keys). Every inconsistency is an InputError naming the key and the allowed range.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,8 @@ struct ContinuumCase {
 
 ContinuumCase continuum_case(const config::Config& config);
 
-/// A solver at the case's initial state (flat layer) at t = 0.
-TimeIntegrator make_solver(const ContinuumCase& c);
+/// A solver at the case's initial state (flat layer) at t = 0; with a `halo`, this rank's
+/// block of it (the root lays out the whole box and scatters it: the same cells as a plain run).
+TimeIntegrator make_solver(const ContinuumCase& c, std::shared_ptr<const Halo> halo = nullptr);
 
 }  // namespace shaker::continuum

@@ -1,6 +1,7 @@
 // Volume sources: gravity and the frame force of the oscillating container (body force per
 // unit mass -g (1 + Gamma cos(omega t)) in z), the collisional energy loss gamma of the
 // model, and the optional external (manufactured) source.
+#include "continuum/halo.hpp"
 #include "continuum/operator.hpp"
 
 namespace shaker::continuum {
@@ -44,19 +45,21 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
   }
   // The external source is a user callback: it stays serial.
   if (external) {
+    const int i0 = halo_ ? halo_->block().i0 : 0, j0 = halo_ ? halo_->block().j0 : 0;
     for (int k = 0; k < g.nz; ++k)
       for (int j = 0; j < g.ny; ++j)
         for (int i = 0; i < g.nx; ++i) {
           const std::ptrdiff_t c = g.index(i, j, k);
           double extra[variable_count] = {0, 0, 0, 0, 0};
-          const double x = g.dimension == 3 ? g.center(i) : 0.0;
-          const double y = g.dimension == 3 ? g.center(j) : 0.0;
+          const double x = g.dimension == 3 ? g.center(i0 + i) : 0.0;
+          const double y = g.dimension == 3 ? g.center(j0 + j) : 0.0;
           external_source(t, x, y, g.center(k), extra);
           for (int v = 0; v < variable_count; ++v) dUdt.q[v][c] += extra[v];
         }
   }
-  // Per unit plate area: a cell holds h / (nx ny) of the column (1D: nx = ny = 1).
-  const double per_area = g.h / (static_cast<double>(g.nx) * g.ny);
+  // Per unit plate area: a cell holds h / (nx ny) of the column (1D: nx = ny = 1), nx ny
+  // those of the whole box (a rank's share is summed over the ranks with its budget).
+  const double per_area = g.h / plate_columns();
   source_power_ = SourcePower{body * per_area, lost * per_area};
 }
 

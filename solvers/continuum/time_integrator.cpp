@@ -6,11 +6,13 @@
 #include <cmath>
 #include <limits>
 
+#include "continuum/halo.hpp"
+
 namespace shaker::continuum {
 
 TimeIntegrator::TimeIntegrator(const Grid& grid, const PhysicsSettings& physics,
-                               const IntegratorSettings& settings)
-    : op_(grid, physics), implicit_(grid), settings_(settings) {
+                               const IntegratorSettings& settings, std::shared_ptr<const Halo> halo)
+    : op_(grid, physics, halo), implicit_(grid, halo), settings_(settings) {
   for (State* s : {&U_, &U0_, &U1_, &U2_, &K_, &K0_, &start_}) s->resize(grid.size());
 }
 
@@ -38,18 +40,37 @@ void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const 
   }
 }
 
-double TimeIntegrator::total_energy() const {
-  const Grid& g = op_.grid();
+double interior_energy_sum(const Grid& g, const State& s) {
   double sum = 0.0;
-  const double* E = U_.q[energy].data();
+  const double* E = s.q[energy].data();
   for (int row = 0; row < g.interior_rows(); ++row) {
     const std::ptrdiff_t first = g.row_start(row);
     for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) sum += E[c];
   }
-  return sum * g.h / (static_cast<double>(g.nx) * g.ny);
+  return sum;
+}
+
+double TimeIntegrator::total_energy() const {
+  return interior_energy_sum(op_.grid(), U_) * op_.grid().h / op_.plate_columns();
 }
 
 bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double* added) {
+  const Halo* halo = op_.halo();
+  if (!halo) return admissible_here(s, t, failure, added);
+  const std::int64_t floors_before = counters_.temperature_floor_uses;
+  std::int64_t failing_cell = 0;
+  const bool here = admissible_here(s, t, failure, added, &failing_cell);
+  // Every rank must take the same branch (retry or go on), and name the cell a plain run
+  // names: the first failing one in the box's storage order.
+  std::string first_failure = here ? std::string() : failure;
+  if (halo->agree(first_failure, failing_cell)) return true;
+  failure = first_failure;
+  counters_.temperature_floor_uses = floors_before;  // a failed check counts no floors
+  return false;
+}
+
+bool TimeIntegrator::admissible_here(State& s, double t, std::string& failure, double* added,
+                                     std::int64_t* failing_cell) {
   const Grid& g = op_.grid();
   const double floor = settings_.temperature_floor;
   std::int64_t floors = 0;
@@ -99,9 +120,13 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
         const auto k = static_cast<int>(from_plane / g.stride_z());
         const auto j = static_cast<int>((c - g.index(0, 0, k)) / g.stride_y());
         const auto i = static_cast<int>(c - g.index(0, j, k));
+        const Halo* halo = op_.halo();  // the cell's place in the whole box
+        const int box_i = halo ? halo->block().i0 + i : i, box_j = halo ? halo->block().j0 + j : j;
         failure = fmt::format("t = {:.10g}, cell (i, j, k) = ({}, {}, {}) at z = {:.6g}: n = {:.6g}, "
                               "E = {:.6g} (need 0 < nu < nu_max and finite values)",
-                              t, i, j, k, g.center(k), n, E[c]);
+                              t, box_i, box_j, k, g.center(k), n, E[c]);
+        if (failing_cell && halo)
+          *failing_cell = (static_cast<std::int64_t>(k) * halo->box().ny + box_j) * halo->box().nx + box_i;
         return false;
       }
       const double kinetic = 0.5 * (Mx[c] * Mx[c] + My[c] * My[c] + Mz[c] * Mz[c]) / n;
@@ -113,7 +138,7 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
     }
   }
   counters_.temperature_floor_uses += floors;
-  if (added) *added = raised * g.h / (static_cast<double>(g.nx) * g.ny);
+  if (added) *added = raised * g.h / op_.plate_columns();
   return true;
 }
 

@@ -17,6 +17,7 @@
 // and every such use is counted. A step that still fails after max_retries halvings stops the
 // run with an error naming the time and the cell; the state stays the last good one.
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -52,6 +53,9 @@ struct EnergyBudget {
   double body_work = 0, collisional_loss = 0, floor_energy = 0;
 };
 
+/// Sum of the energy density over the interior cells, in storage order.
+double interior_energy_sum(const Grid& g, const State& s);
+
 /// A step that cannot be completed even with the smallest retried step.
 class StepFailure : public std::runtime_error {
  public:
@@ -60,7 +64,13 @@ class StepFailure : public std::runtime_error {
 
 class TimeIntegrator {
  public:
-  TimeIntegrator(const Grid& grid, const PhysicsSettings& physics, const IntegratorSettings& settings);
+  /// With a `halo`, `grid` is this rank's block (halo->local()) and the integrator one of the
+  /// ranks that advance the decomposed box together: every decision (step size, rejection,
+  /// failure) is taken alike on every rank. The energy budget, the temperature floor count
+  /// and total_energy() are then this rank's shares (per unit plate area of the whole box),
+  /// summed over the ranks by whoever reports them.
+  TimeIntegrator(const Grid& grid, const PhysicsSettings& physics, const IntegratorSettings& settings,
+                 std::shared_ptr<const Halo> halo = nullptr);
 
   Operator& op() { return op_; }
   const Operator& op() const { return op_; }
@@ -93,6 +103,10 @@ class TimeIntegrator {
   void book(double dt, double weight, const Operator::SourcePower& p);
   /// `added` (if given) receives the energy per unit plate area the temperature floor added.
   bool admissible(State& s, double t, std::string& failure, double* added = nullptr);
+  /// admissible on this rank's cells; `failing_cell` (if given) receives a failing cell's place
+  /// in the box's storage order.
+  bool admissible_here(State& s, double t, std::string& failure, double* added,
+                       std::int64_t* failing_cell = nullptr);
   void axpy(State& out, double a, const State& x, double b, const State& y, double c,
             const State& k) const;  ///< out = a x + b y + c k on interior cells
 

@@ -268,7 +268,6 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
   } else {
     for (int row = 0; row < rows; ++row) run(row);
   }
-  copy_closure_to_ghosts();
 }
 
 }  // namespace shaker::continuum

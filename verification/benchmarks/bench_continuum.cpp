@@ -1,14 +1,23 @@
 // Continuum solver throughput: cell updates per second (cells x steps / wall time), one cycle
 // of the 1D base case at 0.1 sigma (paper transport), a slice of a cycle of the 3D base case
 // (11 x 11 x 80 at 0.5 sigma) with its per-cycle estimate, and memory per 3D cell measured
-// from the heap (mallinfo2) around the solver's construction.
+// from the heap (mallinfo2) around the solver's construction; and, run under `mpirun -np P`,
+// the decomposed 3D box's weak scaling (BM_Continuum3D_DecomposedBlock, docs/parallel.md).
 #include <benchmark/benchmark.h>
 #include <malloc.h>
+#include <mpi.h>
 
 #include <chrono>
+#include <cstdio>
 #include <ctime>
+#include <limits>
 #include <map>
+#include <memory>
+#include <string>
+#include <vector>
 
+#include "common/ranks.hpp"
+#include "continuum/halo.hpp"
 #include "continuum/setup.hpp"
 
 namespace {
@@ -207,6 +216,68 @@ void BM_Continuum3D_MemoryPerCell(benchmark::State& state) {
 }
 BENCHMARK(BM_Continuum3D_MemoryPerCell)->Iterations(1);
 
+// Weak scaling of the decomposed 3D box: every rank owns a block of W x W columns (W the
+// argument) of the base case's height at cell 0.5 (160 planes). Under `mpirun -np P` the box
+// is (px W) x (py W) cells, px x py = MPI_Dims_create(P, 2); without a launcher W x W on one
+// process (the serial path). Twenty steps of the paper transport with explicit diffusion from
+// the flat layer, timed between barriers; cell updates per second of the whole box and per
+// rank (per core with OMP_NUM_THREADS=1), and the fraction of rank 0's time spent in messages
+// and reductions.
+void BM_Continuum3D_DecomposedBlock(benchmark::State& state) {
+  const int width = static_cast<int>(state.range(0));
+  const bool launched = launched_by_mpi();
+  const int ranks = Ranks::world().size();
+  int dims[2] = {1, 1};
+  if (launched) {
+    dims[0] = dims[1] = 0;
+    MPI_Dims_create(ranks, 2, dims);
+  }
+  continuum::ContinuumCase c = base_case(3, 0.5, "paper", "explicit");
+  c.grid.nx = dims[0] * width;
+  c.grid.ny = dims[1] * width;
+  const auto halo = launched ? std::make_shared<const continuum::Halo>(c.grid, ranks) : nullptr;
+  const auto barrier = [&] {
+    if (launched) MPI_Barrier(MPI_COMM_WORLD);
+  };
+  constexpr int steps = 20;
+  double seconds = 0, communication = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    continuum::TimeIntegrator solver = continuum::make_solver(c, halo);
+    barrier();
+    state.ResumeTiming();
+    const double communicated = halo ? halo->communication_seconds() : 0.0;
+    const auto start = std::chrono::steady_clock::now();
+    for (int s = 0; s < steps; ++s) solver.step(std::numeric_limits<double>::infinity());
+    barrier();
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    communication += halo ? halo->communication_seconds() - communicated : 0.0;
+  }
+  const double cells = static_cast<double>(c.grid.interior_cells());
+  const double rate = cells * steps * static_cast<double>(state.iterations()) / seconds;
+  state.counters["ranks"] = ranks;
+  state.counters["cells_per_rank"] = cells / ranks;
+  state.counters["cell_updates_per_second"] = rate;
+  state.counters["cell_updates_per_second_per_rank"] = rate / ranks;
+  // Rank 0's time in messages and reductions (waiting for the others included) / wall time.
+  state.counters["communication_fraction"] = communication / seconds;
+}
+BENCHMARK(BM_Continuum3D_DecomposedBlock)->Arg(16)->Arg(32)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
 }  // namespace
 
-BENCHMARK_MAIN();
+// Under mpirun every rank runs the benchmarks (the decomposed ones together, each rank its own
+// copy of the others: filter with --benchmark_filter); rank 0 alone reports and writes files.
+int main(int argc, char** argv) {
+  std::vector<char*> arguments(argv, argv + argc);
+  if (!shaker::Ranks::world().root()) {
+    std::erase_if(arguments, [](const char* a) { return std::string(a).rfind("--benchmark_out", 0) == 0; });
+    if (std::freopen("/dev/null", "w", stdout) == nullptr) return 1;
+  }
+  int count = static_cast<int>(arguments.size());
+  benchmark::Initialize(&count, arguments.data());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  shaker::Ranks::finalize();
+  return 0;
+}

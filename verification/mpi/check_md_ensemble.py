@@ -7,8 +7,6 @@
   check_md_ensemble.py SHAKER ranks P [P ...] [--mpirun CMD]
       `mpirun -np P shaker md` writes the same file as the plain run for every P (more ranks
       than replicas included), every dataset and attribute but the creation date.
-  check_md_ensemble.py SHAKER continuum-refused [--mpirun CMD]
-      `mpirun -np 2 shaker continuum` exits 2 with a message, writing nothing.
 
 Exit status 0 when every check holds; each failure is printed. Runs in a temporary directory,
 removed on success.
@@ -136,22 +134,10 @@ def check_ranks(shaker, work, launcher, counts):
     return failures
 
 
-def check_continuum_refused(shaker, work, launcher):
-    result = run(mpirun_prefix(launcher, 2) + [shaker, "continuum", "case.toml", "--set",
-                                               "run.output=c.h5", "--quiet"], work, expect=2)
-    failures = []
-    if "one rank" not in result.stderr:
-        failures.append(f"continuum on 2 ranks: message lacks 'one rank': {result.stderr[-500:]}")
-    if os.path.exists(os.path.join(work, "c.h5")):
-        failures.append("continuum on 2 ranks: c.h5 was written")
-    print(f"continuum on 2 ranks: exit 2, {len(failures)} problems")
-    return failures
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
-    parser.add_argument("check", choices=["pooling", "ranks", "continuum-refused"])
+    parser.add_argument("check", choices=["pooling", "ranks"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -160,10 +146,8 @@ def main():
         f.write(CASE)
     if args.check == "pooling":
         failures = check_pooling(args.shaker, work)
-    elif args.check == "ranks":
-        failures = check_ranks(args.shaker, work, args.mpirun, args.ranks)
     else:
-        failures = check_continuum_refused(args.shaker, work, args.mpirun)
+        failures = check_ranks(args.shaker, work, args.mpirun, args.ranks)
     for failure in failures:
         print("FAIL:", failure)
     return keep_on_failure.finish(work, failures)

@@ -1,0 +1,254 @@
+#include "continuum/halo.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include "common/errors.hpp"
+
+namespace shaker::continuum {
+
+namespace {
+
+/// [first, first + length) of the `parts` near-equal pieces of `cells`, piece `part`.
+std::pair<int, int> piece(int cells, int parts, int part) {
+  const int first = static_cast<int>(static_cast<std::int64_t>(part) * cells / parts);
+  const int end = static_cast<int>(static_cast<std::int64_t>(part + 1) * cells / parts);
+  return {first, end - first};
+}
+
+/// Calls visit(storage index) for every cell of one layer of the block, in the same order on
+/// both ranks of a message. `first` is the layer's first coordinate along `direction`; x layers
+/// span the interior rows, y layers the x ghosts too.
+template <class Visit> void for_layer(const Grid& g, int direction, int first, Visit visit) {
+  const int G = Grid::ghosts;
+  for (int k = 0; k < g.nz; ++k) {
+    if (direction == 0) {
+      for (int j = 0; j < g.ny; ++j)
+        for (int m = 0; m < G; ++m) visit(g.index(first + m, j, k));
+    } else {
+      for (int m = 0; m < G; ++m)
+        for (int i = -G; i < g.nx + G; ++i) visit(g.index(i, first + m, k));
+    }
+  }
+}
+
+constexpr int tag_downwards = 0, tag_upwards = 1;
+
+/// Adds the wall seconds of its lifetime to `total`.
+class Stopwatch {
+ public:
+  explicit Stopwatch(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~Stopwatch() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  Stopwatch(const Stopwatch&) = delete;
+  Stopwatch& operator=(const Stopwatch&) = delete;
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+Halo::Halo(const Grid& box, int ranks) : box_(box), local_(box) {
+  dims_[0] = dims_[1] = 0;  // both free for MPI_Dims_create
+  MPI_Dims_create(ranks, 2, dims_);
+  const int fewest_x = box.nx / dims_[0], fewest_y = box.ny / dims_[1];
+  if (fewest_x < min_cells_per_rank || fewest_y < min_cells_per_rank)
+    throw InputError(fmt::format(
+        "the 3D box of {} x {} cells (continuum.box_width / continuum.cell_size) cannot be split "
+        "over {} ranks: MPI_Dims_create gives {} x {} ranks, {} x {} cells or fewer each; allowed: "
+        "at least {} cells per rank in x and in y, so at most {} ranks in x and {} in y (fewer "
+        "ranks, or a wider box)",
+        box.nx, box.ny, ranks, dims_[0], dims_[1], fewest_x, fewest_y, min_cells_per_rank,
+        box.nx / min_cells_per_rank, box.ny / min_cells_per_rank));
+  const int periodic[2] = {1, 1};
+  // No reordering: rank 0 of the launch stays the root that reads and writes.
+  MPI_Cart_create(MPI_COMM_WORLD, 2, dims_, periodic, 0, &cartesian_);
+  MPI_Comm_rank(cartesian_, &rank_);
+  MPI_Comm_size(cartesian_, &size_);
+  MPI_Cart_coords(cartesian_, rank_, 2, coords_);
+  for (int d = 0; d < 2; ++d) MPI_Cart_shift(cartesian_, d, 1, &low_[d], &high_[d]);
+  block_ = block_of(rank_);
+  local_.nx = block_.nx;
+  local_.ny = block_.ny;
+}
+
+Halo::~Halo() {
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (cartesian_ != MPI_COMM_NULL && !finalized) MPI_Comm_free(&cartesian_);
+}
+
+Block Halo::block_of(int rank) const {
+  int coords[2] = {0, 0};
+  MPI_Cart_coords(cartesian_, rank, 2, coords);
+  const auto [i0, nx] = piece(box_.nx, dims_[0], coords[0]);
+  const auto [j0, ny] = piece(box_.ny, dims_[1], coords[1]);
+  return Block{i0, j0, nx, ny};
+}
+
+void Halo::exchange(const std::vector<double*>& fields) const {
+  exchange_direction(0, fields);
+  exchange_direction(1, fields);
+}
+
+void Halo::exchange_direction(int d, const std::vector<double*>& fields) const {
+  const Grid& g = local_;
+  const int G = Grid::ghosts;
+  const int n = d == 0 ? g.nx : g.ny;
+  if (dims_[d] == 1) {  // periodic onto itself: each ghost layer copies the opposite edge
+    const std::ptrdiff_t across = n * g.stride(d);
+    for (double* field : fields) {
+      for_layer(g, d, n - G, [&](std::ptrdiff_t c) { field[c - across] = field[c]; });
+      for_layer(g, d, 0, [&](std::ptrdiff_t c) { field[c + across] = field[c]; });
+    }
+    return;
+  }
+  const std::size_t layer = static_cast<std::size_t>(G) * g.nz * (d == 0 ? g.ny : g.nx + 2 * G);
+  const std::size_t count = layer * fields.size();
+  for (auto* buffer : {&send_low_, &send_high_, &receive_low_, &receive_high_}) buffer->resize(count);
+  const auto pack = [&](int first, std::vector<double>& buffer) {
+    std::size_t at = 0;
+    for (const double* field : fields)
+      for_layer(g, d, first, [&](std::ptrdiff_t c) { buffer[at++] = field[c]; });
+  };
+  const auto unpack = [&](int first, const std::vector<double>& buffer) {
+    std::size_t at = 0;
+    for (double* field : fields)
+      for_layer(g, d, first, [&](std::ptrdiff_t c) { field[c] = buffer[at++]; });
+  };
+  const int size = static_cast<int>(count);
+  MPI_Request requests[4];
+  // Receives posted before the sends, so that the messages need no buffering on arrival.
+  MPI_Irecv(receive_low_.data(), size, MPI_DOUBLE, low_[d], tag_upwards, cartesian_, &requests[0]);
+  MPI_Irecv(receive_high_.data(), size, MPI_DOUBLE, high_[d], tag_downwards, cartesian_, &requests[1]);
+  pack(0, send_low_);
+  pack(n - G, send_high_);
+  {
+    const Stopwatch timed(communication_seconds_);
+    MPI_Isend(send_low_.data(), size, MPI_DOUBLE, low_[d], tag_downwards, cartesian_, &requests[2]);
+    MPI_Isend(send_high_.data(), size, MPI_DOUBLE, high_[d], tag_upwards, cartesian_, &requests[3]);
+    MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
+  }
+  unpack(-G, receive_low_);
+  unpack(n, receive_high_);
+}
+
+double Halo::sum(double local) const {
+  const Stopwatch timed(communication_seconds_);
+  double total = 0.0;
+  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, cartesian_);
+  return total;
+}
+
+double Halo::max(double local) const {
+  const Stopwatch timed(communication_seconds_);
+  double largest = 0.0;
+  MPI_Allreduce(&local, &largest, 1, MPI_DOUBLE, MPI_MAX, cartesian_);
+  return largest;
+}
+
+void Halo::sum(std::vector<double>& values) const {
+  const Stopwatch timed(communication_seconds_);
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM,
+                cartesian_);
+}
+
+void Halo::broadcast(std::vector<double>& values) const {
+  MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, 0, cartesian_);
+}
+
+bool Halo::agree(std::string& failure) const { return agree(failure, 0); }
+
+bool Halo::agree(std::string& failure, std::int64_t position) const {
+  const Stopwatch timed(communication_seconds_);
+  // (position, rank) as one key, so that one reduction finds the first failure.
+  const std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  const std::int64_t mine = failure.empty() ? none : position * size_ + rank_;
+  std::int64_t earliest = none;
+  MPI_Allreduce(&mine, &earliest, 1, MPI_INT64_T, MPI_MIN, cartesian_);
+  if (earliest == none) return true;
+  const int first = static_cast<int>(earliest % size_);
+  int length = static_cast<int>(failure.size());
+  MPI_Bcast(&length, 1, MPI_INT, first, cartesian_);
+  failure.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(failure.data(), length, MPI_CHAR, first, cartesian_);
+  return false;
+}
+
+namespace {
+/// Calls visit(storage index in g of box column (i0 + i, j0 + j), plane k, m) for every cell
+/// of a block, m counting the cells in (k, j, i) order.
+template <class Visit> void for_block(const Grid& g, const Block& b, bool offset, Visit visit) {
+  std::size_t m = 0;
+  const int di = offset ? b.i0 : 0, dj = offset ? b.j0 : 0;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < b.ny; ++j)
+      for (int i = 0; i < b.nx; ++i) visit(g.index(di + i, dj + j, k), m++);
+}
+}  // namespace
+
+void Halo::gather(const State& local_state, State& box_state) const {
+  const std::size_t cells = local_.interior_cells();
+  std::vector<double> mine(variable_count * cells);
+  for (int v = 0; v < variable_count; ++v)
+    for_block(local_, block_, false, [&](std::ptrdiff_t c, std::size_t m) {
+      mine[v * cells + m] = local_state.q[v][c];
+    });
+  std::vector<int> counts, offsets;
+  std::vector<double> all;
+  if (root()) {
+    for (int r = 0, at = 0; r < size_; ++r) {
+      const Block b = block_of(r);
+      counts.push_back(variable_count * b.nx * b.ny * box_.nz);
+      offsets.push_back(at);
+      at += counts.back();
+    }
+    all.resize(static_cast<std::size_t>(offsets.back() + counts.back()));
+  }
+  MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), counts.data(),
+              offsets.data(), MPI_DOUBLE, 0, cartesian_);
+  if (!root()) return;
+  if (box_state.size() != box_.size()) box_state.resize(box_.size());
+  for (int r = 0; r < size_; ++r) {
+    const Block b = block_of(r);
+    const std::size_t block_cells = static_cast<std::size_t>(b.nx) * b.ny * box_.nz;
+    const double* from = all.data() + offsets[static_cast<std::size_t>(r)];
+    for (int v = 0; v < variable_count; ++v)
+      for_block(box_, b, true, [&](std::ptrdiff_t c, std::size_t m) {
+        box_state.q[v][c] = from[v * block_cells + m];
+      });
+  }
+}
+
+void Halo::scatter(const State& box_state, State& local_state) const {
+  std::vector<int> counts, offsets;
+  std::vector<double> all;
+  if (root()) {
+    for (int r = 0; r < size_; ++r) {
+      const Block b = block_of(r);
+      const std::size_t block_cells = static_cast<std::size_t>(b.nx) * b.ny * box_.nz;
+      offsets.push_back(static_cast<int>(all.size()));
+      counts.push_back(static_cast<int>(variable_count * block_cells));
+      all.resize(all.size() + variable_count * block_cells);
+      double* to = all.data() + offsets.back();
+      for (int v = 0; v < variable_count; ++v)
+        for_block(box_, b, true, [&](std::ptrdiff_t c, std::size_t m) {
+          to[v * block_cells + m] = box_state.q[v][c];
+        });
+    }
+  }
+  const std::size_t cells = local_.interior_cells();
+  std::vector<double> mine(variable_count * cells);
+  MPI_Scatterv(all.data(), counts.data(), offsets.data(), MPI_DOUBLE, mine.data(),
+               static_cast<int>(mine.size()), MPI_DOUBLE, 0, cartesian_);
+  for (int v = 0; v < variable_count; ++v)
+    for_block(local_, block_, false, [&](std::ptrdiff_t c, std::size_t m) {
+      local_state.q[v][c] = mine[v * cells + m];
+    });
+}
+
+}  // namespace shaker::continuum

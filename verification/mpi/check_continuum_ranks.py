@@ -1,0 +1,337 @@
+#!/usr/bin/env python3
+"""The 3D continuum decomposed over MPI ranks (docs/parallel.md): checks through the program.
+
+  check_continuum_ranks.py SHAKER explicit P [P ...] [--mpirun CMD]
+      An explicit run (no implicit diffusion) writes the same run file and fields file on P
+      ranks as without a launcher, bit for bit, every dataset and attribute but the creation
+      date; only the energy budget's accumulators, summed over the ranks' shares, may differ,
+      within 1e-12 of the budget's scale.
+  check_continuum_ranks.py SHAKER hybrid [--mpirun CMD]
+      The explicit check on a box of 16 x 16 x 40 cells, on 2 ranks of 2 OpenMP threads each
+      (blocks large enough to be shared between threads) against the plain run on one thread.
+  check_continuum_ranks.py SHAKER implicit P [P ...] [--mpirun CMD]
+      The full transport (implicit diffusion) on P ranks, by the distributed CG whose dot
+      products are sums over the ranks, against the run without a launcher (Eigen's CG): every
+      dataset within 1e-12 of its largest magnitude (a field's velocity components of the
+      largest component: the horizontal ones, seeded by the 1e-3 perturbation, are four orders
+      below u_z and take its round-off; the budget's accumulators of the budget's scale).
+  check_continuum_ranks.py SHAKER restart [--mpirun CMD]
+      A checkpoint written on 2 ranks after 1 of 2 cycles, continued on 1 and on 4 ranks: the
+      final checkpoint and the time-series rows after the restart equal the straight run's
+      (without a launcher) bit for bit; the budget within 1e-12 of its scale.
+  check_continuum_ranks.py SHAKER failure [--mpirun CMD]
+      A step that fails (unlimited slopes at Courant number 1) on 2 and 4 ranks: exit 1 with the
+      plain run's message (the same first failing cell, in box coordinates) and its last good
+      state, bit for bit but the budget.
+  check_continuum_ranks.py SHAKER refused [--mpirun CMD]
+      A 1D column on 2 ranks, and an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x),
+      exit 2 with a message naming the sizes and the allowed range, writing nothing.
+
+The budget's accumulators are sums, over steps, of the ranks' shares of the energy sources;
+on P ranks they are added in another order than on one, so they agree to rounding relative to
+the energies summed (frame_energy, the accumulated work and loss), not relative to themselves
+(the floor energy and the budget residual are small differences of large sums).
+
+Exit status 0 when every check holds; each failure is printed. Runs in a temporary directory,
+removed on success and kept (and printed) on failure.
+"""
+import argparse
+import os
+import shlex
+import subprocess
+import sys
+
+import h5py
+import keep_on_failure
+import numpy as np
+
+# 8 x 8 x 20 cells, one fast cycle (f = 0.5: about 100 steps), fields at two phases.
+EXPLICIT_CASE = """
+[layer]
+particles = 1000
+[shaker]
+frequency = 0.5
+[continuum]
+dimension = 3
+cell_size = 0.5
+box_width = 4.0
+ceiling = 10.0
+diffusion_integrator = "explicit"
+field_phases = [0.25, 0.75]
+[run]
+transient_cycles = 0
+sampled_cycles = 1
+phases_per_cycle = 4
+seed = 3
+"""
+# 6 x 6 x 10 cells (3 x 3 columns per rank on 4 ranks), full transport with backward-Euler
+# diffusion (one implicit step per half step; the default Richardson extrapolation takes three)
+# and a fast shaker (f = 2, about 15 steps): every step takes hundreds of CG iterations, each a
+# halo exchange and two reductions, which on an oversubscribed machine wait for time slices.
+IMPLICIT_CASE = """
+[layer]
+particles = 1000
+[shaker]
+frequency = 2.0
+[continuum]
+dimension = 3
+cell_size = 1.0
+box_width = 6.0
+ceiling = 10.0
+transport = "full"
+diffusion_integrator = "implicit"
+field_phases = [0.5]
+[run]
+transient_cycles = 0
+sampled_cycles = 1
+phases_per_cycle = 4
+seed = 3
+"""
+IGNORED_ATTRIBUTES = {"created", "configuration"}
+BUDGET = {"timeseries/accumulated_body_work", "timeseries/accumulated_collisional_loss",
+          "timeseries/accumulated_floor_energy", "timeseries/energy_budget_residual",
+          "energy_budget"}
+BUDGET_SCALE = ("timeseries/frame_energy", "timeseries/accumulated_body_work",
+                "timeseries/accumulated_collisional_loss")
+# Time-series columns that count from the start of each run: a continued run starts afresh.
+RUN_RELATIVE = {"timeseries/com_z_change_from_previous_cycle", "timeseries/energy_budget_residual",
+                "timeseries/periodicity_last_two_cycles"}
+TOLERANCE = 1e-12
+
+
+def mpirun_prefix(command, ranks):
+    """The launcher's words for P ranks; as root OpenMPI needs its explicit consent. Ranks
+    yield the core while they wait (the tests oversubscribe a shared machine) and get the
+    launcher's OMP_NUM_THREADS."""
+    words = shlex.split(command) + ["-np", str(ranks), "--oversubscribe",
+                                    "--mca", "mpi_yield_when_idle", "1", "-x", "OMP_NUM_THREADS"]
+    if os.geteuid() == 0:
+        words.append("--allow-run-as-root")
+    return words
+
+
+def run(words, cwd, expect=0, threads=1):
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    result = subprocess.run(words, cwd=cwd, capture_output=True, text=True, env=env)
+    if result.returncode != expect:
+        raise SystemExit(f"{' '.join(words)}: exit {result.returncode}, expected {expect}\n"
+                         f"{result.stdout[-2000:]}\n{result.stderr[-2000:]}")
+    return result
+
+
+def shaker_run(shaker, case, output, work, launcher=None, ranks=None, settings=(), threads=1):
+    prefix = mpirun_prefix(launcher, ranks) if ranks else []
+    words = prefix + [shaker, "continuum", case, "--set", f"run.output={output}", "--quiet"]
+    for setting in settings:
+        words += ["--set", setting]
+    return run(words, work, threads=threads)
+
+
+def contents(path):
+    """Every dataset (as arrays) and attribute of a file, by path."""
+    found = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, item):
+            if isinstance(item, h5py.Dataset):
+                found[name] = np.asarray(item[()])
+            for key, value in item.attrs.items():
+                if key not in IGNORED_ATTRIBUTES:
+                    found[f"{name}@{key}"] = np.asarray(value)
+        f.visititems(visit)
+        for key, value in f.attrs.items():
+            if key not in IGNORED_ATTRIBUTES:
+                found[f"@{key}"] = np.asarray(value)
+    return found
+
+
+def budget_scale(*files):
+    return max((float(np.nanmax(np.abs(f[name]))) for f in files for name in BUDGET_SCALE
+                if name in f), default=0.0)
+
+
+def same_bits(x, y):
+    return x.shape == y.shape and (x.tobytes() == y.tobytes() or (
+        x.dtype.kind == "f" and np.array_equal(x, y, equal_nan=True)
+        and np.all(np.signbit(x) == np.signbit(y))))
+
+
+def within(x, y, scale):
+    if x.shape != y.shape or x.dtype.kind != "f":
+        return same_bits(x, y)
+    finite = np.isfinite(x) & np.isfinite(y)
+    if not np.array_equal(np.isnan(x), np.isnan(y)):
+        return False
+    return bool(np.all(np.abs(x[finite] - y[finite]) <= TOLERANCE * scale))
+
+
+def largest(x):
+    return float(np.nanmax(np.abs(x))) if x.size and np.any(np.isfinite(x)) else 0.0
+
+
+def magnitude(found, name):
+    """The scale of dataset `name`: its largest magnitude, or for a velocity component of a
+    field snapshot the largest of the three components."""
+    group, _, leaf = name.rpartition("/")
+    if group.startswith("snapshot_") and leaf in ("ux", "uy", "uz"):
+        return max(largest(found[f"{group}/{c}"]) for c in ("ux", "uy", "uz"))
+    return largest(found[name])
+
+
+def differences(a, b, label, exact, scale, skip=()):
+    """Names that differ: bit for bit if `exact`, else within TOLERANCE of the dataset's
+    largest magnitude; the budget within TOLERANCE of `scale` either way."""
+    out = [f"{label}: {n} only in one file" for n in sorted(set(a) ^ set(b))]
+    for name in sorted(set(a) & set(b)):
+        if name in skip:
+            continue
+        x, y = a[name], b[name]
+        if name in BUDGET:
+            same = within(x, y, scale)
+        elif exact or x.dtype.kind != "f":
+            same = same_bits(x, y)
+        else:
+            same = within(x, y, magnitude(a, name))
+        if not same:
+            out.append(f"{label}: {name} differs")
+    return out
+
+
+def compare_rank_counts(shaker, work, launcher, counts, exact, settings=(), threads=1):
+    """Runs the case without a launcher on one thread, then on each count of ranks of
+    `threads` threads each."""
+    failures = []
+    reference = "plain"
+    shaker_run(shaker, "case.toml", f"{reference}.h5", work, settings=settings)
+    files = {kind: contents(os.path.join(work, f"{reference}{kind}.h5"))
+             for kind in ("", ".fields")}
+    for p in counts:
+        result = shaker_run(shaker, "case.toml", f"ranks{p}.h5", work, launcher, p, settings,
+                            threads)
+        found = []
+        for kind, expected in files.items():
+            mine = contents(os.path.join(work, f"ranks{p}{kind}.h5"))
+            found += differences(mine, expected, f"{p} ranks{kind}", exact,
+                                 budget_scale(mine, expected))
+        with open(os.path.join(work, f"{reference}.fields.xdmf")) as x, \
+                open(os.path.join(work, f"ranks{p}.fields.xdmf")) as y:
+            if exact and x.read().replace(reference, f"ranks{p}") != y.read():
+                found.append(f"{p} ranks: the XDMF sidecar differs")
+        summaries = result.stdout.count("shaker continuum:")
+        if summaries != 1:
+            found.append(f"{p} ranks: {summaries} summaries printed, expected 1 (the root's)")
+        compared = sum(len(f) for f in files.values())
+        print(f"{p} rank(s) of {threads} thread(s) against {reference}: {compared} datasets "
+              f"and attributes compared ({'bit for bit' if exact else f'within {TOLERANCE}'}); "
+              f"{len(found)} differences")
+        failures += found
+    return failures
+
+
+def check_restart(shaker, work, launcher):
+    failures = []
+    two = ["run.sampled_cycles=2"]
+    shaker_run(shaker, "case.toml", "straight.h5", work,
+               settings=two + ["run.checkpoint=straight.ckpt.h5"])
+    shaker_run(shaker, "case.toml", "first.h5", work, launcher, 2,
+               settings=["run.checkpoint=first.ckpt.h5"])
+    straight = contents(os.path.join(work, "straight.ckpt.h5"))
+    with h5py.File(os.path.join(work, "straight.h5"), "r") as f:
+        straight_series = {f"timeseries/{k}": np.asarray(v[()]) for k, v in f["timeseries"].items()}
+    for p in (1, 4):
+        shaker_run(shaker, "case.toml", f"rest{p}.h5", work, launcher, p,
+                   settings=two + ["run.restart_from=first.ckpt.h5",
+                                   f"run.checkpoint=rest{p}.ckpt.h5"])
+        rest = contents(os.path.join(work, f"rest{p}.ckpt.h5"))
+        scale = budget_scale(straight_series)
+        found = differences(rest, straight, f"continued on {p} ranks: final checkpoint", True,
+                            scale)
+        with h5py.File(os.path.join(work, f"rest{p}.h5"), "r") as f:
+            series = {f"timeseries/{k}": np.asarray(v[()]) for k, v in f["timeseries"].items()}
+        rows = len(series["timeseries/t"])
+        tail = {k: v[-rows:] for k, v in straight_series.items()}
+        if rows == 0 or rows >= len(straight_series["timeseries/t"]):
+            found.append(f"continued on {p} ranks: {rows} rows, not the straight run's last ones")
+        found += differences(series, tail, f"continued on {p} ranks: time series", True, scale,
+                             skip=RUN_RELATIVE)
+        print(f"checkpoint of 2 ranks continued on {p}: {len(rest)} checkpoint datasets and "
+              f"attributes and {rows} rows x {len(series)} columns compared with the straight "
+              f"run; {len(found)} differences")
+        failures += found
+    return failures
+
+
+def check_failure(shaker, work, launcher):
+    failures = []
+    unstable = ["continuum.limiter=none", "continuum.cfl=1.0"]
+
+    def failed(output, ranks=None):
+        words = (mpirun_prefix(launcher, ranks) if ranks else []) + [
+            shaker, "continuum", "case.toml", "--set", f"run.output={output}.h5", "--quiet"]
+        result = run(words + [w for s in unstable for w in ("--set", s)], work, expect=1)
+        return result.stderr.split("\n")[0]
+
+    message = failed("plain")
+    expected = contents(os.path.join(work, "plain.last_good.h5"))
+    for p in (2, 4):
+        found = []
+        mine = failed(f"ranks{p}", p)
+        if mine != message:
+            found.append(f"{p} ranks: message '{mine}' instead of '{message}'")
+        last_good = contents(os.path.join(work, f"ranks{p}.last_good.h5"))
+        found += differences(last_good, expected, f"{p} ranks: last good state", True,
+                             float(np.max(np.abs(expected["energy_budget"]))))
+        print(f"step failure on {p} ranks: exit 1; {len(found)} differences from the plain run")
+        failures += found
+    return failures
+
+
+def check_refused(shaker, work, launcher):
+    failures = []
+    for label, ranks, settings, needles in (
+            ("1D column on 2 ranks", 2, ["continuum.dimension=1", "continuum.field_phases=[]"],
+             ["continuum.dimension = 1", "one rank"]),
+            ("8 x 8 box on 3 ranks", 3, [],
+             ["8 x 8 cells", "3 x 1 ranks", "at least 3 cells per rank", "at most 2 ranks in x"])):
+        result = run(mpirun_prefix(launcher, ranks) + [shaker, "continuum", "case.toml", "--set",
+                                                       "run.output=refused.h5", "--quiet"]
+                     + [w for s in settings for w in ("--set", s)], work, expect=2)
+        for needle in needles:
+            if needle not in result.stderr:
+                failures.append(f"{label}: message lacks '{needle}': {result.stderr[-600:]}")
+        written = [n for n in os.listdir(work) if n.startswith("refused")]
+        if written:
+            failures.append(f"{label}: wrote {written}")
+        print(f"{label}: exit 2, {len(failures)} problems so far")
+    return failures
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("shaker")
+    parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "failure",
+                                          "refused"])
+    parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
+    parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
+    args = parser.parse_args()
+    work = keep_on_failure.work_folder(f"continuum-ranks-{args.check}-")
+    with open(os.path.join(work, "case.toml"), "w") as f:
+        f.write(IMPLICIT_CASE if args.check == "implicit" else EXPLICIT_CASE)
+    if args.check in ("explicit", "implicit"):
+        failures = compare_rank_counts(args.shaker, work, args.mpirun, args.ranks,
+                                       args.check == "explicit")
+    elif args.check == "hybrid":
+        failures = compare_rank_counts(args.shaker, work, args.mpirun, [2], True,
+                                       ["continuum.box_width=8", "continuum.ceiling=20"], 2)
+    elif args.check == "restart":
+        failures = check_restart(args.shaker, work, args.mpirun)
+    elif args.check == "failure":
+        failures = check_failure(args.shaker, work, args.mpirun)
+    else:
+        failures = check_refused(args.shaker, work, args.mpirun)
+    for failure in failures:
+        print("FAIL:", failure)
+    return keep_on_failure.finish(work, failures)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
