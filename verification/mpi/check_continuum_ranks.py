@@ -42,6 +42,7 @@ import subprocess
 import sys
 
 import h5py
+import hdf5_contents
 import keep_on_failure
 import numpy as np
 
@@ -128,20 +129,7 @@ def shaker_run(shaker, case, output, work, launcher=None, ranks=None, settings=(
 
 
 def contents(path):
-    """Every dataset (as arrays) and attribute of a file, by path."""
-    found = {}
-    with h5py.File(path, "r") as f:
-        def visit(name, item):
-            if isinstance(item, h5py.Dataset):
-                found[name] = np.asarray(item[()])
-            for key, value in item.attrs.items():
-                if key not in IGNORED_ATTRIBUTES:
-                    found[f"{name}@{key}"] = np.asarray(value)
-        f.visititems(visit)
-        for key, value in f.attrs.items():
-            if key not in IGNORED_ATTRIBUTES:
-                found[f"@{key}"] = np.asarray(value)
-    return found
+    return hdf5_contents.contents(path, IGNORED_ATTRIBUTES)
 
 
 def budget_scale(*files):

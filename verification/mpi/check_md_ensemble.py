@@ -17,7 +17,7 @@ import shlex
 import subprocess
 import sys
 
-import h5py
+import hdf5_contents
 import keep_on_failure
 import numpy as np
 
@@ -56,24 +56,7 @@ def run(words, cwd, expect=0):
 
 
 def contents(path, groups=None):
-    """Every dataset (as arrays) and attribute of a file, by path; `groups` limits the
-    datasets to those under the named top-level groups."""
-    found = {}
-    with h5py.File(path, "r") as f:
-        def visit(name, item):
-            if groups and name.split("/")[0] not in groups:
-                return
-            if isinstance(item, h5py.Dataset):
-                found[name] = np.asarray(item[()])
-            for key, value in item.attrs.items():
-                if key not in IGNORED_ATTRIBUTES:
-                    found[f"{name}@{key}"] = np.asarray(value)
-        f.visititems(visit)
-        if not groups:
-            for key, value in f.attrs.items():
-                if key not in IGNORED_ATTRIBUTES:
-                    found[f"@{key}"] = np.asarray(value)
-    return found
+    return hdf5_contents.contents(path, IGNORED_ATTRIBUTES, groups)
 
 
 def differences(a, b, label):
