@@ -323,11 +323,7 @@ def plot_study(study, series, design_orders, out_dir):
         ax.set_ylabel("error")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    name = f"convergence-{safe_name(study)}.png"
-    rc.save_figure_atomically(fig, os.path.join(out_dir, name))
-    plt.close(fig)
-    return name
+    return finished_plot(fig, out_dir, f"convergence-{safe_name(study)}.png")
 
 
 def phase_text(phase):
@@ -364,11 +360,7 @@ def plot_sampling(study, rows, out_dir):
     ax.set_title(f"{study}: standard error against K")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=6)
-    fig.tight_layout()
-    name = f"sampling-{safe_name(study)}.png"
-    rc.save_figure_atomically(fig, os.path.join(out_dir, name))
-    plt.close(fig)
-    return name
+    return finished_plot(fig, out_dir, f"sampling-{safe_name(study)}.png")
 
 
 def sampling_fit_line(r, mark):
@@ -389,12 +381,21 @@ def relation_of(criterion):
     return {"at_least": ">=", "at_most": "<="}.get(criterion, criterion)
 
 
+def finished_plot(fig, out_dir, name):
+    """Lays out, writes (atomically) and closes a figure; returns its file name."""
+    fig.tight_layout()
+    rc.save_figure_atomically(fig, os.path.join(out_dir, name))
+    plt.close(fig)
+    return name
+
+
 def bin_size_line(r, mark):
-    return (f"| {r['study']} | {r['quantity']} | {units_of(r['quantity'])} | "
-            f"{phase_text(r['phase'])} | "
-            f"{rc.fmt(r['sigma_value'], 5)} | {rc.fmt(r['half_sigma_value'], 5)} | "
-            f"{r['statistic']} | {bin_size_value_units(r)} | {rc.fmt(r['value'], 4)} | "
-            f"{relation_of(r['criterion'])} {rc.fmt(r['limit'], 4)} | {mark} |")
+    quantity = r["quantity"]
+    return rc.table_row([
+        r["study"], quantity, units_of(quantity), phase_text(r["phase"]),
+        rc.fmt(r["sigma_value"], 5), rc.fmt(r["half_sigma_value"], 5), r["statistic"],
+        bin_size_value_units(r), rc.fmt(r["value"], 4),
+        f"{relation_of(r['criterion'])} {rc.fmt(r['limit'], 4)}", mark])
 
 
 def bin_size_failure(r):
@@ -429,13 +430,12 @@ def gci_result_text(r, mark):
 
 
 def gci_line(r, mark):
-    return (f"| {r['study']} | {r['quantity']} | {units_of(r['quantity'])} | "
-            f"{rc.fmt(r['phi1'], 6)} | "
-            f"{rc.fmt(r['phi2'], 6)} | {rc.fmt(r['phi3'], 6)} | {rc.fmt(r['order'], 4)} | "
-            f"{rc.fmt(r['phi_extrapolated'], 6)} | "
-            f"{rc.fmt(100 * r['relative_difference21'], 3)} | {rc.fmt(100 * r['gci21'], 3)} | "
-            f"{rc.fmt(100 * r['gci32'], 3)} | {rc.fmt(r['asymptotic_ratio'], 4)} | "
-            f"{r['convergence']} | {gci_result_text(r, mark)} |")
+    percent = [rc.fmt(100 * r[k], 3) for k in ("relative_difference21", "gci21", "gci32")]
+    return rc.table_row(
+        [r["study"], r["quantity"], units_of(r["quantity"])]
+        + [rc.fmt(r[k], 6) for k in ("phi1", "phi2", "phi3")]
+        + [rc.fmt(r["order"], 4), rc.fmt(r["phi_extrapolated"], 6)] + percent
+        + [rc.fmt(r["asymptotic_ratio"], 4), r["convergence"], gci_result_text(r, mark)])
 
 
 def gci_failure(r):

@@ -156,4 +156,9 @@ def analysis_header(label, name):
 
 def table_head(cells):
     """The header line and the separator line of a markdown table with these header cells."""
-    return ["| " + " | ".join(cells) + " |", "| " + " | ".join("---" for _ in cells) + " |"]
+    return [table_row(cells), table_row("---" for _ in cells)]
+
+
+def table_row(cells):
+    """One line of a markdown table."""
+    return "| " + " | ".join(str(c) for c in cells) + " |"
