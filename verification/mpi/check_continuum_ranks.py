@@ -215,6 +215,12 @@ def compare_rank_counts(shaker, work, launcher, counts, exact, settings=(), thre
     return failures
 
 
+def time_series(path):
+    """The time-series columns of a run file, keyed timeseries/NAME."""
+    with h5py.File(path, "r") as f:
+        return {f"timeseries/{k}": np.asarray(v[()]) for k, v in f["timeseries"].items()}
+
+
 def check_restart(shaker, work, launcher):
     failures = []
     two = ["run.sampled_cycles=2"]
@@ -223,8 +229,7 @@ def check_restart(shaker, work, launcher):
     shaker_run(shaker, "case.toml", "first.h5", work, launcher, 2,
                settings=["run.checkpoint=first.ckpt.h5"])
     straight = contents(os.path.join(work, "straight.ckpt.h5"))
-    with h5py.File(os.path.join(work, "straight.h5"), "r") as f:
-        straight_series = {f"timeseries/{k}": np.asarray(v[()]) for k, v in f["timeseries"].items()}
+    straight_series = time_series(os.path.join(work, "straight.h5"))
     for p in (1, 4):
         shaker_run(shaker, "case.toml", f"rest{p}.h5", work, launcher, p,
                    settings=two + ["run.restart_from=first.ckpt.h5",
@@ -233,8 +238,7 @@ def check_restart(shaker, work, launcher):
         scale = budget_scale(straight_series)
         found = differences(rest, straight, f"continued on {p} ranks: final checkpoint", True,
                             scale)
-        with h5py.File(os.path.join(work, f"rest{p}.h5"), "r") as f:
-            series = {f"timeseries/{k}": np.asarray(v[()]) for k, v in f["timeseries"].items()}
+        series = time_series(os.path.join(work, f"rest{p}.h5"))
         rows = len(series["timeseries/t"])
         tail = {k: v[-rows:] for k, v in straight_series.items()}
         if rows == 0 or rows >= len(straight_series["timeseries/t"]):
