@@ -39,6 +39,10 @@ allowed); names contain no commas.
       The least-squares slope of ln se against ln K; the judge (SamplingFit::pass) passes it
       when |slope - expected_slope| <= band (the band follows from the degrees of freedom of
       each standard error).
+  *.term-shares.csv   study,term,equation,rms,share
+      A manufactured solution's source split by term (verification/mms/mms_run.hpp,
+      term_shares): the root mean square of one term's part in one equation, and its share of
+      the sum over the terms there. Shown as a table; the check (MmsTermShares3D) is ctest's.
   *.bin-size.csv      study,quantity,phase,sigma_value,half_sigma_value,statistic,value,
                       criterion,limit,pass
       Bin size sigma against sigma/2: `statistic` names `value`; the judge
@@ -92,7 +96,9 @@ SAMPLING_FIT_HEADER = ["study", "quantity", "phase", "fit_points", "fitted_slope
                        "slope_std_error", "expected_slope", "band", "pass"]
 BIN_SIZE_HEADER = ["study", "quantity", "phase", "sigma_value", "half_sigma_value", "statistic",
                    "value", "criterion", "limit", "pass"]
-TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence", "statistic", "criterion"}
+TERM_SHARES_HEADER = ["study", "term", "equation", "rms", "share"]
+TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence", "statistic", "criterion",
+                "term", "equation"}
 NORM_ORDER = {"L1": 0, "L2": 1, "Linf": 2}
 
 # The units of every field and quantity the C++ writers name (docs/units.md): the fields of the
@@ -221,15 +227,17 @@ def remove_stale_plots(out_dir, report_text):
 
 def read_inputs(directory):
     found = {"errors": [], "orders": [], "gci": [], "sampling": [], "sampling-fit": [],
-             "bin-size": []}
+             "bin-size": [], "term-shares": []}
     files = []
     for kind, header in (("errors", ERRORS_HEADER), ("orders", ORDERS_HEADER), ("gci", GCI_HEADER),
                          ("sampling", SAMPLING_HEADER), ("sampling-fit", SAMPLING_FIT_HEADER),
-                         ("bin-size", BIN_SIZE_HEADER)):
+                         ("bin-size", BIN_SIZE_HEADER), ("term-shares", TERM_SHARES_HEADER)):
         for path in sorted(glob.glob(os.path.join(directory, "**", f"*.{kind}.csv"),
                                      recursive=True)):
             records = read_csv(path, header)
             for record in records:  # every name must have units before anything is written
+                if kind == "term-shares":
+                    continue  # shares are fractions of a sum; rms is per-equation source
                 try:
                     units_of(record.get("field", record.get("quantity")))
                     if kind == "bin-size":
@@ -517,6 +525,28 @@ def sampling_section(data, out_dir, failures):
     return lines, fit_checks + bin_checks
 
 
+def term_share_tables(rows):
+    """One table per study: each term's share of the manufactured source per equation."""
+    if not rows:
+        return []
+    lines = ["## Term shares of the manufactured sources", "",
+             "Each term's part of the source (root mean square over the cell centres of the "
+             "coarsest grid at three times in [0, t_end]) as a share of the sum of every term's "
+             "part in that equation [1]; a blank cell: the term does not enter the equation. "
+             "MmsTermShares3D requires every term's largest share to be at least 0.01.", ""]
+    for study in sorted({r["study"] for r in rows}):
+        mine = [r for r in rows if r["study"] == study]
+        equations = list(dict.fromkeys(r["equation"] for r in mine))
+        lines += [f"### {study}: term shares", "",
+                  "| term | " + " | ".join(equations) + " |", "|---" * (1 + len(equations)) + "|"]
+        for term in dict.fromkeys(r["term"] for r in mine):
+            share = {r["equation"]: r["share"] for r in mine if r["term"] == term}
+            lines.append(f"| {term} | " + " | ".join(
+                rc.fmt(share[e], 3) if e in share else "" for e in equations) + " |")
+        lines.append("")
+    return lines
+
+
 def error_tables(series):
     lines = ["## Errors per level", "",
              "Error norms in the units of their field; h is the cell size [sigma] of a spatial "
@@ -590,7 +620,8 @@ def main(argv=None):
     if failures:
         lines += ["", "Failing checks (measured values):", ""] + [f"- {f}" for f in failures]
     lines.append("")
-    lines += order_lines + gci_lines + sampling_lines + error_tables(series) + plot_lines
+    lines += (order_lines + gci_lines + sampling_lines + term_share_tables(data["term-shares"]) +
+              error_tables(series) + plot_lines)
     tables = os.path.join(out_dir, TABLES_DIRECTORY)
     lines += ["## Input files", "",
               f"Copied beside this report into {TABLES_DIRECTORY}/ (the validation report reads "

@@ -6,7 +6,8 @@ their pass/fail marks, the failure summary with measured values, the units of ev
 (in a column's header, or in a units column where the rows hold different quantities; a name
 without declared units is refused), the PNG plot, --strict, and bad input; and the MD sampling
 section (slope fits against K^-1/2, the se table, its plot, the
-bin-size checks) on a synthetic sampling study.
+bin-size checks) on a synthetic sampling study; and the term-share tables of the
+manufactured sources.
 
 The report is tested against the one judge, the `pass` column the C++ side writes: for every
 row of every table it reads (the synthetic ones and the repository's convergence-tables/), the
@@ -470,3 +471,27 @@ def test_repository_tables(work_dir):
     assert result.returncode == (1 if failure_list(text) else 0), \
         f"--strict exit {result.returncode} with {len(failure_list(text))} failing checks"
     print(f"{compared} rows of the repository's tables shown as their pass column says")
+
+
+def test_term_shares_section(work_dir):
+    """A *.term-shares.csv table: one row per term, a column per equation, blank where the term
+    does not enter; a malformed share is refused."""
+    inputs = os.path.join(work_dir, "shares-input")
+    os.makedirs(inputs)
+    header = "study,term,equation,rms,share"
+    write(os.path.join(inputs, "mms-3d.term-shares.csv"), header,
+          [("mms-3d", "advection", "mass", 0.35, 0.9675), ("mms-3d", "advection", "energy", 0.68, 0.1718),
+           ("mms-3d", "conduction", "energy", 0.44, 0.1113)])
+    report = os.path.join(work_dir, "shares-out", "convergence.md")
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 0, f"exit {result.returncode}: {result.stderr}"
+    text = open(report).read()
+    assert "### mms-3d: term shares" in text, "term-share table missing"
+    assert line_with(text, "| term | mass | energy |") != "", "equation columns missing"
+    assert line_with(text, "| advection | 0.968 | 0.172 |") != "", "advection row wrong"
+    assert line_with(text, "| conduction |  | 0.111 |") != "", \
+        "a term absent from an equation must leave its cell blank"
+    write(os.path.join(inputs, "bad.term-shares.csv"), header, [("mms-3d", "gravity", "energy", 0.2, "lots")])
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 2 and "share = 'lots' is not a number" in result.stderr, \
+        f"a malformed share must be refused with exit 2: {result.returncode} {result.stderr}"

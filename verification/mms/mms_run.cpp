@@ -1,5 +1,8 @@
 #include "mms_run.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -96,6 +99,7 @@ ManufacturedSolution solution_for(const MmsCase& c) {
   ManufacturedSolution s;
   s.dimension = c.dimension;
   s.wall_compatible = c.boundary == continuum::ZBoundary::walls;
+  s.U0 = c.velocity_amplitude;
   s.Lz = 10.0;
   s.Lx = s.Ly = 5.0;  // a smaller 3D box: half the cells of a cube, same resolution
   return s;
@@ -162,6 +166,80 @@ MmsResult run_mms(const MmsCase& c) {
   store_exact_averages(solution, g, c.t_end, exact);
   append_primitives(g, exact, result.exact);
   return result;
+}
+
+double TermShares::share(std::size_t term, int equation) const {
+  double total = 0.0;
+  for (const auto& r : rms) total += r[static_cast<std::size_t>(equation)];
+  return total > 0.0 ? rms[term][static_cast<std::size_t>(equation)] / total : 0.0;
+}
+
+TermShares term_shares(const MmsCase& c, int samples) {
+  const ManufacturedSolution solution = solution_for(c);
+  const Grid g = grid_for(c, solution);
+  const Physics physics{c.e, c.transport, physics_for(c).shaker};
+  const Terms whole = effective_terms(c);
+  using Switch = bool Terms::*;
+  const std::vector<std::pair<std::string, Switch>> switches{
+      {"time_derivative", &Terms::time_derivative}, {"advection", &Terms::advection},
+      {"pressure", &Terms::pressure},               {"bulk_viscosity", &Terms::bulk_viscosity},
+      {"shear_viscosity", &Terms::shear_viscosity}, {"conduction", &Terms::conduction},
+      {"collisional_loss", &Terms::collisional_loss}, {"gravity", &Terms::gravity},
+      {"frame_forcing", &Terms::frame_forcing}};
+  const auto components = [](const Residual& r) {
+    return std::array<double, 5>{r.mass, r.momentum[0], r.momentum[1], r.momentum[2], r.energy};
+  };
+  TermShares shares;
+  std::vector<std::array<double, 5>> sum_of_squares;
+  for (const auto& [name, on] : switches)
+    if (whole.*on) {
+      shares.terms.push_back(name);
+      sum_of_squares.push_back({});
+    }
+  double largest = 0.0, largest_defect = 0.0;
+  std::size_t points = 0;
+  for (int sample = 0; sample < samples; ++sample) {
+    const double t = samples > 1 ? c.t_end * sample / (samples - 1) : 0.0;
+    for_each_cell(g, [&](std::ptrdiff_t, const std::array<double, 3>& x) {
+      const auto all = components(conservative_source(solution, physics, whole, t, x));
+      std::array<double, 5> sum{};
+      std::size_t term = 0;
+      for (const auto& [name, on] : switches) {
+        if (!(whole.*on)) continue;
+        Terms alone = Terms::none();
+        alone.*on = true;
+        const auto part = components(conservative_source(solution, physics, alone, t, x));
+        for (std::size_t q = 0; q < 5; ++q) {
+          sum_of_squares[term][q] += part[q] * part[q];
+          sum[q] += part[q];
+        }
+        ++term;
+      }
+      for (std::size_t q = 0; q < 5; ++q) {
+        largest = std::max(largest, std::abs(all[q]));
+        largest_defect = std::max(largest_defect, std::abs(all[q] - sum[q]));
+      }
+      ++points;
+    });
+  }
+  for (auto& squares : sum_of_squares) {
+    std::array<double, 5> rms{};
+    for (std::size_t q = 0; q < 5; ++q) rms[q] = std::sqrt(squares[q] / static_cast<double>(points));
+    shares.rms.push_back(rms);
+  }
+  shares.largest_sum_defect = largest > 0.0 ? largest_defect / largest : 0.0;
+  return shares;
+}
+
+std::string term_shares_csv(const std::string& study, const TermShares& shares) {
+  std::string csv = "study,term,equation,rms,share\n";
+  for (std::size_t t = 0; t < shares.terms.size(); ++t)
+    for (int q = 0; q < 5; ++q)
+      if (shares.rms[t][static_cast<std::size_t>(q)] > 0.0)
+        csv += fmt::format("{},{},{},{:.17g},{:.17g}\n", study, shares.terms[t],
+                           equation_names[static_cast<std::size_t>(q)],
+                           shares.rms[t][static_cast<std::size_t>(q)], shares.share(t, q));
+  return csv;
 }
 
 void spatial_study(const MmsCase& base, const std::vector<int>& cells_z, const std::string& study,

@@ -39,6 +39,7 @@ struct MmsCase {
   /// Source per cell: the Gauss cell average (3 points in 1D, 27 in 3D) or the value at the
   /// centre. Both are consistent to O(h^2); the centre value is 27 times cheaper in 3D.
   bool source_at_centre = false;
+  double velocity_amplitude = 0.3;     ///< ManufacturedSolution::U0
 };
 
 /// The manufactured solution a case uses (wall-compatible with walls; 3D box 5 x 5 x 10).
@@ -59,6 +60,25 @@ struct MmsResult {
 MmsResult run_mms(const MmsCase& c);
 
 inline const std::array<std::string, 5> field_names{"n", "ux", "uy", "uz", "T"};
+
+/// Each term's part of the manufactured source: the root mean square of the source with that
+/// term alone, per equation (mass, momentum x, y, z, energy), over the cell centres of the
+/// case's grid at `samples` times in [0, t_end]. The terms' sources add up to the whole one;
+/// `largest_sum_defect` is the largest |whole - sum of terms| over the sample, relative to the
+/// largest |whole|.
+struct TermShares {
+  std::vector<std::string> terms;
+  std::vector<std::array<double, 5>> rms;  ///< per term, per equation
+  double largest_sum_defect = 0.0;
+  /// rms of the term in `equation` over the sum of every term's rms there
+  double share(std::size_t term, int equation) const;
+};
+inline const std::array<std::string, 5> equation_names{"mass", "momentum_x", "momentum_y",
+                                                       "momentum_z", "energy"};
+TermShares term_shares(const MmsCase& c, int samples = 3);
+/// study,term,equation,rms,share: the rows of a *.term-shares.csv table (reports/
+/// make_convergence_report.py), one per term and equation the term enters (rms > 0).
+std::string term_shares_csv(const std::string& study, const TermShares& shares);
 
 /// Runs the case on each resolution (cells_z) and adds L1, L2, Linf of every field
 /// (ux, uy only in 3D) to `table` under `study`, level 0 the coarsest.

@@ -385,19 +385,8 @@ std::vector<std::filesystem::path> write_sampling_study(const std::filesystem::p
                         number(b.sigma_value), number(b.half_sigma_value), b.statistic,
                         number(b.value), b.criterion, number(b.limit), b.pass() ? 1 : 0);
 
-  std::vector<std::filesystem::path> targets{directory}, written;
-  if (const char* collected = std::getenv(study_directory_variable); collected && *collected)
-    targets.emplace_back(collected);
-  for (const auto& target : targets) {
-    std::filesystem::create_directories(target);
-    for (const auto& [suffix, text] : {std::pair{".sampling.csv", &se},
-                                       std::pair{".sampling-fit.csv", &fit},
-                                       std::pair{".bin-size.csv", &bins}}) {
-      write_text_atomically(target / (name + suffix), *text);
-      written.push_back(target / (name + suffix));
-    }
-  }
-  return written;
+  return write_study_files(directory, name, {{".sampling.csv", se}, {".sampling-fit.csv", fit},
+                                             {".bin-size.csv", bins}});
 }
 
 }  // namespace shaker::convergence

@@ -244,10 +244,9 @@ void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> ro
   write_text_atomically(path, gci_to_csv(rows));
 }
 
-std::vector<std::filesystem::path> write_study(const std::filesystem::path& directory,
-                                               const std::string& name, const ErrorTable& table,
-                                               std::span<const OrderCheck> checks,
-                                               std::span<const GciRow> gci) {
+std::vector<std::filesystem::path> write_study_files(
+    const std::filesystem::path& directory, const std::string& name,
+    const std::vector<std::pair<std::string, std::string>>& files) {
   if (checked_name(name).find('/') != std::string::npos)
     throw std::invalid_argument("study file name may not contain '/': " + name);
   std::vector<std::filesystem::path> targets{directory};
@@ -257,16 +256,22 @@ std::vector<std::filesystem::path> write_study(const std::filesystem::path& dire
   std::vector<std::filesystem::path> written;
   for (const auto& target : targets) {
     std::filesystem::create_directories(target);
-    table.write_csv(target / (name + ".errors.csv"));
-    write_orders_csv(target / (name + ".orders.csv"), checks);
-    written.push_back(target / (name + ".errors.csv"));
-    written.push_back(target / (name + ".orders.csv"));
-    if (!gci.empty()) {
-      write_gci_csv(target / (name + ".gci.csv"), gci);
-      written.push_back(target / (name + ".gci.csv"));
+    for (const auto& [suffix, text] : files) {
+      write_text_atomically(target / (name + suffix), text);
+      written.push_back(target / (name + suffix));
     }
   }
   return written;
+}
+
+std::vector<std::filesystem::path> write_study(const std::filesystem::path& directory,
+                                               const std::string& name, const ErrorTable& table,
+                                               std::span<const OrderCheck> checks,
+                                               std::span<const GciRow> gci) {
+  std::vector<std::pair<std::string, std::string>> files{{".errors.csv", table.to_csv()},
+                                                         {".orders.csv", orders_to_csv(checks)}};
+  if (!gci.empty()) files.emplace_back(".gci.csv", gci_to_csv(gci));
+  return write_study_files(directory, name, files);
 }
 
 }  // namespace shaker::convergence

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/convergence.hpp"
@@ -98,6 +99,12 @@ void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> ro
 /// Environment variable naming the directory that collects study tables for the nightly
 /// convergence report (ci/nightly sets it; unset in ordinary ctest runs).
 inline constexpr const char* study_directory_variable = "SHAKER_CONVERGENCE_DIR";
+
+/// Writes each (suffix, text) of `files` to <directory>/<name><suffix>, atomically, and the
+/// same files to SHAKER_CONVERGENCE_DIR when it is set. Returns every file written.
+std::vector<std::filesystem::path> write_study_files(
+    const std::filesystem::path& directory, const std::string& name,
+    const std::vector<std::pair<std::string, std::string>>& files);
 
 /// Writes <directory>/<name>.errors.csv and <name>.orders.csv (and <name>.gci.csv when GCI
 /// rows are given), atomically; when SHAKER_CONVERGENCE_DIR is set, writes the same files there
