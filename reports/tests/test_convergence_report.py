@@ -480,7 +480,8 @@ def test_term_shares_section(work_dir):
     os.makedirs(inputs)
     header = "study,term,equation,rms,share"
     write(os.path.join(inputs, "mms-3d.term-shares.csv"), header,
-          [("mms-3d", "advection", "mass", 0.35, 0.9675), ("mms-3d", "advection", "energy", 0.68, 0.1718),
+          [("mms-3d", "advection", "mass", 0.35, 0.9675),
+           ("mms-3d", "advection", "energy", 0.68, 0.1718),
            ("mms-3d", "conduction", "energy", 0.44, 0.1113)])
     report = os.path.join(work_dir, "shares-out", "convergence.md")
     result = run("--input", inputs, "--output", report, "--commit", "abc")
@@ -491,7 +492,8 @@ def test_term_shares_section(work_dir):
     assert line_with(text, "| advection | 0.968 | 0.172 |") != "", "advection row wrong"
     assert line_with(text, "| conduction |  | 0.111 |") != "", \
         "a term absent from an equation must leave its cell blank"
-    write(os.path.join(inputs, "bad.term-shares.csv"), header, [("mms-3d", "gravity", "energy", 0.2, "lots")])
+    write(os.path.join(inputs, "bad.term-shares.csv"), header,
+          [("mms-3d", "gravity", "energy", 0.2, "lots")])
     result = run("--input", inputs, "--output", report, "--commit", "abc")
     assert result.returncode == 2 and "share = 'lots' is not a number" in result.stderr, \
         f"a malformed share must be refused with exit 2: {result.returncode} {result.stderr}"
