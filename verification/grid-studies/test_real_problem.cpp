@@ -284,7 +284,10 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
 // below the grid uncertainty at the production cell (1D: the transport's reference triple
 // 0.4/0.2/0.1; 3D: the column's triple 1.0/0.5/0.25, its middle grid, the same flow while it stays
 // horizontally uniform, see BaseCase3DThreeGridsAgreeWithThe1DColumn). The integrators: every
-// row of the README's table (1D) and the two it gives for 3D.
+// row of the README's table (1D). The 3D cases are not instantiated: from the layer at rest the
+// 3D box's first cycle alone runs about 1.5 h at the production step on two threads (the packed
+// layer's sound speed sets the step), so three steps cost about 10 h; they need to start from
+// the column's periodic state, as bench_continuum's periodic-cycle benchmarks do.
 struct TimeStepCase {
   int dimension;
   std::string transport, diffusion;
@@ -361,8 +364,7 @@ INSTANTIATE_TEST_SUITE_P(
                       TimeStepCase{1, "paper", "implicit_extrapolated", 4},
                       TimeStepCase{1, "paper", "implicit", 2},
                       TimeStepCase{1, "full", "implicit_extrapolated", 2},
-                      TimeStepCase{1, "full", "implicit", 2}, TimeStepCase{3, "paper", "explicit", 2},
-                      TimeStepCase{3, "paper", "explicit", 10}),
+                      TimeStepCase{1, "full", "implicit", 2}),
     [](const ::testing::TestParamInfo<TimeStepCase>& p) {
       return fmt::format("d{}_{}_{}_s{}", p.param.dimension, p.param.transport, p.param.diffusion,
                          p.param.stages);
