@@ -35,7 +35,9 @@ std::vector<ParameterSpec> common_parameters() {
       text("run.restart_from", "", {},
            "checkpoint to continue from (empty: the solver's initial state): the run continues the "
            "checkpoint's schedule, its cycles counted from that run's start, up to "
-           "run.transient_cycles + run.sampled_cycles").in("-"),
+           "run.transient_cycles + run.sampled_cycles; a 1D continuum column's checkpoint also "
+           "starts a 3D box of the same cell size and ceiling, every column of the box taking "
+           "its state").in("-"),
       text("run.checkpoint", "", {},
            "checkpoint file written (atomically) at the end of the run, every "
            "run.checkpoint_every cycles and on SIGTERM or SIGINT; the one it replaces is kept as "

@@ -80,7 +80,8 @@ void load_checked(hid_t file, const std::filesystem::path& path, const Grid& g, 
   check("ny", g.ny);
   check("nz", g.nz);
   if (h5::read_double_attribute(file, "cell_size") != g.h)
-    throw InputError(fmt::format("{}: cell size differs from continuum.cell_size = {}", restart_source(path), g.h));
+    throw InputError(fmt::format("{}: checkpoint has cell size {}, the configuration needs continuum.cell_size = {}",
+                                 restart_source(path), h5::read_double_attribute(file, "cell_size"), g.h));
   const double time = h5::read_double_attribute(file, "time");
   if (!std::isfinite(time))
     throw InputError(fmt::format("attribute 'time' = {}; allowed: a finite time", time));
@@ -134,12 +135,43 @@ SchedulePosition read_checkpoint(const std::filesystem::path& path, TimeIntegrat
   return position;
 }
 
+namespace {
+
+/// A 1D column's checkpoint continued as a 3D box of the same cell size and ceiling: every
+/// column of the box takes the checkpoint's column (a horizontally uniform state).
+void load_extruded(hid_t file, const std::filesystem::path& path, const Grid& box, State& state,
+                   RunScalars& scalars) {
+  const Grid column = make_grid(1, 1.0, box.height(), box.h);
+  const auto found = h5::read_integer_attribute(file, "nz");
+  if (found != column.nz)
+    throw InputError(fmt::format(
+        "{}: the 1D column checkpoint has nz = {} cells, the 3D box nz = {} (continuum.ceiling / "
+        "continuum.cell_size); allowed: a column of the box's height and cell size",
+        restart_source(path), found, column.nz));
+  State profile;
+  profile.resize(column.size());
+  load_checked(file, path, column, profile, scalars);
+  for (int v = 0; v < variable_count; ++v)
+    for (int k = 0; k < box.nz; ++k)
+      for (int j = 0; j < box.ny; ++j)
+        for (int i = 0; i < box.nx; ++i) state.q[v][box.index(i, j, k)] = profile.q[v][column.index(0, 0, k)];
+}
+
+bool column_into_box(hid_t file, const Grid& grid) {
+  return grid.dimension == 3 && h5::read_integer_attribute(file, "dimension") == 1;
+}
+
+}  // namespace
+
 SchedulePosition read_checkpoint(const std::filesystem::path& path, const Grid& grid, State& state,
                                  RunScalars& scalars) {
   const h5::Handle file = open_checkpoint(path, checkpoint_kind);
   try {
     const SchedulePosition position = read_schedule_position(file.id());
-    load_checked(file.id(), path, grid, state, scalars);
+    if (column_into_box(file.id(), grid))
+      load_extruded(file.id(), path, grid, state, scalars);
+    else
+      load_checked(file.id(), path, grid, state, scalars);
     return position;
   } catch (const std::exception& error) {
     const std::string what = error.what();

@@ -23,6 +23,9 @@ inline void write_checkpoint(const std::filesystem::path& path, const TimeIntegr
 /// Loads a checkpoint into the solver and returns its schedule position; throws InputError
 /// naming run.restart_from ("not a valid checkpoint: ...") if it is not a continuum checkpoint,
 /// does not match the grid or holds a damaged value (the solver is then left unchanged).
+/// A 1D column's checkpoint also starts a 3D box of the same cell size and ceiling, every
+/// column of the box taking the checkpoint's: the box begins in the column's (periodic) state
+/// instead of at rest, without the 3D cost of the transient.
 SchedulePosition read_checkpoint(const std::filesystem::path& path, TimeIntegrator& solver);
 /// The same into a state of `grid` (interior cells) and `scalars`: what the root of a
 /// decomposed run reads before scattering it.

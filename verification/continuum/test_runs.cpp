@@ -109,6 +109,82 @@ TEST(Restart, ContinuesIdentically) {
   EXPECT_EQ(straight.time(), second.time());
 }
 
+// A 1D column's checkpoint starts a 3D box: each column of the box takes the checkpoint's, the
+// time, e, counters and the budget (per unit area) carry over, and at a common fixed step the
+// box then stays the column continued, to the bit (as Uniform3D above).
+TEST(Restart, ColumnCheckpointStartsTheBoxInTheColumnState) {
+  const auto dir = test_directory();
+  config::Config c = base_config(dir);
+  c.set("continuum.cell_size=0.5");
+  c.set("continuum.ceiling=20");
+  c.set("continuum.perturbation=0");
+  ContinuumCase one = continuum_case(c);
+  c.set("continuum.dimension=3");
+  c.set("continuum.box_width=2");
+  ContinuumCase three = continuum_case(c);
+  one.integration.fixed_dt = three.integration.fixed_dt = 2e-4;
+  const double period = one.parameters.shaker.period();
+  TimeIntegrator column = make_solver(one);
+  column.advance_to(0.3 * period);
+  write_checkpoint(dir / "column.h5", column, SchedulePosition{}, c.to_toml());
+  TimeIntegrator box = make_solver(three);
+  read_checkpoint(dir / "column.h5", box);
+  EXPECT_EQ(box.time(), column.time());
+  EXPECT_EQ(box.counters().steps, column.counters().steps);
+  EXPECT_EQ(box.budget().collisional_loss, column.budget().collisional_loss);
+  const auto worst_difference = [&] {
+    double worst = 0.0;
+    for (int v = 0; v < variable_count; ++v)
+      for (int k = 0; k < three.grid.nz; ++k)
+        for (int j = 0; j < three.grid.ny; ++j)
+          for (int i = 0; i < three.grid.nx; ++i)
+            worst = std::max(worst, std::abs(box.state().q[v][three.grid.index(i, j, k)] -
+                                             column.state().q[v][one.grid.index(0, 0, k)]));
+    return worst;
+  };
+  EXPECT_EQ(worst_difference(), 0.0);
+  column.advance_to(0.4 * period);
+  box.advance_to(0.4 * period);
+  std::printf("box - column after 0.1 cycle from the column's checkpoint: %.3e (%lld steps)\n",
+              worst_difference(), static_cast<long long>(box.counters().steps));
+  EXPECT_EQ(worst_difference(), 0.0);
+  // The box sums its cells in another order: the budget agrees to round-off.
+  EXPECT_NEAR(box.budget().body_work, column.budget().body_work, 1e-13 * std::abs(column.budget().body_work));
+}
+
+// A column continues only a box of its own cell size and height; anything else is refused
+// before the box is touched, naming the mismatch.
+TEST(Restart, ColumnCheckpointOfAnotherGridIsRefused) {
+  const auto dir = test_directory();
+  config::Config c = base_config(dir);
+  c.set("continuum.cell_size=0.5");
+  c.set("continuum.ceiling=20");
+  c.set("layer.particles=1000");  // a layer low enough for the box of ceiling 10
+  TimeIntegrator column = make_solver(continuum_case(c));
+  write_checkpoint(dir / "column.h5", column, SchedulePosition{}, c.to_toml());
+  c.set("continuum.dimension=3");
+  c.set("continuum.box_width=2");
+  const auto message = [&](const std::vector<std::string>& settings) {
+    config::Config box_config = c;
+    for (const auto& setting : settings) box_config.set(setting);
+    TimeIntegrator box = make_solver(continuum_case(box_config));
+    try {
+      read_checkpoint(dir / "column.h5", box);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  const std::string taller = message({"continuum.ceiling=25"});
+  EXPECT_NE(taller.find("nz = 40 cells, the 3D box nz = 50"), std::string::npos) << taller;
+  EXPECT_NE(taller.find("run.restart_from"), std::string::npos) << taller;
+  const std::string finer = message({"continuum.cell_size=0.25"});
+  EXPECT_NE(finer.find("nz = 40 cells, the 3D box nz = 80"), std::string::npos) << finer;
+  const std::string finer_same_cells = message({"continuum.cell_size=0.25", "continuum.ceiling=10"});
+  EXPECT_NE(finer_same_cells.find("cell size 0.5, the configuration needs continuum.cell_size = 0.25"),
+            std::string::npos) << finer_same_cells;
+}
+
 TEST(Restart, ThroughTheProgramGivesTheSameProfiles) {
   const auto dir = test_directory();
   config::Config c = base_config(dir);

@@ -19,6 +19,10 @@
       A checkpoint written on 2 ranks after 1 of 2 cycles, continued on 1 and on 4 ranks: the
       final checkpoint and the time-series rows after the restart equal the straight run's
       (without a launcher) bit for bit; the budget within 1e-12 of its scale.
+  check_continuum_ranks.py SHAKER column [--mpirun CMD]
+      A 1D column's checkpoint (one cycle) starts the 3D box, which continues it for a second
+      cycle: the same run file and fields file on 2 and 4 ranks as without a launcher, bit for
+      bit but the budget, and the box stays horizontally uniform (u_x = u_y = 0 in every field).
   check_continuum_ranks.py SHAKER failure [--mpirun CMD]
       A step that fails (unlimited slopes at Courant number 1) on 2 and 4 ranks: exit 1 with the
       plain run's message (the same first failing cell, in box coordinates) and its last good
@@ -252,6 +256,24 @@ def check_restart(shaker, work, launcher):
     return failures
 
 
+def check_column_start(shaker, work, launcher):
+    shaker_run(shaker, "case.toml", "column.h5", work,
+               settings=["continuum.dimension=1", "continuum.field_phases=[]",
+                         "run.checkpoint=column.ckpt.h5"])
+    continued = ["run.restart_from=column.ckpt.h5", "run.sampled_cycles=2"]
+    failures = compare_rank_counts(shaker, work, launcher, [2, 4], True, continued)
+    with h5py.File(os.path.join(work, "plain.fields.h5"), "r") as f:
+        snapshots = [name for name in f if name.startswith("snapshot_")]
+        horizontal = max(largest(np.asarray(f[f"{s}/{c}"][()])) for s in snapshots
+                         for c in ("ux", "uy"))
+    print(f"box from the column: {len(snapshots)} field snapshots, largest |u_x|, |u_y| "
+          f"{horizontal:.3e}")
+    if not snapshots or horizontal != 0.0:
+        failures.append(f"box from the column: {len(snapshots)} snapshots, largest horizontal "
+                        f"velocity {horizontal} (expected 0: a horizontally uniform start)")
+    return failures
+
+
 def check_failure(shaker, work, launcher):
     failures = []
     unstable = ["continuum.limiter=none", "continuum.cfl=1.0"]
@@ -300,8 +322,8 @@ def check_refused(shaker, work, launcher):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
-    parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "failure",
-                                          "refused"])
+    parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "column",
+                                          "failure", "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -316,6 +338,8 @@ def main():
                                        ["continuum.box_width=8", "continuum.ceiling=20"], 2)
     elif args.check == "restart":
         failures = check_restart(args.shaker, work, args.mpirun)
+    elif args.check == "column":
+        failures = check_column_start(args.shaker, work, args.mpirun)
     elif args.check == "failure":
         failures = check_failure(args.shaker, work, args.mpirun)
     else:
