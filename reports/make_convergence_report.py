@@ -28,7 +28,8 @@ allowed); names contain no commas.
       quantities as fractions) and the asymptotic-range ratio GCI32 / (r21^p GCI21); the judge
       (GciRow::pass) passes it when |ratio - 1| <= asymptotic_tolerance. A two-grid row
       (convergence "two-grids"; h3, phi3, gci32, ratio and pass nan; assumed order, Fs = 3) is
-      shown as "not checked" and is not counted as a check.
+      shown as "not checked" and is not counted as a check. Each study gets a figure below
+      the table: phi against h per quantity, with phi_extrapolated and the GCI21 band.
   *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,
                       standard_error
       MD sampling convergence (verification/sampling/md_sampling.hpp): the standard error
@@ -334,6 +335,61 @@ def plot_study(study, series, design_orders, out_dir):
     return finished_plot(fig, out_dir, f"convergence-{safe_name(study)}.png")
 
 
+def label_log_ticks(ax, values):
+    """Ticks a log x axis at exactly `values`, without minor-tick labels."""
+    ticks = sorted(set(values))
+    ax.set_xticks(ticks)
+    ax.set_xticklabels([f"{v:g}" for v in ticks])
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
+GCI_PANEL_COLUMNS = 4
+
+
+def gci_order_text(r):
+    assumed = " (assumed)" if r["convergence"] == "two-grids" else ""
+    return f"p = {rc.fmt(r['order'], 3)}{assumed}"
+
+
+def gci_panel(ax, r, h_label):
+    """One GCI row: phi on its grids against h, phi_extrapolated and phi1 ± |phi1| GCI21."""
+    grids = [(r[f"h{i}"], r[f"phi{i}"]) for i in (1, 2, 3)
+             if math.isfinite(r[f"h{i}"]) and math.isfinite(r[f"phi{i}"])]
+    if grids:
+        h, phi = zip(*grids)
+        ax.plot(h, phi, "o-", ms=4, lw=1, label="phi")
+        ax.set_xscale("log")
+        label_log_ticks(ax, h)
+    if math.isfinite(r["phi_extrapolated"]):
+        ax.axhline(r["phi_extrapolated"], color="k", ls="--", lw=1, label="extrapolated")
+    band = abs(r["phi1"]) * r["gci21"]
+    if math.isfinite(band):
+        ax.axhspan(r["phi1"] - band, r["phi1"] + band, color="C1", alpha=0.25, label="GCI21")
+    ax.set_title(f"{r['quantity']}: {gci_order_text(r)}", fontsize=8)
+    ax.set_xlabel(h_label, fontsize=8)
+    ax.set_ylabel(rc.with_units("phi", units_of(r["quantity"])), fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.ticklabel_format(axis="y", useOffset=False)
+    ax.grid(True, which="both", alpha=0.3)
+
+
+def plot_gci_study(study, rows, out_dir):
+    """One panel per GCI row of `study`, at most GCI_PANEL_COLUMNS to a line."""
+    columns = min(GCI_PANEL_COLUMNS, len(rows))
+    lines = -(-len(rows) // columns)
+    fig, axes = plt.subplots(lines, columns, figsize=(3.3 * columns, 2.9 * lines),
+                             squeeze=False)
+    h_label = "step scale" if study.startswith("real-time-") else "cell size h"
+    for ax, r in zip(axes.flat, rows):
+        gci_panel(ax, r, h_label)
+    for ax in axes.flat[len(rows):]:
+        ax.set_visible(False)
+    axes.flat[0].legend(fontsize=6)
+    fig.suptitle(f"{study}: quantities of interest against the {h_label}", fontsize=10)
+    # "-gci": a study may also have an error table, whose plot takes the plain name.
+    return finished_plot(fig, out_dir, f"convergence-{safe_name(study)}-gci.png")
+
+
 def phase_text(phase):
     return "all" if math.isnan(phase) else rc.fmt(phase, 3)
 
@@ -359,10 +415,7 @@ def plot_sampling(study, rows, out_dir):
     if k_all:
         ks = np.array([min(k_all), max(k_all)], dtype=float)  # reference line over the K range
         ax.loglog(ks, (ks / ks[0]) ** -0.5, "k--", lw=1.5, label="K^-1/2")
-        ticks = sorted(set(k_all))
-        ax.set_xticks(ticks)
-        ax.set_xticklabels([f"{k:g}" for k in ticks])
-    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        label_log_ticks(ax, k_all)
     ax.set_xlabel("sampled cycles K (effective)")
     ax.set_ylabel("se / se(smallest K)")
     ax.set_title(f"{study}: standard error against K")
@@ -463,17 +516,23 @@ def order_section(data, failures):
     return ["## Observed orders against the design order", ""] + table, checks
 
 
-def gci_section(data, failures):
-    """The GCI of the quantities of interest; returns (lines, checks)."""
+def gci_section(data, out_dir, failures):
+    """The GCI of the quantities of interest, then a figure per study; returns (lines, checks)."""
     rows = sorted(data["gci"], key=lambda r: (r["study"], r["quantity"]))
     table, checks = judged_table(
         "| study | quantity | units | phi1 (fine) | phi2 | phi3 | p [1] | phi extrapolated | "
         "e21 [%] | GCI21 [%] | GCI32 [%] | ratio [1] | convergence | result |", rows, gci_line,
         gci_failure, failures, "no GCI studies found")
+    plots = []
+    for study in dict.fromkeys(r["study"] for r in rows):
+        name = plot_gci_study(study, [r for r in rows if r["study"] == study], out_dir)
+        plots += [f"![{study}]({name})", ""]
     return ["## Grid convergence index of the quantities of interest", "",
             "GCI in percent of the fine-grid value (Fs = 1.25); asymptotic ratio = "
             "GCI32 / (r21^p GCI21), close to 1 in the asymptotic range; phi in the units "
-            "of its row.", ""] + table, checks
+            "of its row. The figures: phi against h (the step scale of a time-step study), "
+            "dashed the extrapolated value, shaded the band phi1 ± |phi1| GCI21.",
+            ""] + table + plots, checks
 
 
 def sampling_section(data, out_dir, failures):
@@ -596,7 +655,7 @@ def main(argv=None):
 
     failures = []
     order_lines, order_checks = order_section(data, failures)
-    gci_lines, gci_checks = gci_section(data, failures)
+    gci_lines, gci_checks = gci_section(data, out_dir, failures)
     sampling_lines, sampling_checks = sampling_section(data, out_dir, failures)
 
     series = series_of(data["errors"])

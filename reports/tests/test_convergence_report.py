@@ -7,7 +7,8 @@ their pass/fail marks, the failure summary with measured values, the units of ev
 without declared units is refused), the PNG plot, --strict, and bad input; and the MD sampling
 section (slope fits against K^-1/2, the se table, its plot, the
 bin-size checks) on a synthetic sampling study; and the term-share tables of the
-manufactured sources.
+manufactured sources; and the GCI figures (one per study, linked below the GCI table, removed
+with their study).
 
 The report is tested against the one judge, the `pass` column the C++ side writes: for every
 row of every table it reads (the synthetic ones and the repository's convergence-tables/), the
@@ -33,6 +34,9 @@ SCRIPT = os.path.abspath(make_convergence_report.__file__)
 REPORTS = os.path.dirname(SCRIPT)
 ORDERS_HEADER = ("study,field,norm,fit_points,fitted_order,order_std_error,pair_order_finest,"
                  "pair_order_next,design_order,tolerance,pass")
+GCI_HEADER = ("study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,"
+              "relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,"
+              "convergence,asymptotic_tolerance,pass")
 
 
 def write(path, header, rows):
@@ -65,14 +69,11 @@ def synthetic_study(directory):
     write(os.path.join(directory, "synthetic.errors.csv"), "study,field,norm,level,h,error", errors)
     write(os.path.join(directory, "synthetic.orders.csv"), ORDERS_HEADER, orders)
     phi = [2.0 + 0.3 * x * x for x in (0.025, 0.05, 0.1)]
-    gci_header = ("study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,"
-                  "relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,"
-                  "convergence,asymptotic_tolerance,pass")
     e21 = abs(phi[0] - phi[1]) / phi[0]
     gci21 = 1.25 * e21 / 3.0
     gci32 = 1.25 * abs(phi[1] - phi[2]) / phi[1] / 3.0
     ratio = gci32 / (4.0 * gci21)
-    write(os.path.join(directory, "qoi.gci.csv"), gci_header, [
+    write(os.path.join(directory, "qoi.gci.csv"), GCI_HEADER, [
         ("base-1d", "shock_location", 0.025, 0.05, 0.1, *phi, 2.0, 2.0, e21, 0.0, gci21, gci32,
          ratio, "monotonic", 0.1, 1),
         ("base-1d", "max_mach", 0.025, 0.05, 0.1, 3.1, 3.0, 3.3, 1.5, 3.2, 0.032, 0.03, 0.05,
@@ -111,6 +112,11 @@ def synthetic_sampling_study(directory):
               (study, "uz", 0.22, "nan", "nan", "fraction of layer bins within 2 combined se", 0.8,
                "at_least", 0.9, 0),
               (study, "shock_location", 0.22, 17.0, 17.5, "shift", 0.5, "at_most", 1.1, 1)])
+
+
+def is_png(path, min_size=5000):
+    return (os.path.exists(path) and open(path, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+            and os.path.getsize(path) > min_size)
 
 
 def run(*args):
@@ -318,8 +324,7 @@ def test_report_on_a_synthetic_study(work_dir):
         "GCI row of max_mach lacks its units 1"
 
     png = os.path.join(out_dir, "convergence-synthetic-1d-space.png")
-    assert (os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
-            and os.path.getsize(png) > 5000), "PNG plot missing or not a PNG"
+    assert is_png(png), "PNG plot missing or not a PNG"
     assert "![synthetic-1d-space](convergence-synthetic-1d-space.png)" in text, "plot not linked"
     leftovers = [f for f in os.listdir(out_dir) if f.startswith((".partial", ".old"))]
     assert not leftovers, f"temporary files left: {leftovers}"
@@ -454,8 +459,7 @@ def test_md_sampling_section(work_dir):
                       "17.5 | shift | sigma | 0.5 |")
     assert shock.endswith("| PASS |") and "<= 1.1" in shock, f"bin-size shock row wrong: '{shock}'"
     png = os.path.join(work, "sampling-out", "sampling-synthetic-md-sampling.png")
-    assert (os.path.exists(png) and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
-            and os.path.getsize(png) > 5000), "sampling PNG missing or not a PNG"
+    assert is_png(png), "sampling PNG missing or not a PNG"
     assert "(sampling-synthetic-md-sampling.png)" in text, "sampling plot not linked"
 
 
@@ -497,3 +501,36 @@ def test_term_shares_section(work_dir):
     result = run("--input", inputs, "--output", report, "--commit", "abc")
     assert result.returncode == 2 and "share = 'lots' is not a number" in result.stderr, \
         f"a malformed share must be refused with exit 2: {result.returncode} {result.stderr}"
+
+
+def test_gci_plots(work_dir):
+    """A figure per GCI study (three grids, or two), linked below the GCI table; the figure of
+    a study no longer in the input goes with it."""
+    inputs = os.path.join(work_dir, "gci-input")
+    os.makedirs(inputs)
+    three_grids = ("real-time-s2", "center_of_mass_ft0.25", 0.25, 0.5, 1, 17.682, 17.6827,
+                   17.6834, 1.05, 17.6813, 4e-5, 4e-5, 5e-5, 1e-4, 1.0, "monotonic", 0.1, 1)
+    stagnant = ("real-time-s2", "shock_width_ft0.22", 0.25, 0.5, 1, 3.6, 3.6, 3.6, "nan",
+                "nan", 0, "nan", "nan", "nan", "nan", "stagnant", 0.1, 0)
+    two_grids = ("real-3d", "max_mach", 0.5, 1.0, "nan", 11.17, 11.68, "nan", 2.0, 11.0, 0.046,
+                 0.015, 0.06, "nan", "nan", "two-grids", "nan", "nan")
+    table = os.path.join(inputs, "studies.gci.csv")
+    write(table, GCI_HEADER, [three_grids, stagnant, two_grids])
+    report = os.path.join(work_dir, "gci-out", "convergence.md")
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 0, f"exit {result.returncode}: {result.stderr}"
+    text = open(report).read()
+    gci_part = text.split("## Grid convergence index of the quantities of interest")[-1]
+    for study in ("real-time-s2", "real-3d"):
+        png = os.path.join(work_dir, "gci-out", f"convergence-{study}-gci.png")
+        assert is_png(png), f"GCI figure of {study} missing or not a PNG"
+        assert f"![{study}](convergence-{study}-gci.png)" in gci_part.split("\n## ")[0], \
+            f"GCI figure of {study} not linked below the GCI table"
+
+    write(table, GCI_HEADER, [three_grids, stagnant])
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 0, f"second run: exit {result.returncode}: {result.stderr}"
+    assert not os.path.exists(os.path.join(work_dir, "gci-out", "convergence-real-3d-gci.png")), \
+        "the GCI figure of a study no longer in the input survived"
+    assert is_png(os.path.join(work_dir, "gci-out", "convergence-real-time-s2-gci.png")), \
+        "the second run removed the GCI figure of a study still in the input"
