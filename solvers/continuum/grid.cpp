@@ -22,17 +22,17 @@ int cells_fitting(double length, double h, const char* key) {
 }
 }  // namespace
 
-Grid make_grid(int dimension, double width, double height, double h) {
+Grid make_grid(int dimension, double width, double height, double h, int processes) {
   if (dimension != 1 && dimension != 3)
     throw InputError(fmt::format("continuum.dimension = {}: allowed values are 1 and 3", dimension));
-  // The memory first (the cell counts in double: a huge grid overflows an int): about
-  // bytes_per_cell per cell, the 3D solver's measured 579 B (reports/benchmarks.md) rounded up.
-  constexpr double bytes_per_cell = 600.0;
+  // A grid that cannot fit even when split evenly over the processes is refused before its
+  // cell counts (ints) are formed; the run checks its exact need per machine later.
   const double cells = (height / h) * (dimension == 3 ? (width / h) * (width / h) : 1.0);
-  check_memory(cells * bytes_per_cell,
+  check_memory(cells * solver_bytes_per_cell / processes,
                fmt::format("a {}D grid of {:.3g} cells (continuum.cell_size = {}, continuum.ceiling "
-                           "= {}{})", dimension, cells, h, height,
-                           dimension == 3 ? fmt::format(", continuum.box_width = {}", width) : ""),
+                           "= {}{}){}", dimension, cells, h, height,
+                           dimension == 3 ? fmt::format(", continuum.box_width = {}", width) : "",
+                           processes > 1 ? fmt::format(", split evenly over {} processes,", processes) : ""),
                "allowed: a larger continuum.cell_size or a smaller box");
   Grid g;
   g.dimension = dimension;

@@ -48,8 +48,14 @@ struct Grid {
   bool threaded() const { return dimension == 3 && interior_cells() > 4096; }
 };
 
+/// The solver's working set per interior cell: the 3D solver's measured 579 B
+/// (reports/benchmarks.md) rounded up. A run checks its memory before it allocates
+/// (run_continuum.cpp), per machine when decomposed.
+inline constexpr double solver_bytes_per_cell = 600.0;
+
 /// A grid of cell size h over [0, width]^2 x [0, height]; throws InputError naming the key
-/// when the cell size does not divide the box.
-Grid make_grid(int dimension, double width, double height, double h);
+/// when the cell size does not divide the box, or when the grid split evenly over `processes`
+/// would not fit the available memory.
+Grid make_grid(int dimension, double width, double height, double h, int processes = 1);
 
 }  // namespace shaker::continuum

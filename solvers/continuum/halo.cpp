@@ -157,6 +157,17 @@ void Halo::sum(std::vector<double>& values) const {
                 cartesian_);
 }
 
+std::pair<double, int> Halo::sum_on_machine(double local) const {
+  MPI_Comm machine = MPI_COMM_NULL;
+  MPI_Comm_split_type(cartesian_, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &machine);
+  double total = 0.0;
+  int ranks = 0;
+  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, machine);
+  MPI_Comm_size(machine, &ranks);
+  MPI_Comm_free(&machine);
+  return {total, ranks};
+}
+
 void Halo::broadcast(std::vector<double>& values) const {
   MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_DOUBLE, 0, cartesian_);
 }

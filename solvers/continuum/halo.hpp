@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "continuum/grid.hpp"
@@ -56,6 +57,9 @@ class Halo {
   double max(double local) const;
   /// Element-wise sum over the ranks, in place.
   void sum(std::vector<double>& values) const;
+  /// The sum of `local` over the ranks on this rank's machine (those sharing its memory), and
+  /// their number.
+  std::pair<double, int> sum_on_machine(double local) const;
   /// Every rank's `failure` (empty: none); returns true if none failed, else false on every
   /// rank with `failure` set to the message of the lowest failing rank.
   bool agree(std::string& failure) const;

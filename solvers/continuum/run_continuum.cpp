@@ -18,9 +18,12 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
+#include "common/memory.hpp"
 #include "common/progress.hpp"
 #include "common/ranks.hpp"
 #include "common/run_file.hpp"
@@ -267,6 +270,38 @@ std::shared_ptr<const Halo> decomposition(const Grid& grid) {
   return nullptr;
 }
 
+/// The run's memory on this machine, checked before anything is allocated (InputError on every
+/// rank alike). Each process holds the solver's working set of its cells (its block under a
+/// launcher); the writer also the field snapshots and, decomposed, the gathered box. The ranks
+/// sharing a machine share its MemAvailable, so their needs add up.
+void check_memory_of_run(const ContinuumCase& c, const Halo* halo) {
+  const Grid& g = c.grid;
+  const double box_cells = static_cast<double>(g.nx) * g.ny * g.nz;
+  const double own_cells = halo ? static_cast<double>(halo->block().nx) * halo->block().ny * g.nz : box_cells;
+  constexpr double stored_bytes_per_cell = variable_count * sizeof(double);
+  const double copies = (halo ? 1.0 : 0.0) + static_cast<double>(c.field_phases.size());
+  const bool writer = !halo || halo->root();
+  const double mine = own_cells * solver_bytes_per_cell + (writer ? copies * box_cells * stored_bytes_per_cell : 0.0);
+  const auto [machine, ranks_here] = halo ? halo->sum_on_machine(mine) : std::pair<double, int>{mine, 1};
+  const std::string grid = fmt::format(
+      "a {}D grid of {:.3g} cells (continuum.cell_size = {}, continuum.ceiling = {}{})", g.dimension,
+      box_cells, g.h, g.height(), g.dimension == 3 ? fmt::format(", continuum.box_width = {}", g.nx * g.h) : "");
+  std::string failure;
+  try {
+    if (halo)
+      check_memory(machine, fmt::format("{} over {} ranks, {} of them on this machine (this rank's block: {:.3g} "
+                                        "cells; the root also holds a copy of the box)",
+                                        grid, halo->size(), ranks_here, own_cells),
+                   "allowed: a larger continuum.cell_size, a smaller box, or fewer ranks per machine "
+                   "(more machines)");
+    else
+      check_memory(machine, grid, "allowed: a larger continuum.cell_size or a smaller box");
+  } catch (const InputError& error) {
+    failure = error.what();
+  }
+  if (halo ? !halo->agree(failure) : !failure.empty()) throw InputError(failure);
+}
+
 /// A checkpoint read by the root and scattered to the ranks of a decomposed run: the same
 /// checkpoint continues on any number of ranks. Every rank fails alike on a bad checkpoint.
 SchedulePosition read_decomposed_checkpoint(const std::filesystem::path& path, const Halo& halo,
@@ -327,6 +362,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   const CheckpointSettings checkpoints = CheckpointSettings::from(config);
   check_outputs(c, checkpoints, inputs);
   const std::shared_ptr<const Halo> halo = decomposition(c.grid);
+  check_memory_of_run(c, halo.get());
   const RunProtocol& run = c.parameters.run;
   const ShakerKinematics& shaker = c.parameters.shaker;
   TimeIntegrator solver = make_solver(c, halo);

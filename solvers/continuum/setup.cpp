@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/errors.hpp"
+#include "common/ranks.hpp"
 #include "continuum/halo.hpp"
 
 namespace shaker::continuum {
@@ -59,7 +60,7 @@ ContinuumCase continuum_case(const config::Config& config) {
   c.parameters = CaseParameters::from(config);
   c.grid = make_grid(static_cast<int>(config.integer("continuum.dimension")),
                      config.real("continuum.box_width"), config.real("continuum.ceiling"),
-                     config.real("continuum.cell_size"));
+                     config.real("continuum.cell_size"), launched_by_mpi() ? Ranks::world().size() : 1);
   PhysicsSettings& p = c.physics;
   p.eos = EquationOfState::granular;
   p.e = c.parameters.restitution.e;

@@ -28,8 +28,10 @@
       plain run's message (the same first failing cell, in box coordinates) and its last good
       state, bit for bit but the budget.
   check_continuum_ranks.py SHAKER refused [--mpirun CMD]
-      A 1D column on 2 ranks, and an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x),
-      exit 2 with a message naming the sizes and the allowed range, writing nothing.
+      A 1D column on 2 ranks, an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x), and a
+      box too large for the machine's memory on 2 ranks (their blocks' needs added up, as both
+      share the machine), exit 2 with a message naming the sizes and the allowed range,
+      writing nothing.
 
 The budget's accumulators are sums, over steps, of the ranks' shares of the energy sources;
 on P ranks they are added in another order than on one, so they agree to rounding relative to
@@ -299,13 +301,27 @@ def check_failure(shaker, work, launcher):
     return failures
 
 
+def width_filling(share):
+    """A box width (cell 0.5, ceiling 10: 20 cells high) whose solver working set, 600 bytes
+    a cell, is `share` of this machine's MemAvailable: at 1.5 each of 2 ranks' halves fits,
+    their sum does not."""
+    with open("/proc/meminfo") as meminfo:
+        available = next(int(line.split()[1]) * 1024 for line in meminfo
+                         if line.startswith("MemAvailable:"))
+    return int((share * available / (600 * 20 * 4)) ** 0.5)
+
+
 def check_refused(shaker, work, launcher):
     failures = []
     for label, ranks, settings, needles in (
             ("1D column on 2 ranks", 2, ["continuum.dimension=1", "continuum.field_phases=[]"],
              ["continuum.dimension = 1", "one rank"]),
             ("8 x 8 box on 3 ranks", 3, [],
-             ["8 x 8 cells", "3 x 1 ranks", "at least 3 cells per rank", "at most 2 ranks in x"])):
+             ["8 x 8 cells", "3 x 1 ranks", "at least 3 cells per rank", "at most 2 ranks in x"]),
+            ("box too large for this machine on 2 ranks", 2,
+             [f"continuum.box_width={width_filling(1.5)}", "continuum.field_phases=[]"],
+             ["over 2 ranks, 2 of them on this machine", "MemAvailable",
+              "fewer ranks per machine"])):
         result = run(mpirun_prefix(launcher, ranks) + [shaker, "continuum", "case.toml", "--set",
                                                        "run.output=refused.h5", "--quiet"]
                      + [w for s in settings for w in ("--set", s)], work, expect=2)
