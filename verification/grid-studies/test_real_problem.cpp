@@ -257,8 +257,9 @@ INSTANTIATE_TEST_SUITE_P(
 // cells: while the flow stays horizontally uniform the two codes differ only in the time step
 // of the box's cycle (the 3D step is a third of the column's), so 3D minus 1D at equal cell
 // size is the part of the difference that is not grid error; it is written as the table
-// real-3d-minus-1d. The check that can fail: the 3D fine-grid value lies within the 3D GCI plus
-// the grid uncertainty of the 1D column's finest value (triple 0.05-0.2) of the 1D column's value.
+// real-3d-minus-1d. The checks that can fail: the 3D fine-grid value lies within the 3D GCI plus
+// the grid uncertainty of the 1D column's finest value (triple 0.05-0.2) of the 1D column's
+// value; and 3D minus 1D at cell 0.25 lies within the 3D grid uncertainty.
 TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
   const auto dir = test_directory("real-problem-3d");
   const std::vector<double> cells_3d{1.0, 0.5, 0.25};
@@ -270,7 +271,8 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
   std::vector<Quantities> values_1d;
   for (double h : cells_1d) values_1d.push_back(run_base_case(dir, "1d", h));
   const auto rows_1d = three_grid_rows("real-1d-base-fine", cells_1d, values_1d, 3, false);
-  const auto rows = three_grid_rows("real-3d-base", cells_3d, values_3d, 2, false);
+  // The coarsest box (cell 1.0) may not resolve the fitted front: that quantity has no row.
+  const auto rows = three_grid_rows("real-3d-base", cells_3d, values_3d, 2, false, true);
 
   conv::ErrorTable differences;
   for (std::size_t level = 0; level < cells_3d.size(); ++level)
@@ -290,6 +292,13 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
                 row_1d->phi1, grid_uncertainty(*row_1d), difference, allowed);
     EXPECT_LE(difference, allowed) << row.quantity << ": 3D (cell 0.25) " << row.phi1
                                    << ", 1D (cell 0.05) " << row_1d->phi1;
+    // The 3D effect itself: the box against the column at the same cell, within the box's grid
+    // uncertainty (beyond it, the box would be a different flow, not a finer or coarser one).
+    const double same_cell = std::abs(row.phi1 - values_1d_same_cells.back().at(row.quantity));
+    std::printf("3D %-26s h 0.25: 3D - 1D at the same cell %.3e, 1D(0.25) - 1D(0.05) %.3e\n",
+                row.quantity.c_str(), same_cell,
+                std::abs(values_1d_same_cells.back().at(row.quantity) - row_1d->phi1));
+    EXPECT_LE(same_cell, grid_uncertainty(row)) << row.quantity << ": 3D - 1D at cell 0.25";
   }
   EXPECT_FALSE(conv::write_study(dir, "real-3d-base", conv::ErrorTable{}, {}, rows).empty());
   EXPECT_FALSE(conv::write_study(dir, "real-3d-minus-1d", differences, {}).empty());
@@ -300,7 +309,8 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
 // continuum.diffusion_number together (the adaptive step is the smaller of the two limits, so
 // both scale it). Each quantity gets its observed temporal order and GCI over the steps
 // 1, 1/2, 1/4 of production, and the time error of the production step (|phi(1) - phi_ext|
-// where the three steps are in the asymptotic range, else the largest change seen) must lie
+// where the three steps converge monotonically in the asymptotic range, else the largest
+// change seen) must lie
 // below the grid uncertainty at the production cell (1D: the transport's reference triple
 // 0.4/0.2/0.1; 3D: the column's triple 1.0/0.5/0.25, its middle grid, the same flow while it
 // stays horizontally uniform, see BaseCase3DThreeGridsAgreeWithThe1DColumn). The integrators:
@@ -324,6 +334,13 @@ std::vector<std::string> integrator_settings(const TimeStepCase& c, double step_
 /// The same for the middle grid's value phi2: its GCI32 in the asymptotic range, else |phi2 - phi1|.
 double middle_grid_uncertainty(const conv::GciRow& row) {
   return row.pass() ? std::abs(row.phi2) * row.result.gci32 : std::abs(row.phi2 - row.phi1);
+}
+
+/// The smallest change a quantity can show at cell size h: the shock width d is a distance
+/// between cell centres, so it moves in whole cells (and three grids that agree on it give a
+/// grid error of 0, which says nothing about a change of one cell); the others are continuous.
+double resolution(const std::string& quantity, double h) {
+  return quantity == "shock_width_ft0.22" ? h : 0.0;
 }
 
 class TimeStepConvergence : public ::testing::TestWithParam<TimeStepCase> {};
@@ -360,18 +377,22 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
     const auto grid_row = std::find_if(grid_rows.begin(), grid_rows.end(),
                                        [&](const conv::GciRow& r) { return r.quantity == row.quantity; });
     const double production = row.phi3;  // the coarsest "grid": the production step
+    // Richardson extrapolation only for monotonic convergence: across an oscillation the fitted
+    // order means nothing (an order near 0 sends phi_ext anywhere), so the spread is the estimate.
+    const bool extrapolated = row.pass() && row.result.kind == conv::ConvergenceKind::monotonic;
     const double time_error =
-        row.pass() ? std::abs(production - row.result.phi_extrapolated)
-                   : std::max(std::abs(production - row.phi1), std::abs(production - row.phi2));
+        extrapolated ? std::abs(production - row.result.phi_extrapolated)
+                     : std::max(std::abs(production - row.phi1), std::abs(production - row.phi2));
     if (grid_row == grid_rows.end()) {
       std::printf("%-40s %-26s order %.2f  time error %.3e  no grid estimate at this cell\n",
                   label.c_str(), row.quantity.c_str(), row.result.order, time_error);
       continue;
     }
-    const double grid_error = box ? middle_grid_uncertainty(*grid_row) : grid_uncertainty(*grid_row);
+    const double grid_error = std::max(box ? middle_grid_uncertainty(*grid_row) : grid_uncertainty(*grid_row),
+                                       resolution(row.quantity, cell));
     std::printf("%-40s %-26s order %.2f  time error %.3e  grid error %.3e  ratio %.3f (%s)\n",
                 label.c_str(), row.quantity.c_str(), row.result.order, time_error, grid_error,
-                time_error / grid_error, row.pass() ? "extrapolated" : "largest change");
+                time_error / grid_error, extrapolated ? "extrapolated" : "largest change");
     // <=: a quantity that changes neither with the step nor with the grid (both 0) passes.
     EXPECT_LE(time_error, grid_error) << label << " " << row.quantity << ": time error "
                                       << time_error << ", grid error " << grid_error;
