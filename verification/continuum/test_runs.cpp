@@ -2,6 +2,7 @@
 // 1D run, restart continues identically, and the base-case smoke test (H = 9, e = 0.9, 1D).
 #include <cmath>
 #include <fstream>
+#include <utility>
 
 #include "analysis/analysis.hpp"
 #include "common/errors.hpp"
@@ -51,8 +52,9 @@ TEST(MassConservation, ThreeDimensionalToRoundOff) {
   EXPECT_LT(relative_mass_drift(c, 0.3), 1e-13);
 }
 
-TEST(Uniform3D, MatchesOneDimensionalRunToRoundOff) {
-  config::Config c = base_config(test_directory());
+/// One horizontally uniform case as a column (cell 0.5, ceiling 20) and as a 2 x 2 box of it,
+/// both at the same fixed step; `c` ends as the box's configuration.
+std::pair<ContinuumCase, ContinuumCase> column_and_box(config::Config& c) {
   c.set("continuum.cell_size=0.5");
   c.set("continuum.ceiling=20");
   c.set("continuum.perturbation=0");
@@ -61,6 +63,12 @@ TEST(Uniform3D, MatchesOneDimensionalRunToRoundOff) {
   c.set("continuum.box_width=2");
   ContinuumCase three = continuum_case(c);
   one.integration.fixed_dt = three.integration.fixed_dt = 2e-4;
+  return {one, three};
+}
+
+TEST(Uniform3D, MatchesOneDimensionalRunToRoundOff) {
+  config::Config c = base_config(test_directory());
+  const auto [one, three] = column_and_box(c);
   TimeIntegrator a = make_solver(one), b = make_solver(three);
   const double t_end = 0.1 * one.parameters.shaker.period();
   a.advance_to(t_end);
@@ -115,14 +123,7 @@ TEST(Restart, ContinuesIdentically) {
 TEST(Restart, ColumnCheckpointStartsTheBoxInTheColumnState) {
   const auto dir = test_directory();
   config::Config c = base_config(dir);
-  c.set("continuum.cell_size=0.5");
-  c.set("continuum.ceiling=20");
-  c.set("continuum.perturbation=0");
-  ContinuumCase one = continuum_case(c);
-  c.set("continuum.dimension=3");
-  c.set("continuum.box_width=2");
-  ContinuumCase three = continuum_case(c);
-  one.integration.fixed_dt = three.integration.fixed_dt = 2e-4;
+  const auto [one, three] = column_and_box(c);
   const double period = one.parameters.shaker.period();
   TimeIntegrator column = make_solver(one);
   column.advance_to(0.3 * period);
