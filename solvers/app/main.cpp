@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("analyze")) return command_analyze(analysis);
     if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
   } catch (const StopRequested& stop) {
-    fmt::print(stderr, "{}\n", stop.what());
+    if (*stop.what() != '\0') fmt::print(stderr, "{}\n", stop.what());
     return stop.exit_code();
   } catch (const InputError& error) {
     // Every rank reads the same input and fails alike, so none is left waiting.

@@ -122,18 +122,19 @@ void keep_as_previous(const std::filesystem::path& file) {
 }  // namespace
 
 CheckpointObserver::CheckpointObserver(const CheckpointSettings& settings, const PhaseSchedule& schedule,
-                                       CheckpointWriter write, std::string label)
+                                       CheckpointWriter write, std::string label, StopAcrossRanks ranks)
     : settings_(settings),
       schedule_(schedule),
       write_(std::move(write)),
       label_(std::move(label)),
+      ranks_(std::move(ranks)),
       next_(schedule.start()),
       deferred_(std::in_place) {}
 
 void CheckpointObserver::at_phase(const PhaseInstant& instant) {
   next_ = instant.phase + 1 < instant.phases ? schedule_.position(instant.cycle, instant.phase + 1)
                                              : schedule_.position(instant.cycle + 1, 0);
-  stop_if_asked(instant.t);
+  stop_if_asked(instant.t, ranks_.agree(DeferredStop::requested()));
 }
 
 void CheckpointObserver::at_cycle_end(const CycleEnd& end) {
@@ -142,22 +143,24 @@ void CheckpointObserver::at_cycle_end(const CycleEnd& end) {
 
 void CheckpointObserver::at_run_end(double t) {
   next_ = schedule_.position(schedule_.cycles(), 0);
-  if (!settings_.file.empty() && DeferredStop::requested() == 0) save(settings_.file);
-  stop_if_asked(t);
+  const int signal = ranks_.agree(DeferredStop::requested());
+  if (!settings_.file.empty() && signal == 0) save(settings_.file);
+  stop_if_asked(t, signal);
   // From here on the run writes its outputs: a signal removes them and exits at once.
   deferred_.reset();
 }
 
 void CheckpointObserver::save(const std::filesystem::path& path) const {
+  if (!ranks_.writer) return;
   keep_as_previous(path);
   write_(path, next_);
 }
 
-void CheckpointObserver::stop_if_asked(double t) const {
-  const int signal = DeferredStop::requested();
+void CheckpointObserver::stop_if_asked(double t, int signal) const {
   if (signal == 0) return;
   const std::filesystem::path path = settings_.stop_file();
   save(path);
+  if (!ranks_.writer) throw StopRequested(signal, "");  // the writer's message is the run's
   throw StopRequested(signal, fmt::format(
       "{}: stopped by signal {} ({}) at t = {:.10g}; checkpoint written to {} (it continues at "
       "stored phase {} of {} in cycle {}, counted from 0); continue the run with --set "

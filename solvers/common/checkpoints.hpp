@@ -71,12 +71,21 @@ class StopRequested : public std::runtime_error {
 /// Writes the solver's checkpoint of `position` to a file (atomically).
 using CheckpointWriter = std::function<void(const std::filesystem::path&, const SchedulePosition&)>;
 
+/// How the ranks of one decomposed run stop together. A launcher delivers a stop signal to its
+/// ranks at different steps (or to one rank only), so at each stored phase every rank takes the
+/// signal any rank received (`agree`: a reduction over the ranks, called by all alike), and
+/// all stop there; only the `writer` touches checkpoint files. One process: the defaults.
+struct StopAcrossRanks {
+  std::function<int(int)> agree = [](int signal) { return signal; };
+  bool writer = true;
+};
+
 class CheckpointObserver final : public RunObserver {
  public:
   /// `label` starts the stop message ("shaker md"). While the observer lives, SIGTERM and SIGINT
   /// are deferred to the next stored phase (DeferredStop).
   CheckpointObserver(const CheckpointSettings& settings, const PhaseSchedule& schedule,
-                     CheckpointWriter write, std::string label);
+                     CheckpointWriter write, std::string label, StopAcrossRanks ranks = {});
 
   void at_phase(const PhaseInstant& instant) override;
   void at_cycle_end(const CycleEnd& end) override;
@@ -86,13 +95,14 @@ class CheckpointObserver final : public RunObserver {
 
  private:
   void save(const std::filesystem::path& path) const;
-  /// Throws StopRequested after writing the checkpoint if a stop signal came in.
-  void stop_if_asked(double t) const;
+  /// Throws StopRequested after writing the checkpoint if `signal` (agreed) is not 0.
+  void stop_if_asked(double t, int signal) const;
 
   CheckpointSettings settings_;
   const PhaseSchedule& schedule_;
   CheckpointWriter write_;
   std::string label_;
+  StopAcrossRanks ranks_;
   SchedulePosition next_;
   std::optional<DeferredStop> deferred_;
 };

@@ -382,15 +382,16 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
                           [&] { return cells * static_cast<double>(solver.counters().steps); },
                           progress_of_rank);
   // The root writes every checkpoint, of the box gathered at the phase (the Box observer runs
-  // first); a decomposed run's other ranks take no part (so they hold stop signals back, and
-  // the root's checkpoint is the run's).
+  // first); the ranks of a decomposed run stop together at the phase after any of them got a
+  // stop signal.
   const auto write = [&](const std::filesystem::path& path, const SchedulePosition& position) {
     if (box.writer()) write_checkpoint(path, box.view(), position, configuration);
   };
-  CheckpointObserver checkpointing(checkpoints, schedule, write, "shaker continuum");
-  std::vector<RunObserver*> observers{&box, &recorder, &profiles, &progress};
-  if (!c.field_phases.empty()) observers.push_back(&fields);
-  if (box.writer()) observers.push_back(&checkpointing);
+  StopAcrossRanks stop_across_ranks{.writer = box.writer()};
+  if (halo) stop_across_ranks.agree = [&](int signal) { return static_cast<int>(halo->max(signal)); };
+  CheckpointObserver checkpointing(checkpoints, schedule, write, "shaker continuum", stop_across_ranks);
+  std::vector<RunObserver*> observers{&box, &recorder, &profiles, &progress, &checkpointing};
+  if (!c.field_phases.empty()) observers.insert(observers.end() - 1, &fields);
   DrivenIntegrator driven(solver);
   try {
     schedule.run(driven, observers);

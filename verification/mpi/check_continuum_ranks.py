@@ -27,6 +27,13 @@
       A step that fails (unlimited slopes at Courant number 1) on 2 and 4 ranks: exit 1 with the
       plain run's message (the same first failing cell, in box coordinates) and its last good
       state, bit for bit but the budget.
+  check_continuum_ranks.py SHAKER signal [--mpirun CMD]
+      A stop signal during a run on 2 ranks: sent to the launcher (OpenMPI's mpirun forwards
+      SIGTERM to every rank after its odls_base_sigkill_timeout, then waits as long again before
+      SIGKILL), and sent to rank 1 alone. Either way every rank stops at the same stored phase,
+      the root writes the checkpoint and says so once, no run file is written, and the run
+      continued from the checkpoint on 4 ranks ends in the straight run's final checkpoint, bit
+      for bit but the budget.
   check_continuum_ranks.py SHAKER refused [--mpirun CMD]
       A 1D column on 2 ranks, an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x), and a
       box too large for the machine's memory on 2 ranks (their blocks' needs added up, as both
@@ -43,7 +50,9 @@ removed on success and kept (and printed) on failure.
 """
 import argparse
 import os
+import re
 import shlex
+import signal
 import subprocess
 import sys
 
@@ -301,6 +310,80 @@ def check_failure(shaker, work, launcher):
     return failures
 
 
+# Seconds between OpenMPI's mpirun forwarding SIGTERM and its SIGKILL (odls_base_sigkill_timeout;
+# the default, 1, leaves a decomposed run too little time to reach a stored phase).
+SIGNAL_GRACE = 3
+
+
+def rank_process(launcher_pid, rank):
+    """The pid of `rank` among the launcher's child processes (OMPI_COMM_WORLD_RANK)."""
+    for entry in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{entry}/stat") as stat:
+                parent = int(stat.read().rsplit(")", 1)[1].split()[1])
+            with open(f"/proc/{entry}/environ", "rb") as environ:
+                variables = environ.read().split(b"\0")
+        except (OSError, ValueError, IndexError):
+            continue
+        if parent == launcher_pid and f"OMPI_COMM_WORLD_RANK={rank}".encode() in variables:
+            return int(entry)
+    return None
+
+
+def stopped_run(shaker, work, launcher, output, to_rank):
+    """Starts 40 cycles on 2 ranks, waits for the first progress line (the ranks are in the run
+    loop), sends SIGTERM to the launcher or to rank `to_rank`, returns (stderr, problems)."""
+    words = mpirun_prefix(launcher, 2) + [
+        "--mca", "odls_base_sigkill_timeout", str(SIGNAL_GRACE), shaker, "continuum",
+        "case.toml", "--set", f"run.output={output}.h5", "--set", "run.sampled_cycles=40",
+        "--progress-interval", "0"]
+    process = subprocess.Popen(words, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
+    first = process.stderr.readline()
+    target = process.pid if to_rank is None else rank_process(process.pid, to_rank)
+    if target is not None:
+        os.kill(target, signal.SIGTERM)
+    _, rest = process.communicate(timeout=120)
+    problems = [] if target is not None else [f"{output}: no process of rank {to_rank} found"]
+    if "cycle" not in first:
+        problems.append(f"{output}: no progress line before the signal: {first!r}")
+    if process.returncode == 0:
+        problems.append(f"{output}: exit 0, the run ended before the signal reached the ranks")
+    return first + rest, problems
+
+
+def check_signal(shaker, work, launcher):
+    failures = []
+    for output, to_rank in (("launcher", None), ("rank1", 1)):
+        stderr, found = stopped_run(shaker, work, launcher, output, to_rank)
+        stops = re.findall(r"stopped by signal 15 \(SIGTERM\).*in cycle (\d+)", stderr)
+        if len(stops) != 1:
+            found.append(f"{output}: {len(stops)} stop messages, expected 1 (the root's): "
+                         f"{stderr[-600:]}")
+        checkpoint = os.path.join(work, f"{output}.checkpoint.h5")
+        if not os.path.exists(checkpoint) or os.path.exists(os.path.join(work, f"{output}.h5")):
+            found.append(f"{output}: expected the checkpoint and no run file: {os.listdir(work)}")
+        if found:
+            failures += found
+            continue
+        end = [f"run.sampled_cycles={int(stops[0]) + 2}"]
+        shaker_run(shaker, "case.toml", f"{output}-straight.h5", work,
+                   settings=end + [f"run.checkpoint={output}-straight.ckpt.h5"])
+        shaker_run(shaker, "case.toml", f"{output}-rest.h5", work, launcher, 4,
+                   settings=end + [f"run.restart_from={checkpoint}",
+                                   f"run.checkpoint={output}-rest.ckpt.h5"])
+        straight = contents(os.path.join(work, f"{output}-straight.ckpt.h5"))
+        found += differences(contents(os.path.join(work, f"{output}-rest.ckpt.h5")), straight,
+                             f"{output}: continued on 4 ranks", True,
+                             budget_scale(time_series(os.path.join(work,
+                                                                   f"{output}-straight.h5"))))
+        print(f"SIGTERM to the {output}: stopped in cycle {stops[0]}, one checkpoint; continued "
+              f"on 4 ranks to cycle {int(stops[0]) + 2}: {len(straight)} datasets and "
+              f"attributes compared with the straight run; {len(found)} differences")
+        failures += found
+    return failures
+
+
 def width_filling(share):
     """A box width (cell 0.5, ceiling 10: 20 cells high) whose solver working set, 600 bytes
     a cell, is `share` of this machine's MemAvailable: at 1.5 each of 2 ranks' halves fits,
@@ -339,7 +422,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
     parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "column",
-                                          "failure", "refused"])
+                                          "failure", "signal", "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -358,6 +441,8 @@ def main():
         failures = check_column_start(args.shaker, work, args.mpirun)
     elif args.check == "failure":
         failures = check_failure(args.shaker, work, args.mpirun)
+    elif args.check == "signal":
+        failures = check_signal(args.shaker, work, args.mpirun)
     else:
         failures = check_refused(args.shaker, work, args.mpirun)
     for failure in failures:

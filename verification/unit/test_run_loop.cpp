@@ -372,4 +372,47 @@ TEST(CheckpointObserver, StopSignalWritesACheckpointAtTheNextStoredPhaseAndStops
   }
 }
 
+
+/// Sets a stand-in for another rank's signal at stored phase k of cycle m.
+class PeerSignalAt final : public shaker::RunObserver {
+ public:
+  PeerSignalAt(int& peer, std::int64_t m, std::int64_t k) : peer_(peer), m_(m), k_(k) {}
+  void at_phase(const PhaseInstant& p) override {
+    if (p.cycle == m_ && p.phase == k_) peer_ = SIGTERM;
+  }
+
+ private:
+  int& peer_;
+  std::int64_t m_, k_;
+};
+
+TEST(CheckpointObserver, SignalOfAnotherRankStopsThisOneAtTheSamePhaseWithoutWritingHere) {
+  const shaker::testing::TemporaryDirectory dir;
+  const PhaseSchedule s = PhaseSchedule::whole_cycles(protocol(1, 2, 5), shaker_base, 0.0);
+  shaker::CheckpointSettings settings;
+  settings.run_output = dir / "run.h5";
+  settings.file = dir / "c.h5";
+  for (const bool writer : {false, true}) {
+    LoggingSolver solver(0.0);
+    int writes = 0, peer = 0, agreements = 0;
+    PeerSignalAt other_rank(peer, 1, 2);
+    const shaker::StopAcrossRanks ranks{[&](int mine) { ++agreements; return std::max(mine, peer); },
+                                        writer};
+    shaker::CheckpointObserver checkpoints(settings, s, text_writer(solver, writes), "shaker test",
+                                           ranks);
+    try {
+      s.run(solver, {&other_rank, &checkpoints});
+      ADD_FAILURE() << "the run went on after the other rank's signal";
+    } catch (const shaker::StopRequested& stop) {
+      EXPECT_EQ(stop.exit_code(), 143);
+      // The writer's message is the run's; the other ranks stay silent.
+      EXPECT_EQ(std::string(stop.what()).empty(), !writer) << stop.what();
+    }
+    EXPECT_EQ(agreements, 5 + 2 + 1);  // every stored phase up to the stop, the stop's included
+    EXPECT_EQ(solver.time(), s.target(1, 2));
+    EXPECT_EQ(writes, writer ? 1 : 0);
+    EXPECT_EQ(std::filesystem::exists(dir / "c.h5"), writer);
+  }
+}
+
 }  // namespace
