@@ -197,6 +197,30 @@ bool GciRow::pass() const {
   return within(result.asymptotic_ratio, 1.0, asymptotic_tolerance);
 }
 
+CoarseLevelError coarse_level_error(const GciRow& row, double formal_order) {
+  const double change21 = row.phi2 - row.phi1, change32 = row.phi3 - row.phi2;
+  const bool converging = row.result.kind == ConvergenceKind::monotonic &&
+                          std::abs(change32) > std::abs(change21) && row.pass();
+  if (!converging)
+    return {std::max(std::abs(row.phi3 - row.phi1), std::abs(change32)),
+            CoarseLevelError::Method::largest_change};
+  const bool capped = row.result.order > formal_order;
+  const double order = capped ? formal_order : row.result.order;
+  const double extrapolated = row.phi1 - change21 / (std::pow(row.h2 / row.h1, order) - 1.0);
+  return {std::abs(row.phi3 - extrapolated),
+          capped ? CoarseLevelError::Method::extrapolated_at_formal_order
+                 : CoarseLevelError::Method::extrapolated};
+}
+
+std::string to_string(CoarseLevelError::Method method) {
+  switch (method) {
+    case CoarseLevelError::Method::extrapolated: return "extrapolated";
+    case CoarseLevelError::Method::extrapolated_at_formal_order: return "extrapolated at the formal order";
+    case CoarseLevelError::Method::largest_change: return "largest change";
+  }
+  return "unknown";
+}
+
 GciRow make_gci_row(const std::string& study, const std::string& quantity, double h1, double h2,
                     double h3, double phi1, double phi2, double phi3,
                     double asymptotic_tolerance) {

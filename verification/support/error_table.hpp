@@ -93,6 +93,23 @@ GciRow make_gci_row(const std::string& study, const std::string& quantity, doubl
                     double asymptotic_tolerance = 0.1);
 GciRow make_two_grid_gci_row(const std::string& study, const std::string& quantity, double h1,
                              double h2, double phi1, double phi2, double assumed_order);
+/// The error of a three-level study's coarsest value phi3, where the study refines from the
+/// setting in production (the time-step studies: phi3 at the production step). Richardson
+/// extrapolation from the two finest levels only where the levels converge monotonically
+/// (|phi3 - phi2| > |phi2 - phi1|, exact for a constant ratio) in the asymptotic range
+/// (row.pass()), with the observed order held at or below the formal order: an order above
+/// it reads a cancellation of error terms as fast convergence and would put phi_ext too close
+/// to phi1 (Roache, Verification and Validation in Computational Science and Engineering,
+/// 1998, uses min(p, p_formal) likewise). Otherwise (oscillating, diverging or stagnant
+/// levels) nothing can be extrapolated, and the error is the largest change from phi3.
+struct CoarseLevelError {
+  enum class Method { extrapolated, extrapolated_at_formal_order, largest_change };
+  double error = 0.0;
+  Method method = Method::largest_change;
+};
+CoarseLevelError coarse_level_error(const GciRow& row, double formal_order);
+std::string to_string(CoarseLevelError::Method method);
+
 std::string gci_to_csv(std::span<const GciRow> rows);
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows);
 
