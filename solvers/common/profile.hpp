@@ -44,7 +44,10 @@ struct RunRecord {
   std::vector<Profile> profiles;
   /// MD: the sums of each sampled cycle behind the profiles (empty for the continuum).
   CycleSamples samples;
-  TimeSeries series;
+  TimeSeries series;  ///< of replica 0 in an MD ensemble (md.replicas)
+  /// MD ensembles (md.replicas = K > 1): the time series of replicas 1 .. K-1, in replica
+  /// order, with the columns of `series`; empty for a single run.
+  std::vector<TimeSeries> replica_series;
   // Filled when read back from a file:
   int schema_version = 0;
   std::string program_version, git_commit, created;
@@ -52,7 +55,7 @@ struct RunRecord {
 
 /// MD runs of one configuration (repeats, or the replicas of an ensemble) pooled into one
 /// record: their samples appended in the order given, the profiles rebuilt from all samples;
-/// everything else (time series, configuration) is the first run's. Throws InputError if a
+/// everything else (time series, replicas' time series, configuration) is the first run's. Throws InputError if a
 /// run lacks samples or the runs differ in their phases or bins.
 RunRecord pool_runs(const std::vector<RunRecord>& runs);
 

@@ -216,6 +216,57 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
   }
 }
 
+/// A time series as a group: one 1D dataset per column with its units, and the string
+/// attribute `columns` naming them in order (`/timeseries`, and each replica's in an ensemble).
+void write_series(hid_t parent, const std::string& name, const TimeSeries& series) {
+  h5::Handle group = h5::create_group(parent, name);
+  h5::write_attribute(group.id(), "columns", fmt::format("{}", fmt::join(series.names, ",")));
+  for (std::size_t i = 0; i < series.names.size(); ++i)
+    h5::write(group.id(), series.names[i], series.columns[i], {series.columns[i].size()},
+              series_units(series.names[i]));
+}
+
+TimeSeries read_series(hid_t parent, const std::string& name) {
+  h5::Handle group = h5::open_group(parent, name);
+  TimeSeries series;
+  std::stringstream names(h5::read_string_attribute(group.id(), "columns"));
+  for (std::string column; std::getline(names, column, ',');)
+    series.add(column, h5::read_doubles(group.id(), column));
+  return series;
+}
+
+// An MD ensemble's replicas 1 .. K-1 (replica 0's series is /timeseries): the group
+// `replica_timeseries`, its int64 attribute `replicas` = K, and one series group per replica,
+// `replica_00001` ... (five digits, so that name order is replica order for every allowed K).
+constexpr const char* replica_group = "replica_timeseries";
+std::string replica_name(std::size_t r) { return fmt::format("replica_{:05d}", r); }
+
+void write_replica_series(hid_t file, const std::vector<TimeSeries>& replicas) {
+  if (replicas.empty()) return;
+  h5::Handle group = h5::create_group(file, replica_group);
+  h5::write_attribute(group.id(), "replicas", static_cast<std::int64_t>(replicas.size() + 1));
+  for (std::size_t r = 1; r <= replicas.size(); ++r)
+    write_series(group.id(), replica_name(r), replicas[r - 1]);
+}
+
+std::vector<TimeSeries> read_replica_series(hid_t file) {
+  if (!h5::exists(file, replica_group)) return {};
+  h5::Handle group = h5::open_group(file, replica_group);
+  const std::int64_t replicas = h5::read_integer_attribute(group.id(), "replicas");
+  if (replicas < 2)
+    throw InputError(fmt::format("{}: attribute replicas = {}, allowed: >= 2 (the group is "
+                                 "written for an ensemble only)", replica_group, replicas));
+  std::vector<TimeSeries> series;
+  for (std::size_t r = 1; r < static_cast<std::size_t>(replicas); ++r) {
+    const std::string name = replica_name(r);
+    if (!h5::exists(group.id(), name))
+      throw InputError(fmt::format("{} has no group {} (attribute replicas = {}: one group per "
+                                   "replica 1 .. {})", replica_group, name, replicas, replicas - 1));
+    series.push_back(read_series(group.id(), name));
+  }
+  return series;
+}
+
 }  // namespace
 
 void write_run_attributes(hid_t file, const RunRecord& record) {
@@ -235,15 +286,18 @@ void write_run_file(const std::filesystem::path& path, const RunRecord& record) 
       throw std::invalid_argument(fmt::format(
           "run file '{}': the time series has no column '{}'; every run file has the columns {} "
           "(docs/output-schema.md)", path.string(), name, fmt::join(required_series_columns, ", ")));
+  for (std::size_t r = 0; r < record.replica_series.size(); ++r)
+    if (record.replica_series[r].names != record.series.names)
+      throw std::invalid_argument(fmt::format(
+          "run file '{}': the time series of replica {} has the columns {}, replica 0's {}; "
+          "every replica has the same columns (docs/output-schema.md)", path.string(), r + 1,
+          fmt::join(record.replica_series[r].names, ", "), fmt::join(record.series.names, ", ")));
   write_hdf5_atomically(path, [&](hid_t file) {
     write_run_attributes(file, record);
     write_profiles(file, record.profiles);
     write_samples(file, record.samples);
-    h5::Handle series = h5::create_group(file, "timeseries");
-    h5::write_attribute(series.id(), "columns", fmt::format("{}", fmt::join(record.series.names, ",")));
-    for (std::size_t i = 0; i < record.series.names.size(); ++i)
-      h5::write(series.id(), record.series.names[i], record.series.columns[i],
-                {record.series.columns[i].size()}, series_units(record.series.names[i]));
+    write_series(file, "timeseries", record.series);
+    write_replica_series(file, record.replica_series);
   });
 }
 
@@ -274,10 +328,8 @@ RunRecord read_run_file(const std::filesystem::path& path) {
     record.profiles = read_profiles(file.id());
     record.samples = read_samples(file.id(), record.profiles.size(),
                                   record.profiles.empty() ? 0 : record.profiles.front().size());
-    h5::Handle series = h5::open_group(file.id(), "timeseries");
-    std::stringstream names(h5::read_string_attribute(series.id(), "columns"));
-    for (std::string name; std::getline(names, name, ',');)
-      record.series.add(name, h5::read_doubles(series.id(), name));
+    record.series = read_series(file.id(), "timeseries");
+    record.replica_series = read_replica_series(file.id());
     return record;
   } catch (const InputError& error) {
     throw InputError(fmt::format("run file '{}': {}", path.string(), error.what()));

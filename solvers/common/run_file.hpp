@@ -22,7 +22,8 @@ inline constexpr const char* file_kind_attribute = "kind";
 /// Every file a run writes for analysis carries them, so that each says what made it.
 void write_run_attributes(hid_t file, const RunRecord& record);
 /// Writes the record atomically; provenance (schema, version, commit, date) is added here.
-/// Throws std::invalid_argument, writing nothing, if the series lacks a required column.
+/// Throws std::invalid_argument, writing nothing, if the series lacks a required column or a
+/// replica's series (RunRecord::replica_series) has other columns than the series.
 void write_run_file(const std::filesystem::path& path, const RunRecord& record);
 /// Reads a run file; throws InputError naming the file and what is missing or malformed.
 RunRecord read_run_file(const std::filesystem::path& path);

@@ -19,7 +19,8 @@ std::vector<ParameterSpec> md_parameters() {
       real("md.gas_temperature", 1.0, positive(1e6), "gas initial state: temperature").in("g sigma"),
       integer("md.replicas", 1, closed(1, 100000),
               "independent replicas of the case, pooled into one run file (profiles and "
-              "standard errors over all replicas' samples; time series of replica 0). Replica r "
+              "standard errors over all replicas' samples; every replica's time series, replica "
+              "0's in /timeseries, the others' in /replica_timeseries). Replica r "
               "of the periodic protocol takes seed run.seed + r; of the single shock, "
               "run.transient_cycles + r from run.seed. Spread over the ranks of `mpirun -np P "
               "shaker md`; the file is the same for every P. Without checkpoints only "

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "common/case_parameters.hpp"
 #include "common/checkpoints.hpp"
@@ -134,10 +136,12 @@ void check_replicas(const config::Config& config, const CheckpointSettings& chec
                                  spec.range.describe()));
 }
 
-/// What the root rank needs of a replica: its samples and the numbers of the summary. Sent
-/// between ranks as doubles (counts stay exact below 2^53).
+/// What the root rank needs of a replica: its samples, its time series and the numbers of the
+/// summary. Sent between ranks as doubles (counts stay exact below 2^53); the series' column
+/// names, the same for every replica, are not sent.
 struct ReplicaSummary {
   CycleSamples samples;
+  TimeSeries series;
   double time = 0.0, seconds = 0.0, collisions = 0.0, events = 0.0;
   double pair = 0.0, plate = 0.0, ceiling = 0.0, guard_activations = 0.0, overlaps = 0.0;
   EnergyBudget budget;
@@ -154,8 +158,13 @@ struct ReplicaSummary {
       out.insert(out.end(), samples.cycles(k).begin(), samples.cycles(k).end());
       for (const BinSums& b : samples.sums(k)) out.insert(out.end(), {b.count, b.vx, b.vy, b.vz, b.v2});
     }
+    // The single shock's replicas run different numbers of cycles: each sends its row count.
+    const std::size_t rows = series.columns.empty() ? 0 : series.columns.front().size();
+    out.insert(out.end(), {static_cast<double>(series.columns.size()), static_cast<double>(rows)});
+    for (const std::vector<double>& column : series.columns) out.insert(out.end(), column.begin(), column.end());
   }
-  static ReplicaSummary unpack(const double*& at) {
+  /// The summary packed at `at`, its series' columns named `names` (replica 0's).
+  static ReplicaSummary unpack(const double*& at, const std::vector<std::string>& names) {
     ReplicaSummary r;
     for (double* x : {&r.time, &r.seconds, &r.collisions, &r.events, &r.pair, &r.plate, &r.ceiling,
                       &r.guard_activations, &r.overlaps, &r.budget.plate_work, &r.budget.collisional_loss,
@@ -174,6 +183,14 @@ struct ReplicaSummary {
       for (BinSums& b : sums[k]) b = {at[0], at[1], at[2], at[3], at[4]}, at += 5;
     }
     r.samples = CycleSamples::from_arrays(bins, bin_volume, std::move(cycles), std::move(sums));
+    const auto columns = static_cast<std::size_t>(*at++), rows = static_cast<std::size_t>(*at++);
+    if (columns != names.size())
+      throw std::logic_error(fmt::format("a replica's time series has {} columns, replica 0's {}",
+                                         columns, names.size()));
+    for (const std::string& name : names) {
+      r.series.add(name, std::vector<double>(at, at + rows));
+      at += rows;
+    }
     return r;
   }
 };
@@ -181,6 +198,7 @@ struct ReplicaSummary {
 ReplicaSummary summary_of(const Simulation& simulation, const RunOutcome& outcome) {
   ReplicaSummary r;
   r.samples = outcome.samples;
+  r.series = outcome.series;
   r.time = simulation.time();
   r.seconds = outcome.seconds;
   r.collisions = static_cast<double>(outcome.collisions);
@@ -280,11 +298,14 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   for (std::size_t rank = 0; rank < gathered.size(); ++rank) {
     const double* at = gathered[rank].data();
     for (std::size_t r = rank; r < summaries.size(); r += gathered.size())
-      summaries[r] = ReplicaSummary::unpack(at);
+      summaries[r] = ReplicaSummary::unpack(at, record.series.names);
   }
   std::vector<RunRecord> pooled(summaries.size(), record);
   for (std::size_t r = 0; r < summaries.size(); ++r) pooled[r].samples = summaries[r].samples;
   record = pool_runs(pooled);
+  // Replica 0's series stays where a single run's is; the others follow in replica order.
+  for (std::size_t r = 1; r < summaries.size(); ++r)
+    record.replica_series.push_back(std::move(summaries[r].series));
   const ReplicaSummary all = combined(summaries);
 
   record.solver = "md";

@@ -1,11 +1,14 @@
 // The vibrated layer: the base-case smoke test, energy budget, heights reached per cycle,
-// checkpoint restart, the collapse detector and guard, the single-shock protocol, and the
-// hydrostatic elastic gas.
+// checkpoint restart, the collapse detector and guard, the single-shock protocol, the time
+// series of an ensemble's replicas (md.replicas), and the hydrostatic elastic gas.
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <numeric>
+#include <string>
 
 #include "analysis/analysis.hpp"
 #include "common/config.hpp"
@@ -455,6 +458,61 @@ TEST(MdVibrated, SingleShockSwitchesRestitutionAtTheGivenPhase) {
   std::printf("measured: largest loss per interval before %.4g, after %.3g\n", before, after);
   EXPECT_GT(before, 100.0);
   EXPECT_LT(after, 1e-6);
+}
+
+// ---- MD ensembles (md.replicas, docs/parallel.md) ----
+
+/// The tiny case of verification/mpi/check_md_ensemble.py: 40 particles, 1 + 2 cycles of 5 phases.
+config::Config tiny_case(const std::filesystem::path& output, const std::string& protocol) {
+  config::Config c;
+  for (const char* assignment : {"layer.particles=40", "md.box_width=4.0", "md.ceiling=60.0",
+                                 "run.transient_cycles=1", "run.sampled_cycles=2",
+                                 "run.phases_per_cycle=5", "run.seed=7"})
+    c.set(assignment);
+  c.set("run.protocol=" + protocol);
+  c.set("run.output=" + output.string());
+  return c;
+}
+
+void expect_same_series(const TimeSeries& a, const TimeSeries& b, const std::string& what) {
+  ASSERT_EQ(a.names, b.names) << what;
+  for (std::size_t i = 0; i < a.names.size(); ++i) {
+    ASSERT_EQ(a.columns[i].size(), b.columns[i].size()) << what << " " << a.names[i];
+    for (std::size_t k = 0; k < a.columns[i].size(); ++k)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(a.columns[i][k]), std::bit_cast<std::uint64_t>(b.columns[i][k]))
+          << what << " " << a.names[i] << "[" << k << "]: " << a.columns[i][k] << " vs " << b.columns[i][k];
+  }
+}
+
+TEST(MdEnsemble, EveryReplicasTimeSeriesIsThatOfItsSingleRun) {
+  // md.replicas = 3 in one process: replica r's series in the run file (replica 0's in
+  // /timeseries, the others' in /replica_timeseries) equals, bit for bit, the series of a
+  // single run of seed run.seed + r (periodic) or of run.transient_cycles + r (single shock).
+  const auto dir = testing::test_directory();
+  constexpr std::size_t replicas = 3, phases = 5;
+  for (const std::string protocol : {"periodic", "single_shock"}) {
+    config::Config ensemble = tiny_case(dir / (protocol + "-ensemble.h5"), protocol);
+    ensemble.set("md.replicas=" + std::to_string(replicas));
+    ASSERT_EQ(run(ensemble), 0);
+    const RunRecord pooled = read_run_file(dir / (protocol + "-ensemble.h5"));
+    ASSERT_EQ(pooled.replica_series.size(), replicas - 1) << protocol;
+    const std::string varied = protocol == "periodic" ? "run.seed" : "run.transient_cycles";
+    for (std::size_t r = 0; r < replicas; ++r) {
+      const std::string name = protocol + "-single" + std::to_string(r) + ".h5";
+      config::Config single = tiny_case(dir / name, protocol);
+      single.set(varied + "=" + std::to_string(single.integer(varied) + static_cast<std::int64_t>(r)));
+      ASSERT_EQ(run(single), 0);
+      const RunRecord alone = read_run_file(dir / name);
+      EXPECT_TRUE(alone.replica_series.empty()) << name;
+      const TimeSeries& series = r == 0 ? pooled.series : pooled.replica_series[r - 1];
+      // A row at every stored phase of every cycle, transient included, and one at the end;
+      // the single shock's replica r runs r more transient cycles, then the recorded one.
+      const std::size_t cycles = protocol == "periodic" ? 1 + 2 : 1 + r + 1;
+      const std::string what = protocol + " replica " + std::to_string(r);
+      EXPECT_EQ(series.column("com_z").size(), cycles * phases + 1) << what;
+      expect_same_series(series, alone.series, what);
+    }
+  }
 }
 
 TEST(MdHydrostatic, ElasticGasUnderGravityIsIsothermalAndHydrostatic) {

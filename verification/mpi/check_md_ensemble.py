@@ -6,7 +6,10 @@
       single shock, run.transient_cycles + r) pooled by `shaker analyze --pooled`, bit for bit.
   check_md_ensemble.py SHAKER ranks P [P ...] [--mpirun CMD]
       `mpirun -np P shaker md` writes the same file as the plain run for every P (more ranks
-      than replicas included), every dataset and attribute but the creation date.
+      than replicas included), every dataset and attribute but the creation date, for both
+      protocols; the files hold every replica's time series (replica 0's in /timeseries, the
+      others' in /replica_timeseries, docs/output-schema.md), the single shock's of different
+      lengths.
 
 Exit status 0 when every check holds; each failure is printed. Runs in a temporary directory,
 removed on success.
@@ -97,23 +100,47 @@ def check_pooling(shaker, work):
     return failures
 
 
+def replica_series_missing(found, protocol):
+    """What the file lacks of every replica's time series: replica r >= 1 in
+    replica_timeseries/replica_RRRRR with /timeseries's columns, rows as the protocol runs."""
+    out = []
+    if found.get("replica_timeseries@replicas") != REPLICAS:
+        out.append(f"{protocol}: replica_timeseries@replicas is "
+                   f"{found.get('replica_timeseries@replicas')}, expected {REPLICAS}")
+    columns = str(found["timeseries@columns"]).split(",")
+    rows = len(found["timeseries/t"])
+    for r in range(1, REPLICAS):
+        group = f"replica_timeseries/replica_{r:05d}"
+        # The single shock's replica r runs r more cycles of 5 stored phases.
+        expected = rows + (5 * r if protocol == "single_shock" else 0)
+        for column in columns:
+            if found.get(f"{group}/{column}", np.empty(0)).shape != (expected,):
+                out.append(f"{protocol}: {group}/{column} missing or not {expected} rows")
+    return out
+
+
 def check_ranks(shaker, work, launcher, counts):
     failures = []
-    run([shaker, "md", "case.toml", "--set", f"md.replicas={REPLICAS}", "--set",
-         "run.output=plain.h5", "--quiet"], work)
-    plain = contents(os.path.join(work, "plain.h5"))
-    for p in counts:
-        out = f"ranks{p}.h5"
-        result = run(mpirun_prefix(launcher, p) + [shaker, "md", "case.toml", "--set",
-                                                   f"md.replicas={REPLICAS}", "--set",
-                                                   f"run.output={out}", "--quiet"], work)
-        found = differences(contents(os.path.join(work, out)), plain, f"{p} ranks vs plain")
-        summaries = result.stdout.count("shaker md:")
-        if summaries != 1:
-            found.append(f"{p} ranks: {summaries} summaries printed, expected 1 (the root's)")
-        print(f"{p} rank(s): {len(plain)} datasets and attributes compared; "
-              f"{len(found)} differences")
-        failures += found
+    for protocol in ("periodic", "single_shock"):
+        ensemble = [shaker, "md", "case.toml", "--set", f"run.protocol={protocol}", "--set",
+                    f"md.replicas={REPLICAS}", "--quiet"]
+        run(ensemble + ["--set", f"run.output={protocol}-plain.h5"], work)
+        plain = contents(os.path.join(work, f"{protocol}-plain.h5"))
+        failures += replica_series_missing(plain, protocol)
+        for p in counts:
+            out = f"{protocol}-ranks{p}.h5"
+            result = run(mpirun_prefix(launcher, p) + ensemble + ["--set", f"run.output={out}"],
+                         work)
+            found = differences(contents(os.path.join(work, out)), plain,
+                                f"{protocol}, {p} ranks vs plain")
+            summaries = result.stdout.count("shaker md:")
+            if summaries != 1:
+                found.append(f"{protocol}, {p} ranks: {summaries} summaries printed, expected 1 "
+                             "(the root's)")
+            print(f"{protocol}, {p} rank(s): {len(plain)} datasets and attributes compared "
+                  f"({sum(n.startswith('replica_timeseries/') for n in plain)} of replicas 1 .. "
+                  f"{REPLICAS - 1}'s time series); {len(found)} differences")
+            failures += found
     return failures
 
 

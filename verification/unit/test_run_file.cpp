@@ -61,6 +61,31 @@ void expect_same_record(const RunRecord& written, const RunRecord& read) {
   EXPECT_EQ(read.series.names, written.series.names);
   for (const auto& name : written.series.names)
     expect_same_bits(read.series.column(name), written.series.column(name), "series " + name);
+  ASSERT_EQ(read.replica_series.size(), written.replica_series.size());
+  for (std::size_t r = 0; r < written.replica_series.size(); ++r) {
+    const shaker::TimeSeries &w = written.replica_series[r], &got = read.replica_series[r];
+    EXPECT_EQ(got.names, w.names) << "replica " << r + 1;
+    for (const auto& name : w.names)
+      expect_same_bits(got.column(name), w.column(name), "replica " + std::to_string(r + 1) + " " + name);
+  }
+}
+
+/// The sample as an ensemble of three replicas (md.replicas): replicas 1 and 2 have series of
+/// their own, of other lengths (as a single shock's replicas, which run more cycles).
+RunRecord ensemble_record() {
+  RunRecord record = make_sample_record(true);
+  for (std::size_t rows : {6u, 8u}) {
+    shaker::TimeSeries replica;
+    for (const auto& name : record.series.names) {
+      std::vector<double> column;
+      for (std::size_t i = 0; i < rows; ++i)
+        column.push_back(static_cast<double>(rows) + 0.125 * static_cast<double>(i));
+      replica.add(name, column);
+    }
+    record.replica_series.push_back(replica);
+  }
+  record.replica_series[1].columns[3][5] = -0.0;
+  return record;
 }
 
 /// The sample plus values that only survive an exact binary round trip.
@@ -135,6 +160,43 @@ TEST(RunFile, RecordsProvenanceAndTheEffectiveConfiguration) {
   const auto stored = shaker::config::Config::from_toml(read.configuration, "stored");
   EXPECT_EQ(stored.to_toml(), expected.to_toml());
   EXPECT_EQ(stored.hash(), expected.hash());
+}
+
+TEST(RunFile, EnsembleRoundTripKeepsEveryReplicasSeriesInReplicaOrder) {
+  const TemporaryDirectory dir;
+  const RunRecord written = ensemble_record();
+  shaker::write_run_file(dir / "ensemble.h5", written);
+  expect_same_record(written, shaker::read_run_file(dir / "ensemble.h5"));
+  // The layout docs/output-schema.md gives: replica 0 in /timeseries, replica r in
+  // /replica_timeseries/replica_0000r, the group's attribute `replicas` = K.
+  shaker::h5::Handle file = shaker::h5::open_file(dir / "ensemble.h5");
+  shaker::h5::Handle group = shaker::h5::open_group(file.id(), "replica_timeseries");
+  EXPECT_EQ(shaker::h5::read_integer_attribute(group.id(), "replicas"), 3);
+  EXPECT_EQ(shaker::h5::members(group.id()), (std::vector<std::string>{"replica_00001", "replica_00002"}));
+  shaker::h5::Handle second = shaker::h5::open_group(group.id(), "replica_00002");
+  EXPECT_EQ(shaker::h5::read_string_attribute(second.id(), "columns"), "t,phase,plate_z,com_z");
+  EXPECT_EQ(shaker::h5::shape(second.id(), "com_z"), (std::vector<std::size_t>{8}));
+  // A single run has no replica group.
+  shaker::write_run_file(dir / "single.h5", make_sample_record(true));
+  shaker::h5::Handle single = shaker::h5::open_file(dir / "single.h5");
+  EXPECT_FALSE(shaker::h5::exists(single.id(), "replica_timeseries"));
+  EXPECT_TRUE(shaker::read_run_file(dir / "single.h5").replica_series.empty());
+}
+
+TEST(RunFile, RefusesAReplicaSeriesWithOtherColumns) {
+  const TemporaryDirectory dir;
+  RunRecord record = ensemble_record();
+  shaker::TimeSeries shorter;
+  for (std::size_t i = 0; i + 1 < record.series.names.size(); ++i)
+    shorter.add(record.series.names[i], record.replica_series[1].columns[i]);
+  record.replica_series[1] = shorter;
+  try {
+    shaker::write_run_file(dir / "run.h5", record);
+    ADD_FAILURE() << "a replica's series without com_z was written";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("replica 2"), std::string::npos) << error.what();
+  }
+  EXPECT_TRUE(files_in(dir.path()).empty()) << "left behind: " << files_in(dir.path()).front();
 }
 
 TEST(RunFile, RunWithoutProfilesRoundTrips) {
@@ -224,9 +286,10 @@ void expect_read_error(const std::filesystem::path& path,
 
 /// Copies the sample run and damages the copy with the raw HDF5 API.
 std::filesystem::path damaged_copy(const TemporaryDirectory& dir, const std::string& name,
-                                   void (*damage)(hid_t file)) {
+                                   void (*damage)(hid_t file),
+                                   const RunRecord& record = make_sample_record(true)) {
   const auto path = dir / name;
-  shaker::write_run_file(path, make_sample_record(true));
+  shaker::write_run_file(path, record);
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   EXPECT_GE(file, 0);
   damage(file);
@@ -270,6 +333,20 @@ TEST(RunFile, ReadingForeignOrDamagedFilesThrowsInputError) {
                                    H5Gclose(g);
                                  }),
                     {"flat-T.h5", "profiles/T"});
+  expect_read_error(damaged_copy(
+                        dir, "no-replica.h5",
+                        [](hid_t f) { H5Ldelete(f, "replica_timeseries/replica_00002", H5P_DEFAULT); },
+                        ensemble_record()),
+                    {"no-replica.h5", "replica_timeseries", "replica_00002"});
+  expect_read_error(damaged_copy(
+                        dir, "one-replica.h5",
+                        [](hid_t f) {
+                          const hid_t g = H5Gopen2(f, "replica_timeseries", H5P_DEFAULT);
+                          shaker::h5::write_attribute(g, "replicas", std::int64_t{1});
+                          H5Gclose(g);
+                        },
+                        ensemble_record()),
+                    {"one-replica.h5", "replicas = 1"});
 }
 
 }  // namespace
