@@ -57,6 +57,15 @@ def expect(condition, message):
         print("PROBLEM: " + message)
 
 
+def without_launcher(**extra):
+    """This process's environment less an MPI launcher's variables, and `extra`. pvbatch starts
+    MPI as a singleton, which sets PMIX_RANK and OMPI_* for its children; `shaker` would read
+    them as an mpirun launch (common/ranks.cpp) and join pvbatch's MPI job rather than run alone
+    as under python3."""
+    launcher = ("OMPI_", "PMIX_", "PMI_")
+    return {**{k: v for k, v in os.environ.items() if not k.startswith(launcher)}, **extra}
+
+
 def h5_snapshots(path):
     """Every snapshot as h5py reads it: attributes, corners, fields (flattened, cell order)."""
     with h5py.File(path, "r") as f:
@@ -138,7 +147,8 @@ def check_file(fields_path, run_path, shaker):
         for field in FIELDS:  # so that the readers' values are compared on something
             expect(np.ptp(np.concatenate([s[field] for s in snapshots])) > 0,
                    f"{field} is the same in every cell of every snapshot")
-    result = subprocess.run([shaker, "analyze", fields_path], capture_output=True, text=True)
+    result = subprocess.run([shaker, "analyze", fields_path], capture_output=True, text=True,
+                            env=without_launcher())
     expect(result.returncode == 2 and "'shaker continuum fields' file" in result.stderr,
            f"shaker analyze on the fields file: exit {result.returncode}, {result.stderr.strip()}")
     return hexahedra, snapshots
@@ -229,7 +239,7 @@ def main():
     command = [os.path.abspath(args.shaker), "continuum", os.path.join(work, "box.toml"), "--quiet",
                "--set", f"run.output={run_path}"]
     result = subprocess.run(command, capture_output=True, text=True,
-                            env=dict(os.environ, OMP_NUM_THREADS="1"))
+                            env=without_launcher(OMP_NUM_THREADS="1"))
     if result.returncode != 0:
         print(f"PROBLEM: {' '.join(command)} exited {result.returncode}:\n"
               f"{result.stdout}{result.stderr}")
