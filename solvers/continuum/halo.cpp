@@ -202,6 +202,22 @@ template <class Visit> void for_block(const Grid& g, const Block& b, bool offset
 }
 }  // namespace
 
+// The gather and the scatter count in columns of every variable (variable_count x nz
+// values): MPI's counts and displacements are int, and a box of more than 2^31 values (5
+// variables of 430 M cells) would overflow them counted in values, while its columns number
+// far fewer. A rank's values are packed in its own order, a whole number of such units.
+Halo::ColumnCounts::ColumnCounts(const Halo& halo) : values_per_column(variable_count * halo.box_.nz) {
+  MPI_Type_contiguous(values_per_column, MPI_DOUBLE, &type);
+  MPI_Type_commit(&type);
+  for (int r = 0, at = 0; r < halo.size_; ++r) {
+    const Block b = halo.block_of(r);
+    counts.push_back(b.nx * b.ny);
+    offsets.push_back(at);
+    at += counts.back();
+  }
+}
+Halo::ColumnCounts::~ColumnCounts() { MPI_Type_free(&type); }
+
 void Halo::gather(const State& local_state, State& box_state) const {
   const std::size_t cells = local_.interior_cells();
   std::vector<double> mine(variable_count * cells);
@@ -209,25 +225,16 @@ void Halo::gather(const State& local_state, State& box_state) const {
     for_block(local_, block_, false, [&](std::ptrdiff_t c, std::size_t m) {
       mine[v * cells + m] = local_state.q[v][c];
     });
-  std::vector<int> counts, offsets;
-  std::vector<double> all;
-  if (root()) {
-    for (int r = 0, at = 0; r < size_; ++r) {
-      const Block b = block_of(r);
-      counts.push_back(variable_count * b.nx * b.ny * box_.nz);
-      offsets.push_back(at);
-      at += counts.back();
-    }
-    all.resize(static_cast<std::size_t>(offsets.back() + counts.back()));
-  }
-  MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), counts.data(),
-              offsets.data(), MPI_DOUBLE, 0, cartesian_);
+  const ColumnCounts columns(*this);
+  std::vector<double> all(root() ? box_.interior_cells() * variable_count : 0);
+  MPI_Gatherv(mine.data(), block_.nx * block_.ny, columns.type, all.data(), columns.counts.data(),
+              columns.offsets.data(), columns.type, 0, cartesian_);
   if (!root()) return;
   if (box_state.size() != box_.size()) box_state.resize(box_.size());
   for (int r = 0; r < size_; ++r) {
     const Block b = block_of(r);
     const std::size_t block_cells = static_cast<std::size_t>(b.nx) * b.ny * box_.nz;
-    const double* from = all.data() + offsets[static_cast<std::size_t>(r)];
+    const double* from = all.data() + columns.first_value(r);
     for (int v = 0; v < variable_count; ++v)
       for_block(box_, b, true, [&](std::ptrdiff_t c, std::size_t m) {
         box_state.q[v][c] = from[v * block_cells + m];
@@ -236,16 +243,13 @@ void Halo::gather(const State& local_state, State& box_state) const {
 }
 
 void Halo::scatter(const State& box_state, State& local_state) const {
-  std::vector<int> counts, offsets;
-  std::vector<double> all;
+  const ColumnCounts columns(*this);
+  std::vector<double> all(root() ? box_.interior_cells() * variable_count : 0);
   if (root()) {
     for (int r = 0; r < size_; ++r) {
       const Block b = block_of(r);
       const std::size_t block_cells = static_cast<std::size_t>(b.nx) * b.ny * box_.nz;
-      offsets.push_back(static_cast<int>(all.size()));
-      counts.push_back(static_cast<int>(variable_count * block_cells));
-      all.resize(all.size() + variable_count * block_cells);
-      double* to = all.data() + offsets.back();
+      double* to = all.data() + columns.first_value(r);
       for (int v = 0; v < variable_count; ++v)
         for_block(box_, b, true, [&](std::ptrdiff_t c, std::size_t m) {
           to[v * block_cells + m] = box_state.q[v][c];
@@ -254,8 +258,8 @@ void Halo::scatter(const State& box_state, State& local_state) const {
   }
   const std::size_t cells = local_.interior_cells();
   std::vector<double> mine(variable_count * cells);
-  MPI_Scatterv(all.data(), counts.data(), offsets.data(), MPI_DOUBLE, mine.data(),
-               static_cast<int>(mine.size()), MPI_DOUBLE, 0, cartesian_);
+  MPI_Scatterv(all.data(), columns.counts.data(), columns.offsets.data(), columns.type, mine.data(),
+               block_.nx * block_.ny, columns.type, 0, cartesian_);
   for (int v = 0; v < variable_count; ++v)
     for_block(local_, block_, false, [&](std::ptrdiff_t c, std::size_t m) {
       local_state.q[v][c] = mine[v * cells + m];

@@ -83,6 +83,22 @@ class Halo {
   void exchange_direction(int direction, const std::vector<double*>& fields) const;
   Block block_of(int rank) const;
 
+  /// Every rank's share of the box for gather and scatter, counted in columns of all
+  /// variables (`type`: variable_count x nz doubles).
+  struct ColumnCounts {
+    explicit ColumnCounts(const Halo& halo);
+    ColumnCounts(const ColumnCounts&) = delete;
+    ColumnCounts& operator=(const ColumnCounts&) = delete;
+    ~ColumnCounts();
+    /// Where rank r's values start in the root's buffer.
+    std::size_t first_value(int r) const {
+      return static_cast<std::size_t>(offsets[static_cast<std::size_t>(r)]) * values_per_column;
+    }
+    int values_per_column;
+    MPI_Datatype type = MPI_DATATYPE_NULL;
+    std::vector<int> counts, offsets;
+  };
+
   Grid box_, local_;
   Block block_;
   MPI_Comm cartesian_ = MPI_COMM_NULL;
