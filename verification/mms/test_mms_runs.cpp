@@ -309,7 +309,9 @@ INSTANTIATE_TEST_SUITE_P(SspRungeKutta, MmsTime1D, ::testing::Values(2, 3));
 // below the band to 160-320 cells is the third-order upwind dissipation of the Riemann fluxes,
 // proportional to the wave speeds |u| + c, beside a second-order error that scales with the
 // flow: a faster manufactured flow shrinks its share. Every term stays active
-// (MmsTermShares3D checks each one's part of the source).
+// (MmsTermShares3D checks each one's part of the source). The orders are fitted over the
+// three finest levels, 128, 180 and 256 (ratio about sqrt 2): at the same finest level the
+// coarser pair 64 -> 128 still carries n's pre-asymptotic 2.12, the 128 -> 180 pair 2.08.
 constexpr double mms3d_t_end = 0.002;
 constexpr double mms3d_velocity_amplitude = 0.9;
 
@@ -362,7 +364,7 @@ class NightlyMmsSpace3D : public ::testing::TestWithParam<Transport> {};
 TEST_P(NightlyMmsSpace3D, EveryFieldAndNormAtSecondOrder) {
   const mms::MmsCase c = mms3d_case(GetParam());
   conv::ErrorTable table;
-  mms::spatial_study(c, {32, 64, 128, 256}, study_name(), table);
+  mms::spatial_study(c, {32, 64, 128, 180, 256}, study_name(), table);
   mms::MmsCase coarse = c;
   coarse.cells_z = 16;
   conv::write_study_files(test_directory(), study_name(),
