@@ -95,6 +95,51 @@ void add_norms(convergence::ErrorTable& table, const std::string& study, int dim
 }
 }  // namespace
 
+CorrectedCentreSource::CorrectedCentreSource(const ManufacturedSolution& solution,
+                                             const Physics& physics, const Terms& terms,
+                                             const Grid& g)
+    : solution_(solution), physics_(physics), terms_(terms), g_(g),
+      px_(g.dimension == 3 ? g.nx + 2 : 1), py_(g.dimension == 3 ? g.ny + 2 : 1),
+      centre_(static_cast<std::size_t>(px_ * py_ * (g.nz + 2))) {}
+
+Residual CorrectedCentreSource::operator()(double t, const std::array<double, 3>& x) {
+  if (!(t == t_)) fill(t);
+  const bool box = g_.dimension == 3;
+  const auto padded = [&](double coordinate) {
+    return static_cast<int>(std::floor(coordinate / g_.h)) + 1;
+  };
+  const int i = box ? padded(x[0]) : 0, j = box ? padded(x[1]) : 0, k = padded(x[2]);
+  const int directions = box ? 3 : 1;
+  // (S_- - 2 S + S_+) / 24 per direction: h^2 / 24 times the second derivative.
+  Residual average = scaled(at(i, j, k), 1.0 - directions / 12.0);
+  const auto add = [&](int a, int b, int c) { accumulate(average, at(a, b, c), 1.0 / 24.0); };
+  add(i, j, k - 1);
+  add(i, j, k + 1);
+  if (box) {
+    add(i - 1, j, k);
+    add(i + 1, j, k);
+    add(i, j - 1, k);
+    add(i, j + 1, k);
+  }
+  return average;
+}
+
+const Residual& CorrectedCentreSource::at(int i, int j, int k) const {
+  return centre_[static_cast<std::size_t>(i + px_ * (j + py_ * k))];
+}
+
+void CorrectedCentreSource::fill(double t) {
+  const bool box = g_.dimension == 3;
+  for (int k = 0; k < g_.nz + 2; ++k)
+    for (int j = 0; j < py_; ++j)
+      for (int i = 0; i < px_; ++i) {
+        const double x = box ? (i - 0.5) * g_.h : 0.0, y = box ? (j - 0.5) * g_.h : 0.0;
+        centre_[static_cast<std::size_t>(i + px_ * (j + py_ * k))] =
+            conservative_source(solution_, physics_, terms_, t, {x, y, (k - 0.5) * g_.h});
+      }
+  t_ = t;
+}
+
 ManufacturedSolution solution_for(const MmsCase& c) {
   ManufacturedSolution s;
   s.dimension = c.dimension;
@@ -144,10 +189,11 @@ MmsResult run_mms(const MmsCase& c) {
   const Physics source_physics{c.e, c.transport, physics.shaker};
   const Terms terms = effective_terms(c);
   const std::array<double, 3> width = cell_width(g);
+  CorrectedCentreSource corrected(solution, source_physics, terms, g);
   solver.op().external_source = [&](double t, double x, double y, double z, double* out) {
     const Residual s =
-        c.source_at_centre
-            ? conservative_source(solution, source_physics, terms, t, {x, y, z})
+        c.source_rule == SourceRule::corrected_centre
+            ? corrected(t, {x, y, z})
             : average_conservative_source(solution, source_physics, terms, t, {x, y, z}, width);
     out[continuum::density] += s.mass;
     for (int i = 0; i < 3; ++i) out[continuum::momentum_x + i] += s.momentum[i];
