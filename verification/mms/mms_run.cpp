@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 
 namespace shaker::mms {
@@ -124,8 +125,12 @@ Residual CorrectedCentreSource::operator()(double t, const std::array<double, 3>
   return average;
 }
 
+std::size_t CorrectedCentreSource::slot(int i, int j, int k) const {
+  return static_cast<std::size_t>(i + px_ * (j + py_ * k));
+}
+
 const Residual& CorrectedCentreSource::at(int i, int j, int k) const {
-  return centre_[static_cast<std::size_t>(i + px_ * (j + py_ * k))];
+  return centre_[slot(i, j, k)];
 }
 
 void CorrectedCentreSource::fill(double t) {
@@ -134,7 +139,7 @@ void CorrectedCentreSource::fill(double t) {
     for (int j = 0; j < py_; ++j)
       for (int i = 0; i < px_; ++i) {
         const double x = box ? (i - 0.5) * g_.h : 0.0, y = box ? (j - 0.5) * g_.h : 0.0;
-        centre_[static_cast<std::size_t>(i + px_ * (j + py_ * k))] =
+        centre_[slot(i, j, k)] =
             conservative_source(solution_, physics_, terms_, t, {x, y, (k - 0.5) * g_.h});
       }
   t_ = t;
@@ -189,11 +194,12 @@ MmsResult run_mms(const MmsCase& c) {
   const Physics source_physics{c.e, c.transport, physics.shaker};
   const Terms terms = effective_terms(c);
   const std::array<double, 3> width = cell_width(g);
-  CorrectedCentreSource corrected(solution, source_physics, terms, g);
+  std::optional<CorrectedCentreSource> corrected;
+  if (c.source_rule == SourceRule::corrected_centre)
+    corrected.emplace(solution, source_physics, terms, g);
   solver.op().external_source = [&](double t, double x, double y, double z, double* out) {
     const Residual s =
-        c.source_rule == SourceRule::corrected_centre
-            ? corrected(t, {x, y, z})
+        corrected ? (*corrected)(t, {x, y, z})
             : average_conservative_source(solution, source_physics, terms, t, {x, y, z}, width);
     out[continuum::density] += s.mass;
     for (int i = 0; i < 3; ++i) out[continuum::momentum_x + i] += s.momentum[i];
@@ -232,9 +238,6 @@ TermShares term_shares(const MmsCase& c, int samples) {
       {"shear_viscosity", &Terms::shear_viscosity}, {"conduction", &Terms::conduction},
       {"collisional_loss", &Terms::collisional_loss}, {"gravity", &Terms::gravity},
       {"frame_forcing", &Terms::frame_forcing}};
-  const auto components = [](const Residual& r) {
-    return std::array<double, 5>{r.mass, r.momentum[0], r.momentum[1], r.momentum[2], r.energy};
-  };
   TermShares shares;
   std::vector<std::array<double, 5>> sum_of_squares;
   for (const auto& [name, on] : switches)

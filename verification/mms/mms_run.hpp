@@ -26,6 +26,11 @@
 
 namespace shaker::mms {
 
+/// The five conservative components of a source (mass, momentum x, y, z, energy) in order.
+inline std::array<double, 5> components(const Residual& r) {
+  return {r.mass, r.momentum[0], r.momentum[1], r.momentum[2], r.energy};
+}
+
 /// How a run takes the cell average of the source (see CorrectedCentreSource).
 enum class SourceRule { gauss_average, corrected_centre };
 
@@ -61,7 +66,8 @@ class CorrectedCentreSource {
   Residual operator()(double t, const std::array<double, 3>& x);
 
  private:
-  const Residual& at(int i, int j, int k) const;  ///< padded indices, 0 is the layer outside
+  std::size_t slot(int i, int j, int k) const;  ///< padded indices, 0 is the layer outside
+  const Residual& at(int i, int j, int k) const;
   void fill(double t);
 
   const ManufacturedSolution& solution_;

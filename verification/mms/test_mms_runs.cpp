@@ -322,7 +322,8 @@ mms::MmsCase mms3d_case(Transport transport) {
   c.boundary = ZBoundary::walls;
   c.t_end = mms3d_t_end;
   c.velocity_amplitude = mms3d_velocity_amplitude;
-  c.source_rule = mms::SourceRule::corrected_centre;  // 27 Gauss points per cell and stage would dominate the run
+  // The Gauss average (27 points per cell and stage) would dominate the run.
+  c.source_rule = mms::SourceRule::corrected_centre;
   return c;
 }
 
@@ -381,14 +382,11 @@ TEST(MmsSourceRule, CorrectedCentreIsTheCellAverageToFourthOrder) {
       for (int j = 0; j < g.ny; ++j)
         for (int i = 0; i < g.nx; ++i) {
           const std::array<double, 3> x{g.center(i), g.center(j), g.center(k)};
-          const auto components = [](const mms::Residual& r) {
-            return std::array<double, 5>{r.mass, r.momentum[0], r.momentum[1], r.momentum[2],
-                                         r.energy};
-          };
-          const auto average = components(
+          const auto average = mms::components(
               mms::average_conservative_source(solution, physics, terms, t, x, {g.h, g.h, g.h}));
-          const auto from_centres = components(corrected(t, x));
-          const auto at_centre = components(mms::conservative_source(solution, physics, terms, t, x));
+          const auto from_centres = mms::components(corrected(t, x));
+          const auto at_centre =
+              mms::components(mms::conservative_source(solution, physics, terms, t, x));
           for (std::size_t q = 0; q < 5; ++q) {
             largest = std::max(largest, std::abs(average[q]));
             corrected_largest = std::max(corrected_largest, std::abs(from_centres[q] - average[q]));
