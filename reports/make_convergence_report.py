@@ -30,6 +30,13 @@ allowed); names contain no commas.
       (convergence "two-grids"; h3, phi3, gci32, ratio and pass nan; assumed order, Fs = 3) is
       shown as "not checked" and is not counted as a check. Each study gets a figure below
       the table: phi against h per quantity, with phi_extrapolated and the GCI21 band.
+  *.bounds.csv   study,quantity,value,value_basis,bound,bound_basis,pass
+      A study's claim that an error lies within an uncertainty (BoundCheck): the time error of
+      the production step within the grid error (time-step studies), |3D - 1D| within the
+      combined grid uncertainty, a fast integrator's difference from the reference within the
+      reference's grid uncertainty. The judge passes it when value <= bound; a row without a
+      bound (nan) is "not checked". A time-step study's GCI rows are diagnostics there (their
+      ratio decides whether the time error may be extrapolated), shown as "not checked".
   *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,
                       standard_error
       MD sampling convergence (verification/sampling/md_sampling.hpp): the standard error
@@ -98,8 +105,11 @@ SAMPLING_FIT_HEADER = ["study", "quantity", "phase", "fit_points", "fitted_slope
 BIN_SIZE_HEADER = ["study", "quantity", "phase", "sigma_value", "half_sigma_value", "statistic",
                    "value", "criterion", "limit", "pass"]
 TERM_SHARES_HEADER = ["study", "term", "equation", "rms", "share"]
+BOUNDS_HEADER = ["study", "quantity", "value", "value_basis", "bound", "bound_basis", "pass"]
 TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence", "statistic", "criterion",
-                "term", "equation"}
+                "term", "equation", "value_basis", "bound_basis"}
+# The tables whose judge leaves some rows unchecked (pass nan).
+MAY_BE_UNCHECKED = (GCI_HEADER, BOUNDS_HEADER)
 NORM_ORDER = {"L1": 0, "L2": 1, "Linf": 2}
 
 # The units of every field and quantity the C++ writers name (docs/units.md): the fields of the
@@ -179,7 +189,7 @@ def read_csv(path, header):
                 except ValueError:
                     raise InputProblem(f"{path}:{number}: {key} = '{cell}' is not a number")
         if "pass" in record and not is_judge_verdict(record["pass"], header):
-            allowed = "1, 0 or nan" if header == GCI_HEADER else "1 or 0"
+            allowed = "1, 0 or nan" if header in MAY_BE_UNCHECKED else "1 or 0"
             cell = row[header.index("pass")]
             raise InputProblem(f"{path}:{number}: pass = '{cell}' is not {allowed}")
         records.append(record)
@@ -187,9 +197,10 @@ def read_csv(path, header):
 
 
 def is_judge_verdict(cell, header):
-    # The C++ writers put 1 or 0 in every pass column but one: a GCI row they do not check
-    # (two grids, assumed order) carries nan. Anything else is not a verdict to show.
-    return cell in (0.0, 1.0) or (math.isnan(cell) and header == GCI_HEADER)
+    # The C++ writers put 1 or 0 in every pass column but two: a GCI row they do not check (two
+    # grids, or a ratio the study reads as a diagnostic) and a bound that has no estimate carry
+    # nan. Anything else is not a verdict to show.
+    return cell in (0.0, 1.0) or (math.isnan(cell) and header in MAY_BE_UNCHECKED)
 
 
 TABLES_DIRECTORY = "convergence-tables"
@@ -227,12 +238,13 @@ def remove_stale_plots(out_dir, report_text):
 
 
 def read_inputs(directory):
-    found = {"errors": [], "orders": [], "gci": [], "sampling": [], "sampling-fit": [],
-             "bin-size": [], "term-shares": []}
+    found = {"errors": [], "orders": [], "gci": [], "bounds": [], "sampling": [],
+             "sampling-fit": [], "bin-size": [], "term-shares": []}
     files = []
     for kind, header in (("errors", ERRORS_HEADER), ("orders", ORDERS_HEADER), ("gci", GCI_HEADER),
-                         ("sampling", SAMPLING_HEADER), ("sampling-fit", SAMPLING_FIT_HEADER),
-                         ("bin-size", BIN_SIZE_HEADER), ("term-shares", TERM_SHARES_HEADER)):
+                         ("bounds", BOUNDS_HEADER), ("sampling", SAMPLING_HEADER),
+                         ("sampling-fit", SAMPLING_FIT_HEADER), ("bin-size", BIN_SIZE_HEADER),
+                         ("term-shares", TERM_SHARES_HEADER)):
         for path in sorted(glob.glob(os.path.join(directory, "**", f"*.{kind}.csv"),
                                      recursive=True)):
             records = read_csv(path, header)
@@ -487,7 +499,7 @@ def gci_result_text(r, mark):
         return f"{mark} (band 1 ± {rc.fmt(r['asymptotic_tolerance'])})"
     if r["convergence"] == "two-grids":
         return f"{mark} (two grids, assumed p, Fs = 3)"
-    return mark
+    return f"{mark} (a diagnostic: the study's claim is its bound check)"
 
 
 def gci_line(r, mark):
@@ -503,6 +515,33 @@ def gci_failure(r):
     return (f"GCI {r['study']} / {r['quantity']}: asymptotic ratio "
             f"{rc.fmt(r['asymptotic_ratio'], 4)} outside 1 ± "
             f"{rc.fmt(r['asymptotic_tolerance'])} ({r['convergence']})")
+
+
+def bound_line(r, mark):
+    ratio = r["value"] / r["bound"] if r["bound"] > 0 else float("nan")
+    return rc.table_row(
+        [r["study"], r["quantity"], units_of(r["quantity"]), rc.fmt(r["value"], 4),
+         r["value_basis"], rc.fmt(r["bound"], 4), r["bound_basis"], rc.fmt(ratio, 3), mark])
+
+
+def bound_failure(r):
+    return (f"bound {r['study']} / {r['quantity']}: {rc.fmt(r['value'], 4)} "
+            f"({r['value_basis']}) above {rc.fmt(r['bound'], 4)} ({r['bound_basis']})")
+
+
+def bound_section(data, failures):
+    """The studies' error-within-uncertainty claims; returns (lines, checks)."""
+    rows = sorted(data["bounds"], key=lambda r: (r["study"], r["quantity"]))
+    if not rows:
+        return [], 0
+    table, checks = judged_table(
+        "| study | quantity | units | value | value basis | bound | bound basis | "
+        "value / bound [1] | result |", rows, bound_line, bound_failure, failures,
+        "no bound checks found")
+    return ["## Errors within their uncertainty", "",
+            "Each row: an error of the study (value) and the uncertainty it must not exceed "
+            "(bound), in the units of the row; the time-step studies compare the time error of "
+            "the production step with the grid error at the production cell.", ""] + table, checks
 
 
 def order_section(data, failures):
@@ -656,6 +695,7 @@ def main(argv=None):
     failures = []
     order_lines, order_checks = order_section(data, failures)
     gci_lines, gci_checks = gci_section(data, out_dir, failures)
+    bound_lines, bound_checks = bound_section(data, failures)
     sampling_lines, sampling_checks = sampling_section(data, out_dir, failures)
 
     series = series_of(data["errors"])
@@ -665,7 +705,7 @@ def main(argv=None):
         name = plot_study(study, series[study], designs, out_dir)
         plot_lines += [f"![{study}]({name})", ""]
 
-    checks = order_checks + gci_checks + sampling_checks
+    checks = order_checks + gci_checks + bound_checks + sampling_checks
     lines = ["# Convergence report", "",
              f"- commit: {commit}",
              f"- date: {rc.utc_now()}",
@@ -679,8 +719,8 @@ def main(argv=None):
     if failures:
         lines += ["", "Failing checks (measured values):", ""] + [f"- {f}" for f in failures]
     lines.append("")
-    lines += (order_lines + gci_lines + sampling_lines + term_share_tables(data["term-shares"]) +
-              error_tables(series) + plot_lines)
+    lines += (order_lines + gci_lines + bound_lines + sampling_lines +
+              term_share_tables(data["term-shares"]) + error_tables(series) + plot_lines)
     tables = os.path.join(out_dir, TABLES_DIRECTORY)
     lines += ["## Input files", "",
               f"Copied beside this report into {TABLES_DIRECTORY}/ (the validation report reads "

@@ -37,6 +37,7 @@ ORDERS_HEADER = ("study,field,norm,fit_points,fitted_order,order_std_error,pair_
 GCI_HEADER = ("study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,"
               "relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,"
               "convergence,asymptotic_tolerance,pass")
+BOUNDS_HEADER = "study,quantity,value,value_basis,bound,bound_basis,pass"
 
 
 def write(path, header, rows):
@@ -79,7 +80,17 @@ def synthetic_study(directory):
         ("base-1d", "max_mach", 0.025, 0.05, 0.1, 3.1, 3.0, 3.3, 1.5, 3.2, 0.032, 0.03, 0.05,
          0.4, 2.8, "oscillatory", 0.1, 0),
         ("base-3d", "shock_location", 0.5, 1.0, "nan", 1.01, 1.04, "nan", 2.0, 1.0, 0.0297, 0.01,
-         0.0297, "nan", "nan", "two-grids", "nan", "nan")])
+         0.0297, "nan", "nan", "two-grids", "nan", "nan"),
+        # A time-step study's row: its ratio is a diagnostic (the claim is its bound check).
+        ("real-time-x", "max_mach", 0.25, 0.5, 1.0, 3.1, 3.0, 3.3, 1.5, 3.2, 0.032, 0.03, 0.05,
+         0.4, 2.8, "oscillatory", 0.1, "nan")])
+    write(os.path.join(directory, "qoi.bounds.csv"), BOUNDS_HEADER, [
+        ("real-time-x", "max_mach", 0.001, "time error of the production step (largest change)",
+         0.002, "grid uncertainty at cell 0.1 (finest of 0.4/0.2/0.1)", 1),
+        ("real-time-x", "shock_speed", 0.005, "time error of the production step (extrapolated)",
+         0.002, "grid uncertainty at cell 0.1 (finest of 0.4/0.2/0.1)", 0),
+        ("real-time-x", "front_width_over_mfp_ft0.22", 0.004, "time error of the production step "
+         "(largest change)", "nan", "none: the coarse column does not resolve it", "nan")])
 
 
 def synthetic_sampling_study(directory):
@@ -137,6 +148,7 @@ JUDGED_TABLES = {
     "gci": ("## Grid convergence index of the quantities of interest", ("study", "quantity")),
     "sampling-fit": ("## MD sampling convergence", ("study", "quantity", "phase")),
     "bin-size": ("### Bin size: sigma against sigma/2", ("study", "quantity", "phase")),
+    "bounds": ("## Errors within their uncertainty", ("study", "quantity")),
 }
 # Only a GCI mark carries a note: its band, or why a two-grid row is not checked.
 NOTED_TABLES = {"gci"}
@@ -259,7 +271,7 @@ def test_report_on_a_synthetic_study(work_dir):
     text = open(report).read() if os.path.exists(report) else ""
     for header in ("- commit: abc123def", "- date: ", "- machine: ", "- build type: Release"):
         assert header in text, f"header line '{header}' missing"
-    assert "11 checks: 7 pass, 4 fail." in text, "summary count line missing or wrong"
+    assert "13 checks: 8 pass, 5 fail." in text, "summary count line missing or wrong"
     check_marks_follow_the_judge(inputs, text, "synthetic")
 
     judged_in_band = [(field, norm) for field in ("n", "uz") for norm in ("L1", "L2", "Linf")
@@ -300,6 +312,19 @@ def test_report_on_a_synthetic_study(work_dir):
     two_grid = line_with(text, "| base-3d | shock_location |")
     assert "not checked (two grids" in two_grid and "FAIL" not in two_grid, \
         f"two-grid row must be shown but not checked: '{two_grid}'"
+
+    diagnostic = line_with(text, "| real-time-x | max_mach | 1 | 3.1 |")
+    assert "not checked (a diagnostic" in diagnostic and "FAIL" not in diagnostic, \
+        f"a time-step study's GCI row must be shown but not checked: '{diagnostic}'"
+    within = line_with(text, "| real-time-x | max_mach | 1 | 0.001 |")
+    assert within.endswith("| 0.5 | PASS |"), f"bound 0.001 <= 0.002 must pass: '{within}'"
+    above = line_with(text, "| real-time-x | shock_speed | sqrt(g sigma) | 0.005 |")
+    assert above.endswith("| 2.5 | **FAIL** |"), f"bound 0.005 > 0.002 must fail: '{above}'"
+    assert line_with(text, "- bound real-time-x / shock_speed: 0.005 (time error of the "
+                     "production step (extrapolated)) above 0.002") != "", \
+        "the failing bound is not listed with its measured value"
+    no_bound = line_with(text, "| real-time-x | front_width_over_mfp_ft0.22 |")
+    assert no_bound.endswith("| not checked |"), f"a row without a bound: '{no_bound}'"
 
     errors_header = line_with(text, "| field | units | norm | h = 0.1 |")
     assert "p(0-1) [1]" in errors_header and "p(2-3) [1]" in errors_header, \

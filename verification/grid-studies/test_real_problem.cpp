@@ -152,6 +152,7 @@ std::vector<conv::GciRow> three_grid_rows(const std::string& study,
     std::printf("%-20s %-26s order %.3f  extrapolated %.6g  GCI21 %.3e  ratio %.3f  %s\n",
                 study.c_str(), name.c_str(), r.order, r.phi_extrapolated, r.gci21,
                 r.asymptotic_ratio, conv::to_string(r.kind).c_str());
+    rows.back().asymptotic_range_claimed = check;
     if (check) {
       EXPECT_TRUE(rows.back().pass()) << study << " " << name << ": asymptotic ratio "
                                       << r.asymptotic_ratio << ", order " << r.order;
@@ -220,6 +221,7 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
   settings.push_back("continuum.diffusion_integrator=" + fast.diffusion);
   settings.push_back("continuum.integrator_stages=" + std::to_string(fast.stages));
   const Quantities values = run_base_case(dir, label, 0.1, settings);
+  std::vector<conv::BoundCheck> bounds;
   for (const conv::GciRow& row : rows) {
     const double value = values.at(row.quantity);
     const double difference = std::abs(value - row.phi1);
@@ -229,7 +231,14 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
                 row.quantity.c_str(), value, row.phi1, difference, allowed,
                 asymptotic ? "GCI21" : "finest pair, not asymptotic");
     EXPECT_LE(difference, allowed) << label << " " << row.quantity;
+    bounds.push_back({"real-1d-integrator-" + label, row.quantity, difference,
+                      "|this integrator - the reference| at cell 0.1", allowed,
+                      std::string("grid uncertainty of the reference at cell 0.1 (") +
+                          (asymptotic ? "GCI21)" : "finest pair; not asymptotic)")});
   }
+  EXPECT_FALSE(conv::write_study_files(dir, "real-1d-integrator-" + label,
+                                       {{".bounds.csv", conv::bounds_to_csv(bounds)}})
+                   .empty());
 }
 // Measured (see the report): paper + extrapolated + SSP-RK(4,2) agrees in every quantity, and
 // so does paper with explicit diffusion and SSP-RK(s,2) for s = 4, 6 and 10 (largest
@@ -280,6 +289,7 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
       if (std::isfinite(value_3d) && std::isfinite(values_1d_same_cells[level].at(name)))
         differences.add({"real-3d-minus-1d", name, "abs", static_cast<int>(level), cells_3d[level],
                          std::abs(value_3d - values_1d_same_cells[level].at(name))});
+  std::vector<conv::BoundCheck> bounds;
   for (const conv::GciRow& row : rows) {
     const auto row_1d = std::find_if(rows_1d.begin(), rows_1d.end(),
                                      [&](const conv::GciRow& r) { return r.quantity == row.quantity; });
@@ -292,6 +302,8 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
                 row_1d->phi1, grid_uncertainty(*row_1d), difference, allowed);
     EXPECT_LE(difference, allowed) << row.quantity << ": 3D (cell 0.25) " << row.phi1
                                    << ", 1D (cell 0.05) " << row_1d->phi1;
+    bounds.push_back({"real-3d-vs-1d", row.quantity, difference, "|3D (cell 0.25) - 1D (cell 0.05)|",
+                      allowed, "3D grid uncertainty + 1D grid uncertainty"});
     // The 3D effect itself: the box against the column at the same cell, within the box's grid
     // uncertainty (beyond it, the box would be a different flow, not a finer or coarser one).
     const double same_cell = std::abs(row.phi1 - values_1d_same_cells.back().at(row.quantity));
@@ -299,8 +311,13 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
                 row.quantity.c_str(), same_cell,
                 std::abs(values_1d_same_cells.back().at(row.quantity) - row_1d->phi1));
     EXPECT_LE(same_cell, grid_uncertainty(row)) << row.quantity << ": 3D - 1D at cell 0.25";
+    bounds.push_back({"real-3d-vs-1d-same-cell", row.quantity, same_cell,
+                      "|3D - 1D| at cell 0.25", grid_uncertainty(row), "3D grid uncertainty"});
   }
   EXPECT_FALSE(conv::write_study(dir, "real-3d-base", conv::ErrorTable{}, {}, rows).empty());
+  EXPECT_FALSE(conv::write_study_files(dir, "real-3d-vs-1d",
+                                       {{".bounds.csv", conv::bounds_to_csv(bounds)}})
+                   .empty());
   EXPECT_FALSE(conv::write_study(dir, "real-3d-minus-1d", differences, {}).empty());
 }
 
@@ -377,6 +394,7 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
   const auto grid_rows = three_grid_rows(fmt::format("real-d{}-grid-{}", c.dimension, c.transport),
                                          grid_cells, grid_values, 2, false, true);
 
+  std::vector<conv::BoundCheck> bounds;
   for (const conv::GciRow& row : rows) {
     const auto grid_row = std::find_if(grid_rows.begin(), grid_rows.end(),
                                        [&](const conv::GciRow& r) { return r.quantity == row.quantity; });
@@ -384,9 +402,14 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
     // where the steps converge, at most at the integrator's formal order).
     const conv::CoarseLevelError estimate = conv::coarse_level_error(row, formal_order(c));
     const double time_error = estimate.error;
+    const std::string time_basis = "time error of the production step (" +
+                                   conv::to_string(estimate.method) + ")";
     if (grid_row == grid_rows.end()) {
       std::printf("%-40s %-26s order %.2f  time error %.3e  no grid estimate at this cell\n",
                   label.c_str(), row.quantity.c_str(), row.result.order, time_error);
+      bounds.push_back({"real-time-" + label, row.quantity, time_error, time_basis,
+                        std::numeric_limits<double>::quiet_NaN(),
+                        "none: the coarse column does not resolve it"});
       continue;
     }
     const double grid_error = std::max(box ? middle_grid_uncertainty(*grid_row) : grid_uncertainty(*grid_row),
@@ -397,8 +420,16 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
     // <=: a quantity that changes neither with the step nor with the grid (both 0) passes.
     EXPECT_LE(time_error, grid_error) << label << " " << row.quantity << ": time error "
                                       << time_error << ", grid error " << grid_error;
+    bounds.push_back({"real-time-" + label, row.quantity, time_error, time_basis, grid_error,
+                      fmt::format("grid uncertainty at cell {} ({})", cell,
+                                  grid_error == resolution(row.quantity, cell)
+                                      ? "one cell: the resolution of d"
+                                      : box ? "middle of 1.0/0.5/0.25" : "finest of 0.4/0.2/0.1")});
   }
   EXPECT_FALSE(conv::write_study(dir, "real-time-" + label, conv::ErrorTable{}, {}, rows).empty());
+  EXPECT_FALSE(conv::write_study_files(dir, "real-time-" + label,
+                                       {{".bounds.csv", conv::bounds_to_csv(bounds)}})
+                   .empty());
 }
 INSTANTIATE_TEST_SUITE_P(
     NightlyRealProblem, TimeStepConvergence,

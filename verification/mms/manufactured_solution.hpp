@@ -38,6 +38,7 @@ struct ManufacturedSolution {
   double T0 = 1.0;                ///< mean temperature
   double U0 = 0.3;                ///< velocity amplitude
   double omega = 0.5;             ///< angular frequency of the time dependence
+  int density_mode = 4;           ///< half-wavelengths of n's main vertical shape across Lz
 
   template <class S> Fields<S> operator()(const S& t, const S& x, const S& y, const S& z) const {
     using std::cos;
@@ -50,7 +51,7 @@ struct ManufacturedSolution {
     const double d = dimension == 3 ? 1.0 : 0.0;  // switches the horizontal variation on
 
     Fields<S> f;
-    f.n = n0 * (1.0 + 0.2 * c(4) * (1.0 + 0.4 * sin(omega * t)) +
+    f.n = n0 * (1.0 + 0.2 * c(density_mode) * (1.0 + 0.4 * sin(omega * t)) +
                 d * 0.1 * sin(kx * x + 0.3) * cos(ky * y - 0.2 + 0.5 * omega * t) * c(2));
     f.T = T0 * (1.0 + 0.3 * c(3) * cos(omega * t + 0.5) +
                 d * 0.1 * cos(kx * x - ky * y + omega * t) * c(5));

@@ -51,6 +51,7 @@ struct MmsCase {
   /// corrected centre value (one point per cell, O(h^4)).
   SourceRule source_rule = SourceRule::gauss_average;
   double velocity_amplitude = 0.3;     ///< ManufacturedSolution::U0
+  int density_mode = 4;                ///< ManufacturedSolution::density_mode
 };
 
 /// The cell average of the source to O(h^4) from one evaluation per cell: the centre value

@@ -264,6 +264,17 @@ std::string gci_to_csv(std::span<const GciRow> rows) {
   return text;
 }
 
+std::string bounds_to_csv(std::span<const BoundCheck> rows) {
+  std::string text = "study,quantity,value,value_basis,bound,bound_basis,pass\n";
+  for (const auto& row : rows)
+    text += fmt::format("{},{},{},{},{},{},{}\n", checked_name(row.study),
+                        checked_name(row.quantity), number(row.value),
+                        checked_name(row.value_basis), number(row.bound),
+                        checked_name(row.bound_basis),
+                        row.checked() ? (row.pass() ? "1" : "0") : "nan");
+  return text;
+}
+
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows) {
   write_text_atomically(path, gci_to_csv(rows));
 }

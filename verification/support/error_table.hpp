@@ -13,6 +13,7 @@
 //
 // Numbers are written with 17 significant digits (exact round trip); names may not contain
 // commas, quotes or line breaks. Files are written atomically (temp file + rename).
+#include <cmath>
 #include <cstddef>
 #include <filesystem>
 #include <span>
@@ -85,7 +86,12 @@ struct GciRow {
   double h1 = 0.0, h2 = 0.0, h3 = 0.0, phi1 = 0.0, phi2 = 0.0, phi3 = 0.0;
   GciResult result;
   double asymptotic_tolerance = 0.1;  ///< pass: |asymptotic_ratio - 1| <= tolerance
-  bool checked() const { return result.kind != ConvergenceKind::two_grids; }
+  /// False where the study reads the asymptotic ratio as a diagnostic and claims something
+  /// else (a time-step study: its time error against the grid error, a BoundCheck).
+  bool asymptotic_range_claimed = true;
+  bool checked() const {
+    return asymptotic_range_claimed && result.kind != ConvergenceKind::two_grids;
+  }
   bool pass() const;
 };
 GciRow make_gci_row(const std::string& study, const std::string& quantity, double h1, double h2,
@@ -109,6 +115,20 @@ struct CoarseLevelError {
 };
 CoarseLevelError coarse_level_error(const GciRow& row, double formal_order);
 std::string to_string(CoarseLevelError::Method method);
+
+/// A study's claim that an error lies within an uncertainty: `value` (e.g. the time error of
+/// the production step, or |3D - 1D|) at most `bound` (e.g. the grid uncertainty); each basis
+/// says how its number was obtained. A NaN bound (no estimate exists) is not checked.
+struct BoundCheck {
+  std::string study, quantity;
+  double value = 0.0;
+  std::string value_basis;
+  double bound = 0.0;
+  std::string bound_basis;
+  bool checked() const { return !std::isnan(bound); }
+  bool pass() const { return value <= bound; }  // <=: nothing changes and nothing may (0, 0)
+};
+std::string bounds_to_csv(std::span<const BoundCheck> rows);
 
 std::string gci_to_csv(std::span<const GciRow> rows);
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows);

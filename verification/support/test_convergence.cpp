@@ -324,6 +324,42 @@ TEST(GciRows, AsymptoticRatioMustLieWithinItsToleranceOfOne) {
   EXPECT_FALSE(gci_row_with_ratio(std::numeric_limits<double>::quiet_NaN()).pass());
 }
 
+// A study that reads the ratio as a diagnostic (a time-step study) leaves the row unchecked:
+// nan in the pass column, however the ratio falls.
+TEST(GciRows, ARatioTheStudyDoesNotClaimIsNotChecked) {
+  cv::GciRow row = gci_row_with_ratio(2.8);
+  row.study = "real-time-x";
+  row.quantity = "max_mach";
+  ASSERT_TRUE(row.checked());
+  EXPECT_NE(cv::gci_to_csv(std::vector<cv::GciRow>{row}).find(",0\n"), std::string::npos);
+  row.asymptotic_range_claimed = false;
+  EXPECT_FALSE(row.checked());
+  EXPECT_NE(cv::gci_to_csv(std::vector<cv::GciRow>{row}).find(",nan\n"), std::string::npos);
+}
+
+// An error within its bound passes, at equality too (a quantity that changes neither with the
+// step nor with the grid: 0 against 0); above it fails; without a bound it is not checked.
+TEST(BoundChecks, ValueAtMostTheBoundPassesAndANanBoundIsNotChecked) {
+  const std::vector<cv::BoundCheck> rows{
+      {"s", "max_mach", 1e-3, "time error", 2e-3, "grid uncertainty"},
+      {"s", "shock_speed", 0.0, "time error", 0.0, "grid uncertainty"},
+      {"s", "center_of_mass", 2e-3 * (1.0 + just), "time error", 2e-3, "grid uncertainty"},
+      {"s", "front_width_over_mfp", 4e-3, "time error", std::nan(""), "none"}};
+  EXPECT_TRUE(rows[0].pass());
+  EXPECT_TRUE(rows[1].pass());
+  EXPECT_FALSE(rows[2].pass());
+  EXPECT_FALSE(rows[3].checked());
+  const std::string csv = cv::bounds_to_csv(rows);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "study,quantity,value,value_basis,bound,bound_basis,pass");
+  EXPECT_NE(csv.find("s,max_mach,0.001,time error,0.002,grid uncertainty,1\n"), std::string::npos);
+  EXPECT_NE(csv.find(",time error,0.002,grid uncertainty,0\n"), std::string::npos);
+  EXPECT_NE(csv.find(",nan,none,nan\n"), std::string::npos);
+  // A basis is free text in a CSV cell: a comma would shift every later column.
+  EXPECT_THROW(cv::bounds_to_csv(std::vector<cv::BoundCheck>{{"s", "q", 1, "a, b", 2, "c"}}),
+               std::invalid_argument);
+}
+
 // The error of the coarsest of three levels (the production step of a time-step study).
 namespace {
 cv::GciRow levels(double phi1, double phi2, double phi3) {
