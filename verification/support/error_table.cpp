@@ -194,7 +194,29 @@ void write_orders_csv(const std::filesystem::path& path, std::span<const OrderCh
 }
 
 bool GciRow::pass() const {
-  return within(result.asymptotic_ratio, 1.0, asymptotic_tolerance);
+  return result.kind == ConvergenceKind::monotonic &&
+         within(result.asymptotic_ratio, 1.0, asymptotic_tolerance);
+}
+
+namespace {
+/// |value - neighbour|, and for a triple that does not converge monotonically at least half
+/// the range of its three values.
+double non_asymptotic_uncertainty(const GciRow& row, double value, double neighbour) {
+  const double change = std::abs(value - neighbour);
+  if (row.result.kind == ConvergenceKind::monotonic) return change;
+  const auto [low, high] = std::minmax({row.phi1, row.phi2, row.phi3});
+  return std::max(change, 0.5 * (high - low));
+}
+}  // namespace
+
+double fine_grid_uncertainty(const GciRow& row) {
+  return row.pass() ? std::abs(row.phi1) * row.result.gci21
+                    : non_asymptotic_uncertainty(row, row.phi1, row.phi2);
+}
+
+double middle_grid_uncertainty(const GciRow& row) {
+  return row.pass() ? std::abs(row.phi2) * row.result.gci32
+                    : non_asymptotic_uncertainty(row, row.phi2, row.phi1);
 }
 
 CoarseLevelError coarse_level_error(const GciRow& row, double formal_order) {

@@ -85,7 +85,9 @@ struct GciRow {
   std::string study, quantity;
   double h1 = 0.0, h2 = 0.0, h3 = 0.0, phi1 = 0.0, phi2 = 0.0, phi3 = 0.0;
   GciResult result;
-  double asymptotic_tolerance = 0.1;  ///< pass: |asymptotic_ratio - 1| <= tolerance
+  /// pass: the three grids converge monotonically and |asymptotic_ratio - 1| <= tolerance (an
+  /// oscillation's ratio, from the magnitudes of its changes, can fall near 1 by accident)
+  double asymptotic_tolerance = 0.1;
   /// False where the study reads the asymptotic ratio as a diagnostic and claims something
   /// else (a time-step study: its time error against the grid error, a BoundCheck).
   bool asymptotic_range_claimed = true;
@@ -99,6 +101,17 @@ GciRow make_gci_row(const std::string& study, const std::string& quantity, doubl
                     double asymptotic_tolerance = 0.1);
 GciRow make_two_grid_gci_row(const std::string& study, const std::string& quantity, double h1,
                              double h2, double phi1, double phi2, double assumed_order);
+/// The discretisation uncertainty of a three-grid study's finest value phi1, or of its middle
+/// value phi2. In the asymptotic range (pass()): Roache's GCI, |phi1| GCI21 or |phi2| GCI32.
+/// Otherwise nothing can be extrapolated: a monotonic triple gives the change between the
+/// finest pair |phi1 - phi2|; an oscillating or stagnant one at least half the range of its
+/// three values (Stern, Wilson, Coleman and Paterson, J. Fluids Eng. 123, 793, 2001), since
+/// the finest pair of an oscillation may agree by accident (on synthetic triples with a
+/// random first-order scatter, |phi1 - phi2| alone covers the true error of phi1 in about two
+/// thirds of the oscillating draws, this rule in over nine tenths: support.GridUncertainty).
+double fine_grid_uncertainty(const GciRow& row);
+double middle_grid_uncertainty(const GciRow& row);
+
 /// The error of a three-level study's coarsest value phi3, where the study refines from the
 /// setting in production (the time-step studies: phi3 at the production step). Richardson
 /// extrapolation from the two finest levels only where the levels converge monotonically

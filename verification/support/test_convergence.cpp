@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -440,6 +441,60 @@ TEST(CoarseLevelError, HeldAtTheFormalOrderItCoversTheTrueErrorOfMixedSeries) {
   EXPECT_LE(double(covered_uncapped) / draws, 0.6);
   EXPECT_GE(median, 1.0);
   EXPECT_LE(median, 1.05);
+}
+
+// An oscillation's asymptotic ratio comes from the magnitudes of its changes and can fall
+// near 1 by accident: the base case's shock speed on cells 0.1, 0.2, 0.4 (1D study tables).
+TEST(GciRows, AnOscillatingTripleIsNotInTheAsymptoticRangeWhateverItsRatio) {
+  const cv::GciRow row = cv::make_gci_row("s", "shock_speed", 0.1, 0.2, 0.4, 4.2651375614104854,
+                                          4.2648678966915456, 4.2656900566716338);
+  EXPECT_EQ(row.result.kind, cv::ConvergenceKind::oscillatory);
+  EXPECT_NEAR(row.result.asymptotic_ratio, 1.0, 1e-3);
+  EXPECT_FALSE(row.pass());
+  // Not extrapolated: the finest change 2.7e-4 against half the range 4.1e-4.
+  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(row), 0.5 * (4.2656900566716338 - 4.2648678966915456));
+  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(row), cv::fine_grid_uncertainty(row));
+}
+
+TEST(GridUncertainty, MonotonicTriplesKeepTheGciOrTheFinestChange) {
+  const auto phi = [](double h) { return 3.0 + 0.3 * h * h; };
+  const cv::GciRow asymptotic = cv::make_gci_row("s", "q", 0.1, 0.2, 0.4, phi(0.1), phi(0.2), phi(0.4));
+  ASSERT_TRUE(asymptotic.pass());
+  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(asymptotic), phi(0.1) * asymptotic.result.gci21);
+  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(asymptotic), phi(0.2) * asymptotic.result.gci32);
+  // Monotonic, far from the asymptotic range (changes 1, then 0.1): the finest change.
+  const cv::GciRow slow = cv::make_gci_row("s", "q", 0.1, 0.2, 0.4, 3.0, 4.0, 4.1);
+  ASSERT_FALSE(slow.pass());
+  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(slow), 1.0);
+  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(slow), 1.0);
+}
+
+// Synthetic triples of known truth 10: a smooth second-order error plus a random first-order
+// scatter (a front that moves by parts of a cell). Among the draws that oscillate, the finest
+// change alone covers the true error of phi1 in about two thirds; the half range in over 90 %.
+TEST(GridUncertainty, CoversTheTrueErrorOfOscillatingTriples) {
+  std::mt19937_64 random(20261203);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  int oscillating = 0, covered = 0, covered_by_finest_change = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double a = normal(random);
+    std::array<double, 3> phi{};
+    const std::array<double, 3> h{0.1, 0.2, 0.4};
+    for (std::size_t l = 0; l < 3; ++l) phi[l] = 10.0 + a * h[l] * h[l] + 0.05 * normal(random) * h[l];
+    const cv::GciRow row = cv::make_gci_row("synthetic", "q", h[0], h[1], h[2], phi[0], phi[1], phi[2]);
+    if (row.result.kind != cv::ConvergenceKind::oscillatory) continue;
+    ++oscillating;
+    const double truth = std::abs(phi[0] - 10.0);
+    covered += cv::fine_grid_uncertainty(row) >= truth;
+    covered_by_finest_change += std::abs(phi[0] - phi[1]) >= truth;
+  }
+  const double coverage = double(covered) / oscillating;
+  const double finest_change = double(covered_by_finest_change) / oscillating;
+  std::printf("%d oscillating triples: coverage %.3f (finest change alone %.3f)\n", oscillating,
+              coverage, finest_change);
+  ASSERT_GT(oscillating, 1000);
+  EXPECT_GE(coverage, 0.9);
+  EXPECT_LE(finest_change, 0.75);
 }
 
 // The C++ writer and the Python report agree on the schema: a study written by write_study is
