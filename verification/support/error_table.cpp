@@ -207,15 +207,22 @@ double non_asymptotic_uncertainty(const GciRow& row, double value, double neighb
   const auto [low, high] = std::minmax({row.phi1, row.phi2, row.phi3});
   return std::max(change, 0.5 * (high - low));
 }
+
+/// Roache's GCI of the change `change` over refinement ratio r, the order held at `formal`.
+double capped_gci(const GciRow& row, double change, double r, double formal) {
+  constexpr double safety_factor = 1.25;  // three grids (three_grid_gci's default)
+  const double order = std::min(row.result.order, formal);
+  return safety_factor * std::abs(change) / (std::pow(r, order) - 1.0);
+}
 }  // namespace
 
-double fine_grid_uncertainty(const GciRow& row) {
-  return row.pass() ? std::abs(row.phi1) * row.result.gci21
+double fine_grid_uncertainty(const GciRow& row, double formal_order) {
+  return row.pass() ? capped_gci(row, row.phi1 - row.phi2, row.h2 / row.h1, formal_order)
                     : non_asymptotic_uncertainty(row, row.phi1, row.phi2);
 }
 
-double middle_grid_uncertainty(const GciRow& row) {
-  return row.pass() ? std::abs(row.phi2) * row.result.gci32
+double middle_grid_uncertainty(const GciRow& row, double formal_order) {
+  return row.pass() ? capped_gci(row, row.phi2 - row.phi3, row.h3 / row.h2, formal_order)
                     : non_asymptotic_uncertainty(row, row.phi2, row.phi1);
 }
 

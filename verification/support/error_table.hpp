@@ -102,15 +102,18 @@ GciRow make_gci_row(const std::string& study, const std::string& quantity, doubl
 GciRow make_two_grid_gci_row(const std::string& study, const std::string& quantity, double h1,
                              double h2, double phi1, double phi2, double assumed_order);
 /// The discretisation uncertainty of a three-grid study's finest value phi1, or of its middle
-/// value phi2. In the asymptotic range (pass()): Roache's GCI, |phi1| GCI21 or |phi2| GCI32.
-/// Otherwise nothing can be extrapolated: a monotonic triple gives the change between the
+/// value phi2. In the asymptotic range (pass()): Roache's GCI, Fs |phi1 - phi2| / (r21^p - 1)
+/// or Fs |phi2 - phi3| / (r32^p - 1), with the observed order p held at or below the formal
+/// one (with a constant refinement ratio the asymptotic ratio is phi1 / phi2 for any p, so it
+/// cannot tell an order of 10 from one of 2; an order above the formal one is a cancellation,
+/// as in coarse_level_error). Otherwise nothing can be extrapolated: a monotonic triple gives the change between the
 /// finest pair |phi1 - phi2|; an oscillating or stagnant one at least half the range of its
 /// three values (Stern, Wilson, Coleman and Paterson, J. Fluids Eng. 123, 793, 2001), since
 /// the finest pair of an oscillation may agree by accident (on synthetic triples with a
 /// random first-order scatter, |phi1 - phi2| alone covers the true error of phi1 in about two
 /// thirds of the oscillating draws, this rule in over nine tenths: support.GridUncertainty).
-double fine_grid_uncertainty(const GciRow& row);
-double middle_grid_uncertainty(const GciRow& row);
+double fine_grid_uncertainty(const GciRow& row, double formal_order);
+double middle_grid_uncertainty(const GciRow& row, double formal_order);
 
 /// The error of a three-level study's coarsest value phi3, where the study refines from the
 /// setting in production (the time-step studies: phi3 at the production step). Richardson

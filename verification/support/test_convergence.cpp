@@ -452,21 +452,67 @@ TEST(GciRows, AnOscillatingTripleIsNotInTheAsymptoticRangeWhateverItsRatio) {
   EXPECT_NEAR(row.result.asymptotic_ratio, 1.0, 1e-3);
   EXPECT_FALSE(row.pass());
   // Not extrapolated: the finest change 2.7e-4 against half the range 4.1e-4.
-  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(row), 0.5 * (4.2656900566716338 - 4.2648678966915456));
-  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(row), cv::fine_grid_uncertainty(row));
+  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(row, 2.0),
+                   0.5 * (4.2656900566716338 - 4.2648678966915456));
+  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(row, 2.0), cv::fine_grid_uncertainty(row, 2.0));
 }
 
 TEST(GridUncertainty, MonotonicTriplesKeepTheGciOrTheFinestChange) {
   const auto phi = [](double h) { return 3.0 + 0.3 * h * h; };
   const cv::GciRow asymptotic = cv::make_gci_row("s", "q", 0.1, 0.2, 0.4, phi(0.1), phi(0.2), phi(0.4));
   ASSERT_TRUE(asymptotic.pass());
-  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(asymptotic), phi(0.1) * asymptotic.result.gci21);
-  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(asymptotic), phi(0.2) * asymptotic.result.gci32);
-  // Monotonic, far from the asymptotic range (changes 1, then 0.1): the finest change.
+  EXPECT_NEAR(cv::fine_grid_uncertainty(asymptotic, 2.0), phi(0.1) * asymptotic.result.gci21, 1e-15);
+  EXPECT_NEAR(cv::middle_grid_uncertainty(asymptotic, 2.0), phi(0.2) * asymptotic.result.gci32,
+              1e-15);
+  // Changes 1, then 0.1 as the grid coarsens: the changes grow with refinement, so the triple
+  // is not converging and its uncertainty is the finest change.
   const cv::GciRow slow = cv::make_gci_row("s", "q", 0.1, 0.2, 0.4, 3.0, 4.0, 4.1);
   ASSERT_FALSE(slow.pass());
-  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(slow), 1.0);
-  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(slow), 1.0);
+  EXPECT_DOUBLE_EQ(cv::fine_grid_uncertainty(slow, 2.0), 1.0);
+  EXPECT_DOUBLE_EQ(cv::middle_grid_uncertainty(slow, 2.0), 1.0);
+}
+
+// With a constant refinement ratio the asymptotic ratio is phi1 / phi2 whatever the order, so
+// it passes an observed order of 10 (the `full` reference's shock speed on 0.4/0.2/0.1, whose
+// GCI21 at that order was 8.4e-8). The uncertainty holds the order at the formal one.
+TEST(GridUncertainty, AnOrderAboveTheFormalOneIsHeldAtIt) {
+  const double e21 = 1e-4, e32 = e21 * std::pow(2.0, 9.886);
+  const cv::GciRow row = cv::make_gci_row("s", "shock_speed", 0.1, 0.2, 0.4, 4.265, 4.265 + e21,
+                                          4.265 + e21 + e32);
+  ASSERT_TRUE(row.pass());
+  EXPECT_NEAR(row.result.order, 9.886, 1e-6);
+  EXPECT_NEAR(cv::fine_grid_uncertainty(row, 2.0), 1.25 * e21 / 3.0, 1e-15);
+  EXPECT_NEAR(cv::middle_grid_uncertainty(row, 2.0), 1.25 * e32 / 3.0, 1e-12);
+  EXPECT_GT(cv::fine_grid_uncertainty(row, 2.0), 300.0 * 4.265 * row.result.gci21);
+}
+
+// Synthetic triples of known truth 10 with smooth second- and third-order errors of random
+// signs (cancellations give observed orders far from 2): the GCI held at order 2 covers the
+// true error of phi1 at least as often as with the observed order, in at least 97 % of the
+// converging draws.
+TEST(GridUncertainty, HeldAtTheFormalOrderItCoversMixedSeries) {
+  std::mt19937_64 random(20261203);
+  std::normal_distribution<double> coefficient(0.0, 1.0);
+  std::uniform_real_distribution<double> scale(0.025, 0.25);
+  int converging = 0, covered = 0, covered_uncapped = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double a = coefficient(random), b = coefficient(random), h1 = scale(random);
+    const auto phi = [&](double h) { return 10.0 + a * h * h + b * h * h * h; };
+    const cv::GciRow row = cv::make_gci_row("synthetic", "q", h1, 2 * h1, 4 * h1, phi(h1),
+                                            phi(2 * h1), phi(4 * h1));
+    if (!row.pass()) continue;
+    ++converging;
+    const double truth = std::abs(phi(h1) - 10.0);
+    covered += cv::fine_grid_uncertainty(row, 2.0) >= truth;
+    covered_uncapped += cv::fine_grid_uncertainty(row, 100.0) >= truth;
+  }
+  const double coverage = double(covered) / converging;
+  const double uncapped = double(covered_uncapped) / converging;
+  std::printf("%d converging triples: coverage %.4f held at order 2, %.4f with the observed order\n",
+              converging, coverage, uncapped);
+  ASSERT_GT(converging, 10000);
+  EXPECT_GE(coverage, 0.97);
+  EXPECT_GE(coverage, uncapped);
 }
 
 // Synthetic triples of known truth 10: a smooth second-order error plus a random first-order
@@ -485,7 +531,7 @@ TEST(GridUncertainty, CoversTheTrueErrorOfOscillatingTriples) {
     if (row.result.kind != cv::ConvergenceKind::oscillatory) continue;
     ++oscillating;
     const double truth = std::abs(phi[0] - 10.0);
-    covered += cv::fine_grid_uncertainty(row) >= truth;
+    covered += cv::fine_grid_uncertainty(row, 2.0) >= truth;
     covered_by_finest_change += std::abs(phi[0] - phi[1]) >= truth;
   }
   const double coverage = double(covered) / oscillating;
