@@ -371,7 +371,8 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
     values.push_back(box ? run_box_from_column(dir, run_label, cell, integrator_settings(c, f))
                          : run_base_case(dir, run_label, cell, integrator_settings(c, f)));
   }
-  const auto rows = three_grid_rows("real-time-" + label, scales, values, 2, false);
+  // The box's cell 0.5 does not resolve the fitted front (nan at every step): no row for it.
+  const auto rows = three_grid_rows("real-time-" + label, scales, values, 2, false, box);
 
   // The grid uncertainty at `cell` of the column with the transport's reference integrator: in
   // 1D that of the finest of 4 cell, 2 cell, cell; in 3D that of the middle of 2 cell, cell,
