@@ -210,9 +210,8 @@ double non_asymptotic_uncertainty(const GciRow& row, double value, double neighb
 
 /// Roache's GCI of the change `change` over refinement ratio r, the order held at `formal`.
 double capped_gci(const GciRow& row, double change, double r, double formal) {
-  constexpr double safety_factor = 1.25;  // three grids (three_grid_gci's default)
   const double order = std::min(row.result.order, formal);
-  return safety_factor * std::abs(change) / (std::pow(r, order) - 1.0);
+  return safety_factor_three_grids * std::abs(change) / (std::pow(r, order) - 1.0);
 }
 }  // namespace
 
