@@ -426,7 +426,6 @@ INSTANTIATE_TEST_SUITE_P(Variants, NightlyMmsSpace3D,
                          ::testing::Values(Transport::full, Transport::paper),
                          transport_name);
 
-}  // namespace
 // --- The wall cells' closure, which sets n's maximum norm in 3D.
 //
 // Beside a wall the reconstruction takes a one-sided slope (riemann.cpp), exact for
@@ -462,3 +461,5 @@ TEST(MmsWallClosure, SecondCellExcessOfTheDensityErrorIsThirdOrder) {
     EXPECT_NEAR(order, 3.0, 0.2);
   }
 }
+
+}  // namespace

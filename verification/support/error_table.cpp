@@ -327,6 +327,12 @@ std::vector<std::filesystem::path> write_study_files(
   return written;
 }
 
+std::vector<std::filesystem::path> write_bounds(const std::filesystem::path& directory,
+                                                const std::string& name,
+                                                std::span<const BoundCheck> rows) {
+  return write_study_files(directory, name, {{".bounds.csv", bounds_to_csv(rows)}});
+}
+
 std::vector<std::filesystem::path> write_study(const std::filesystem::path& directory,
                                                const std::string& name, const ErrorTable& table,
                                                std::span<const OrderCheck> checks,

@@ -106,12 +106,13 @@ GciRow make_two_grid_gci_row(const std::string& study, const std::string& quanti
 /// or Fs |phi2 - phi3| / (r32^p - 1), with the observed order p held at or below the formal
 /// one (with a constant refinement ratio the asymptotic ratio is phi1 / phi2 for any p, so it
 /// cannot tell an order of 10 from one of 2; an order above the formal one is a cancellation,
-/// as in coarse_level_error). Otherwise nothing can be extrapolated: a monotonic triple gives the change between the
-/// finest pair |phi1 - phi2|; an oscillating or stagnant one at least half the range of its
-/// three values (Stern, Wilson, Coleman and Paterson, J. Fluids Eng. 123, 793, 2001), since
-/// the finest pair of an oscillation may agree by accident (on synthetic triples with a
-/// random first-order scatter, |phi1 - phi2| alone covers the true error of phi1 in about two
-/// thirds of the oscillating draws, this rule in over nine tenths: support.GridUncertainty).
+/// as in coarse_level_error). Otherwise nothing can be extrapolated: a monotonic triple gives
+/// the change between the finest pair |phi1 - phi2|; an oscillating or stagnant one at least
+/// half the range of its three values (Stern, Wilson, Coleman and Paterson, J. Fluids Eng.
+/// 123, 793, 2001), since the finest pair of an oscillation may agree by accident (on
+/// synthetic triples with a random first-order scatter, |phi1 - phi2| alone covers the true
+/// error of phi1 in about two thirds of the oscillating draws, this rule in over nine tenths:
+/// support.GridUncertainty).
 double fine_grid_uncertainty(const GciRow& row, double formal_order);
 double middle_grid_uncertainty(const GciRow& row, double formal_order);
 
@@ -158,6 +159,11 @@ inline constexpr const char* study_directory_variable = "SHAKER_CONVERGENCE_DIR"
 std::vector<std::filesystem::path> write_study_files(
     const std::filesystem::path& directory, const std::string& name,
     const std::vector<std::pair<std::string, std::string>>& files);
+
+/// Writes <directory>/<name>.bounds.csv like write_study_files (and to SHAKER_CONVERGENCE_DIR).
+std::vector<std::filesystem::path> write_bounds(const std::filesystem::path& directory,
+                                                const std::string& name,
+                                                std::span<const BoundCheck> rows);
 
 /// Writes <directory>/<name>.errors.csv and <name>.orders.csv (and <name>.gci.csv when GCI
 /// rows are given), atomically; when SHAKER_CONVERGENCE_DIR is set, writes the same files there
