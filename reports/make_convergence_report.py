@@ -22,21 +22,27 @@ allowed); names contain no commas.
       pair orders lie within `tolerance` of `design_order` (the next pair may be missing, nan,
       only when fit_points < 3).
   *.gci.csv      study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,
-                 relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,
-                 convergence,asymptotic_tolerance,pass
+                 relative_difference21,extrapolated_error21,gci21,gci32,convergence,
+                 design_order,order_tolerance,uncertainty1,pass
       A quantity of interest on three grids (1 finest) with Roache's GCI (Fs = 1.25, relative
-      quantities as fractions) and the asymptotic-range ratio GCI32 / (r21^p GCI21); the judge
-      (GciRow::pass) passes it when |ratio - 1| <= asymptotic_tolerance. A two-grid row
-      (convergence "two-grids"; h3, phi3, gci32, ratio and pass nan; assumed order, Fs = 3) is
-      shown as "not checked" and is not counted as a check. Each study gets a figure below
-      the table: phi against h per quantity, with phi_extrapolated and the GCI21 band.
+      quantities as fractions), the observed order (negative where the changes grow under
+      refinement) and the uncertainty of phi1 in phi's units (GciRow: Fs 1.25 in the
+      asymptotic range, Fs 3 outside it, at least half the range where the triple does not
+      converge monotonically). The judge (GciRow::pass) places the triple in the asymptotic
+      range when it converges monotonically at an order within order_tolerance of
+      design_order. A two-grid row (convergence "two-grids"; h3, phi3, gci32 and pass nan;
+      assumed order, Fs = 3) is shown as "not checked" and is not counted as a check. Each
+      study gets a figure below the table: phi against h per quantity, with phi_extrapolated
+      and the band phi1 ± uncertainty1.
   *.bounds.csv   study,quantity,value,value_basis,bound,bound_basis,pass
       A study's claim that an error lies within an uncertainty (BoundCheck): the time error of
       the production step within the grid error (time-step studies), |3D - 1D| within the
       combined grid uncertainty, a fast integrator's difference from the reference within the
       reference's grid uncertainty. The judge passes it when value <= bound; a row without a
       bound (nan) is "not checked". A time-step study's GCI rows are diagnostics there (their
-      ratio decides whether the time error may be extrapolated), shown as "not checked".
+      order sets the safety factor of the time error), shown as "not checked". Bound tables
+      in the subfolder awaiting-rerun/ were computed by a former rule: they are shown apart,
+      with their former verdicts, and are not checks of the report.
   *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,
                       standard_error
       MD sampling convergence (verification/sampling/md_sampling.hpp): the standard error
@@ -97,7 +103,7 @@ ORDERS_HEADER = ["study", "field", "norm", "fit_points", "fitted_order", "order_
                  "pair_order_finest", "pair_order_next", "design_order", "tolerance", "pass"]
 GCI_HEADER = ["study", "quantity", "h1", "h2", "h3", "phi1", "phi2", "phi3", "order",
               "phi_extrapolated", "relative_difference21", "extrapolated_error21", "gci21",
-              "gci32", "asymptotic_ratio", "convergence", "asymptotic_tolerance", "pass"]
+              "gci32", "convergence", "design_order", "order_tolerance", "uncertainty1", "pass"]
 SAMPLING_HEADER = ["study", "quantity", "phase", "K", "blocks", "degrees_of_freedom",
                    "effective_K", "missing", "standard_error"]
 SAMPLING_FIT_HEADER = ["study", "quantity", "phase", "fit_points", "fitted_slope",
@@ -106,6 +112,8 @@ BIN_SIZE_HEADER = ["study", "quantity", "phase", "sigma_value", "half_sigma_valu
                    "value", "criterion", "limit", "pass"]
 TERM_SHARES_HEADER = ["study", "term", "equation", "rms", "share"]
 BOUNDS_HEADER = ["study", "quantity", "value", "value_basis", "bound", "bound_basis", "pass"]
+# A subfolder of the input whose bound checks a former judge computed (awaiting_section).
+AWAITING_RERUN = "awaiting-rerun"
 TEXT_COLUMNS = {"study", "field", "norm", "quantity", "convergence", "statistic", "criterion",
                 "term", "equation", "value_basis", "bound_basis"}
 # The tables whose judge leaves some rows unchecked (pass nan).
@@ -206,16 +214,29 @@ def is_judge_verdict(cell, header):
 TABLES_DIRECTORY = "convergence-tables"
 
 
+def copied_name(name):
+    """The input file's name in the copied tables: flat, but for the tables awaiting a rerun,
+    which stay in their folder so that the next report reads them as such again."""
+    if is_awaiting_rerun(name):
+        return os.path.join(AWAITING_RERUN, os.path.basename(name))
+    return os.path.basename(name)
+
+
+def is_awaiting_rerun(relative_path):
+    return relative_path.split(os.sep)[0] == AWAITING_RERUN
+
+
 def copy_tables(input_dir, files, tables):
-    """Replaces `tables` by a flat copy of the input CSV files, filled aside and renamed into
-    place, so a reader never sees a half-copied set."""
+    """Replaces `tables` by a copy of the input CSV files (copied_name), filled aside and
+    renamed into place, so a reader never sees a half-copied set."""
     parent = os.path.dirname(tables)
     os.makedirs(parent, exist_ok=True)  # no plot has made it when the input has no error table
     staging = tempfile.mkdtemp(dir=parent, prefix=".partial-tables-")
     try:
         for name in files:
-            shutil.copyfile(os.path.join(input_dir, name),
-                            os.path.join(staging, os.path.basename(name)))
+            target = os.path.join(staging, copied_name(name))
+            os.makedirs(os.path.dirname(target), exist_ok=True)
+            shutil.copyfile(os.path.join(input_dir, name), target)
         old = None
         if os.path.exists(tables):
             old = tempfile.mkdtemp(dir=parent, prefix=".old-tables-")
@@ -239,7 +260,7 @@ def remove_stale_plots(out_dir, report_text):
 
 def read_inputs(directory):
     found = {"errors": [], "orders": [], "gci": [], "bounds": [], "sampling": [],
-             "sampling-fit": [], "bin-size": [], "term-shares": []}
+             "sampling-fit": [], "bin-size": [], "term-shares": [], "awaiting-bounds": []}
     files = []
     for kind, header in (("errors", ERRORS_HEADER), ("orders", ORDERS_HEADER), ("gci", GCI_HEADER),
                          ("bounds", BOUNDS_HEADER), ("sampling", SAMPLING_HEADER),
@@ -257,8 +278,12 @@ def read_inputs(directory):
                         bin_size_value_units(record)
                 except InputProblem as problem:
                     raise InputProblem(f"{path}: {problem}") from None
-            found[kind].extend(records)
-            files.append(os.path.relpath(path, directory))
+            relative = os.path.relpath(path, directory)
+            awaiting = is_awaiting_rerun(relative)
+            if awaiting and kind != "bounds":
+                raise InputProblem(f"{path}: only bound checks can await a rerun")
+            found["awaiting-bounds" if awaiting else kind].extend(records)
+            files.append(relative)
     return found, files
 
 
@@ -364,7 +389,7 @@ def gci_order_text(r):
 
 
 def gci_panel(ax, r, h_label):
-    """One GCI row: phi on its grids against h, phi_extrapolated and phi1 ± |phi1| GCI21."""
+    """One GCI row: phi on its grids against h, phi_extrapolated and phi1 ± uncertainty1."""
     grids = [(r[f"h{i}"], r[f"phi{i}"]) for i in (1, 2, 3)
              if math.isfinite(r[f"h{i}"]) and math.isfinite(r[f"phi{i}"])]
     if grids:
@@ -374,9 +399,10 @@ def gci_panel(ax, r, h_label):
         label_log_ticks(ax, h)
     if math.isfinite(r["phi_extrapolated"]):
         ax.axhline(r["phi_extrapolated"], color="k", ls="--", lw=1, label="extrapolated")
-    band = abs(r["phi1"]) * r["gci21"]
+    band = r["uncertainty1"]
     if math.isfinite(band):
-        ax.axhspan(r["phi1"] - band, r["phi1"] + band, color="C1", alpha=0.25, label="GCI21")
+        ax.axhspan(r["phi1"] - band, r["phi1"] + band, color="C1", alpha=0.25,
+                   label="uncertainty")
     ax.set_title(f"{r['quantity']}: {gci_order_text(r)}", fontsize=8)
     ax.set_xlabel(h_label, fontsize=8)
     ax.set_ylabel(rc.with_units("phi", units_of(r["quantity"])), fontsize=8)
@@ -496,7 +522,7 @@ def order_failure(r):
 
 def gci_result_text(r, mark):
     if mark != NOT_CHECKED:
-        return f"{mark} (band 1 ± {rc.fmt(r['asymptotic_tolerance'])})"
+        return f"{mark} (p in {rc.fmt(r['design_order'])} ± {rc.fmt(r['order_tolerance'])})"
     if r["convergence"] == "two-grids":
         return f"{mark} (two grids, assumed p, Fs = 3)"
     return f"{mark} (a diagnostic: the study's claim is its bound check)"
@@ -508,13 +534,13 @@ def gci_line(r, mark):
         [r["study"], r["quantity"], units_of(r["quantity"])]
         + [rc.fmt(r[k], 6) for k in ("phi1", "phi2", "phi3")]
         + [rc.fmt(r["order"], 4), rc.fmt(r["phi_extrapolated"], 6)] + percent
-        + [rc.fmt(r["asymptotic_ratio"], 4), r["convergence"], gci_result_text(r, mark)])
+        + [rc.fmt(r["uncertainty1"], 3), r["convergence"], gci_result_text(r, mark)])
 
 
 def gci_failure(r):
-    return (f"GCI {r['study']} / {r['quantity']}: asymptotic ratio "
-            f"{rc.fmt(r['asymptotic_ratio'], 4)} outside 1 ± "
-            f"{rc.fmt(r['asymptotic_tolerance'])} ({r['convergence']})")
+    return (f"GCI {r['study']} / {r['quantity']}: observed order {rc.fmt(r['order'], 4)} "
+            f"({r['convergence']}) outside the asymptotic range "
+            f"{rc.fmt(r['design_order'])} ± {rc.fmt(r['order_tolerance'])}")
 
 
 def bound_line(r, mark):
@@ -544,6 +570,24 @@ def bound_section(data, failures):
             "the production step with the grid error at the production cell.", ""] + table, checks
 
 
+def awaiting_section(data):
+    """The bound checks a former judge computed, kept for information until the nightly reruns
+    their studies; not checks of this report."""
+    rows = sorted(data["awaiting-bounds"], key=lambda r: (r["study"], r["quantity"]))
+    if not rows:
+        return []
+    former = {1: "former: pass", 0: "former: fail"}
+    header = ("| study | quantity | units | value | value basis | bound | bound basis | "
+              "value / bound [1] | former verdict |")
+    lines = ["## Bound checks awaiting a rerun", "",
+             f"Tables in {AWAITING_RERUN}/: computed with a former rule for the grid uncertainty "
+             "and the time error, and not counted in this report's checks. The nightly rerun "
+             "of their studies replaces them; until then their former verdicts are shown for "
+             "information.", "", header, "|---" * (header.count("|") - 1) + "|"]
+    lines += [bound_line(r, former.get(r["pass"], "not checked")) for r in rows]
+    return lines + [""]
+
+
 def order_section(data, failures):
     """The observed orders against the design order; returns (lines, checks)."""
     rows = sorted(data["orders"], key=lambda r: (r["study"], r["field"],
@@ -560,17 +604,21 @@ def gci_section(data, out_dir, failures):
     rows = sorted(data["gci"], key=lambda r: (r["study"], r["quantity"]))
     table, checks = judged_table(
         "| study | quantity | units | phi1 (fine) | phi2 | phi3 | p [1] | phi extrapolated | "
-        "e21 [%] | GCI21 [%] | GCI32 [%] | ratio [1] | convergence | result |", rows, gci_line,
-        gci_failure, failures, "no GCI studies found")
+        "e21 [%] | GCI21 [%] | GCI32 [%] | uncertainty of phi1 | convergence | result |",
+        rows, gci_line, gci_failure, failures, "no GCI studies found")
     plots = []
     for study in dict.fromkeys(r["study"] for r in rows):
         name = plot_gci_study(study, [r for r in rows if r["study"] == study], out_dir)
         plots += [f"![{study}]({name})", ""]
     return ["## Grid convergence index of the quantities of interest", "",
-            "GCI in percent of the fine-grid value (Fs = 1.25); asymptotic ratio = "
-            "GCI32 / (r21^p GCI21), close to 1 in the asymptotic range; phi in the units "
-            "of its row. The figures: phi against h (the step scale of a time-step study), "
-            "dashed the extrapolated value, shaded the band phi1 ± |phi1| GCI21.",
+            "GCI in percent of the fine-grid value (Fs = 1.25, the observed order); the "
+            "uncertainty of phi1 in the units of its row: the GCI with Fs 1.25 where the grids "
+            "are in the asymptotic range (monotonic, observed order within the band of the "
+            "design order), Fs 3 with the order held within [0.5, design order] where they are "
+            "not, at least half the range of the three values where they do not converge "
+            "monotonically (Oberkampf and Roy 2010, section 8.6; Stern et al. 2001). The "
+            "figures: phi against h (the step scale of a time-step study), dashed the "
+            "extrapolated value, shaded the band phi1 ± its uncertainty.",
             ""] + table + plots, checks
 
 
@@ -719,7 +767,7 @@ def main(argv=None):
     if failures:
         lines += ["", "Failing checks (measured values):", ""] + [f"- {f}" for f in failures]
     lines.append("")
-    lines += (order_lines + gci_lines + bound_lines + sampling_lines +
+    lines += (order_lines + gci_lines + bound_lines + awaiting_section(data) + sampling_lines +
               term_share_tables(data["term-shares"]) + error_tables(series) + plot_lines)
     tables = os.path.join(out_dir, TABLES_DIRECTORY)
     lines += ["## Input files", "",

@@ -57,7 +57,8 @@ class Results:
 
     def gci(self, quantity, cell_size):
         """The GCI row of the real-problem study whose finest grid is the validation run's
-        cell size (so GCI21 is the discretisation uncertainty of that run's value)."""
+        cell size (so its uncertainty1 is the discretisation uncertainty of that run's
+        value)."""
         if cell_size is None:
             return None
         for r in self.gci_rows:
@@ -464,9 +465,10 @@ def mark(status):
 
 
 def gci_text(results, claim, value):
-    """The continuum value's grid uncertainty: |value| GCI21 of the real-problem study at
-    the validation run's cell size, for claims whose continuum value that study computes
-    (the claim's `continuum_gci` in reference-data/claims.toml)."""
+    """The continuum value's grid uncertainty: the real-problem study's uncertainty of its
+    finest value (uncertainty1, GciRow) at the validation run's cell size, relative to that
+    value and applied to the validation run's, for claims whose continuum value that study
+    computes (the claim's `continuum_gci` in reference-data/claims.toml)."""
     quantity = claim.get("continuum_gci")
     if not quantity or not isinstance(value, (int, float)):
         return ""
@@ -476,12 +478,13 @@ def gci_text(results, claim, value):
     if row is None:
         return f" (GCI: no {quantity} row at cell {cell} in the convergence tables)"
     cells = ", ".join(f"{row[h]:g}" for h in ("h1", "h2", "h3"))
-    gci = row["gci21"]
-    if math.isnan(gci):
-        return f" (GCI n/a: {row['convergence']} on cells {cells})"
-    asymptotic = "asymptotic" if row["pass"] == 1 \
-        else f"not asymptotic, {row['convergence']}"
-    return f" ± {fmt(abs(value) * gci, 2)} (GCI {fmt(100 * gci, 2)} %, cells {cells}; {asymptotic})"
+    relative = row["uncertainty1"] / abs(row["phi1"]) if row["phi1"] else float("nan")
+    if not math.isfinite(relative):
+        return f" (grid uncertainty n/a: {row['convergence']} on cells {cells})"
+    asymptotic = "asymptotic, Fs 1.25" if row["pass"] == 1 \
+        else f"not asymptotic: {row['convergence']}, p {fmt(row['order'], 2)}"
+    return (f" ± {fmt(abs(value) * relative, 2)} (grid {fmt(100 * relative, 2)} %, "
+            f"cells {cells}; {asymptotic})")
 
 
 def solver_cell(results, claim, solver):
@@ -517,13 +520,14 @@ def claims_section(results):
              "periodic run, or the pooled single-shock runs), from `shaker analyze` and "
              "`shaker compare`; a value quantised to the stored phases or to the bins also "
              "carries its rounding error, grid step / sqrt(12) (docs/analysis.md). Continuum "
-             "uncertainty: that rounding error where it applies, and Roache's grid-convergence "
-             "index (Fs = 1.25) of the 1D base-case grid study (verification/grid-studies/"
-             f"test_real_problem.cpp, tables in {gci_source}) at the validation run's cell "
-             "size, for the claims whose continuum value that study computes (field "
-             "continuum_gci of the claim); the study's shortened run (5 transient cycles, "
-             "one sampled) estimates the discretisation error only. Other continuum values "
-             "carry no uncertainty here.",
+             "uncertainty: that rounding error where it applies, and the grid uncertainty "
+             "(Roache's GCI with Fs 1.25 in the asymptotic range, Fs 3 outside it, at least "
+             "half the range of an oscillating triple) of the 1D base-case grid study "
+             f"(verification/grid-studies/test_real_problem.cpp, tables in {gci_source}) at "
+             "the validation run's cell size, for the claims whose continuum value that "
+             "study computes (field continuum_gci of the claim); the study's shortened run "
+             "(5 transient cycles, one sampled) estimates the discretisation error only. "
+             "Other continuum values carry no uncertainty here.",
              "",
              "Verdicts: **pass** when the value lies inside the band by more than 2 standard "
              "errors; **FAIL** when it lies outside by more than 2; **unresolved** in between "

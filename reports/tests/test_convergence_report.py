@@ -35,8 +35,8 @@ REPORTS = os.path.dirname(SCRIPT)
 ORDERS_HEADER = ("study,field,norm,fit_points,fitted_order,order_std_error,pair_order_finest,"
                  "pair_order_next,design_order,tolerance,pass")
 GCI_HEADER = ("study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,"
-              "relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,"
-              "convergence,asymptotic_tolerance,pass")
+              "relative_difference21,extrapolated_error21,gci21,gci32,convergence,"
+              "design_order,order_tolerance,uncertainty1,pass")
 BOUNDS_HEADER = "study,quantity,value,value_basis,bound,bound_basis,pass"
 
 
@@ -73,17 +73,16 @@ def synthetic_study(directory):
     e21 = abs(phi[0] - phi[1]) / phi[0]
     gci21 = 1.25 * e21 / 3.0
     gci32 = 1.25 * abs(phi[1] - phi[2]) / phi[1] / 3.0
-    ratio = gci32 / (4.0 * gci21)
     write(os.path.join(directory, "qoi.gci.csv"), GCI_HEADER, [
         ("base-1d", "shock_location", 0.025, 0.05, 0.1, *phi, 2.0, 2.0, e21, 0.0, gci21, gci32,
-         ratio, "monotonic", 0.1, 1),
+         "monotonic", 2, 0.1, phi[0] * gci21, 1),
         ("base-1d", "max_mach", 0.025, 0.05, 0.1, 3.1, 3.0, 3.3, 1.5, 3.2, 0.032, 0.03, 0.05,
-         0.4, 2.8, "oscillatory", 0.1, 0),
+         0.4, "oscillatory", 2, 0.1, 0.15, 0),
         ("base-3d", "shock_location", 0.5, 1.0, "nan", 1.01, 1.04, "nan", 2.0, 1.0, 0.0297, 0.01,
-         0.0297, "nan", "nan", "two-grids", "nan", "nan"),
-        # A time-step study's row: its ratio is a diagnostic (the claim is its bound check).
+         0.0297, "nan", "two-grids", 2, "nan", 0.03, "nan"),
+        # A time-step study's row: its order is a diagnostic (the claim is its bound check).
         ("real-time-x", "max_mach", 0.25, 0.5, 1.0, 3.1, 3.0, 3.3, 1.5, 3.2, 0.032, 0.03, 0.05,
-         0.4, 2.8, "oscillatory", 0.1, "nan")])
+         0.4, "oscillatory", 2, 0.1, 0.15, "nan")])
     write(os.path.join(directory, "qoi.bounds.csv"), BOUNDS_HEADER, [
         ("real-time-x", "max_mach", 0.001, "time error of the production step (largest change)",
          0.002, "grid uncertainty at cell 0.1 (finest of 0.4/0.2/0.1)", 1),
@@ -150,7 +149,7 @@ JUDGED_TABLES = {
     "bin-size": ("### Bin size: sigma against sigma/2", ("study", "quantity", "phase")),
     "bounds": ("## Errors within their uncertainty", ("study", "quantity")),
 }
-# Only a GCI mark carries a note: its band, or why a two-grid row is not checked.
+# Only a GCI mark carries a note: its order band, or why a row is not checked.
 NOTED_TABLES = {"gci"}
 PHASE_COLUMN = "f t [1]"
 
@@ -232,7 +231,9 @@ def check_marks_follow_the_judge(input_dir, text, label):
     for kind, (heading, key_columns) in JUDGED_TABLES.items():
         shown_rows = tables.get(heading, [])
         paths = sorted(glob.glob(os.path.join(input_dir, "**", f"*.{kind}.csv"), recursive=True))
-        rows = [row for path in paths for row in csv_rows(path)]
+        # A former judge's bound tables are shown apart, not as checks (test below).
+        rows = [row for path in paths for row in csv_rows(path)
+                if make_convergence_report.AWAITING_RERUN not in path.split(os.sep)]
         if rows:
             assert len(shown_rows) == len(rows), \
                 f"{label}: {len(shown_rows)} rows shown under '{heading}', {len(rows)} in tables"
@@ -304,9 +305,10 @@ def test_report_on_a_synthetic_study(work_dir):
     shock = line_with(text, "| base-1d | shock_location |")
     assert "PASS" in shock and "FAIL" not in shock, f"GCI row should pass: '{shock}'"
     mach = line_with(text, "| base-1d | max_mach |")
-    assert "**FAIL**" in mach and "oscillatory" in mach and "| 2.8 |" in mach, \
-        f"GCI row should fail with ratio 2.8: '{mach}'"
-    assert line_with(text, "GCI base-1d / max_mach: asymptotic ratio 2.8") != "", \
+    assert "**FAIL**" in mach and "oscillatory" in mach and "| 0.15 |" in mach, \
+        f"GCI row should fail with its uncertainty 0.15: '{mach}'"
+    assert line_with(text, "GCI base-1d / max_mach: observed order 1.5 (oscillatory) outside "
+                     "the asymptotic range 2 ± 0.1") != "", \
         "GCI failure missing from the summary"
 
     two_grid = line_with(text, "| base-3d | shock_location |")
@@ -534,11 +536,11 @@ def test_gci_plots(work_dir):
     inputs = os.path.join(work_dir, "gci-input")
     os.makedirs(inputs)
     three_grids = ("real-time-s2", "center_of_mass_ft0.25", 0.25, 0.5, 1, 17.682, 17.6827,
-                   17.6834, 1.05, 17.6813, 4e-5, 4e-5, 5e-5, 1e-4, 1.0, "monotonic", 0.1, 1)
+                   17.6834, 1.05, 17.6813, 4e-5, 4e-5, 5e-5, 1e-4, "monotonic", 2, 0.1, 2e-3, 1)
     stagnant = ("real-time-s2", "shock_width_ft0.22", 0.25, 0.5, 1, 3.6, 3.6, 3.6, "nan",
-                "nan", 0, "nan", "nan", "nan", "nan", "stagnant", 0.1, 0)
+                "nan", 0, "nan", "nan", "nan", "stagnant", 2, 0.1, 0, 0)
     two_grids = ("real-3d", "max_mach", 0.5, 1.0, "nan", 11.17, 11.68, "nan", 2.0, 11.0, 0.046,
-                 0.015, 0.06, "nan", "nan", "two-grids", "nan", "nan")
+                 0.015, 0.06, "nan", "two-grids", 2, "nan", 0.67, "nan")
     table = os.path.join(inputs, "studies.gci.csv")
     write(table, GCI_HEADER, [three_grids, stagnant, two_grids])
     report = os.path.join(work_dir, "gci-out", "convergence.md")
@@ -559,3 +561,34 @@ def test_gci_plots(work_dir):
         "the GCI figure of a study no longer in the input survived"
     assert is_png(os.path.join(work_dir, "gci-out", "convergence-real-time-s2-gci.png")), \
         "the second run removed the GCI figure of a study still in the input"
+
+
+def test_bounds_awaiting_a_rerun_are_shown_apart_and_not_counted(work_dir):
+    """Bound tables of a former judge (subfolder awaiting-rerun/) appear in their own section
+    with their former verdicts, count as no check, and are copied back into that subfolder
+    so that the next report treats them alike; any other table there is refused."""
+    inputs = os.path.join(work_dir, "input")
+    waiting = os.path.join(inputs, "awaiting-rerun")
+    os.makedirs(waiting)
+    write(os.path.join(waiting, "old.bounds.csv"), BOUNDS_HEADER, [
+        ("real-time-y", "shock_speed", 0.005, "time error (largest change)", 0.002,
+         "grid uncertainty (finest of 0.4/0.2/0.1)", 0)])
+    write(os.path.join(inputs, "new.bounds.csv"), BOUNDS_HEADER, [
+        ("real-time-z", "max_mach", 0.001, "time error", 0.002, "grid uncertainty", 1)])
+    report = os.path.join(work_dir, "out", "convergence.md")
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 0, result.stderr
+    text = open(report).read()
+    assert "1 checks: 1 pass, 0 fail." in text, "a former verdict was counted as a check"
+    apart = text.split("## Bound checks awaiting a rerun")[-1].split("\n## ")[0]
+    old = line_with(apart, "| real-time-y | shock_speed |")
+    assert old.endswith("| 2.5 | former: fail |"), f"former verdict not shown: '{old}'"
+    assert "real-time-y" not in text.split("## Bound checks awaiting a rerun")[0], \
+        "a former verdict is shown among the judged checks"
+    copied = os.path.join(work_dir, "out", "convergence-tables", "awaiting-rerun",
+                          "old.bounds.csv")
+    assert os.path.exists(copied), "the table awaiting a rerun was not copied into its folder"
+    write(os.path.join(waiting, "old.gci.csv"), GCI_HEADER, [])
+    refused = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert refused.returncode == 2 and "only bound checks can await a rerun" in refused.stderr, \
+        f"a GCI table awaiting a rerun must be refused: {refused.returncode} {refused.stderr}"

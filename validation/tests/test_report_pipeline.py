@@ -36,18 +36,19 @@ FIGURES = ("fig1-profiles.png", "fig2-single-shock.png", "fig3-mach.png", "fig4-
 
 
 GCI_HEADER = ("study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,"
-              "relative_difference21,extrapolated_error21,gci21,gci32,asymptotic_ratio,"
-              "convergence,asymptotic_tolerance,pass")
+              "relative_difference21,extrapolated_error21,gci21,gci32,convergence,"
+              "design_order,order_tolerance,uncertainty1,pass")
 
 
 def write_gci_table(path):
-    """A GCI of 2 % for C6's quantity at every cell size the quick cases might use, and no row
-    for C5's, so the report must show one uncertainty and say why the other is missing."""
+    """A grid uncertainty of 2 % for C6's quantity at every cell size the quick cases might
+    use, and no row for C5's, so the report must show one uncertainty and say why the other
+    is missing."""
     with open(path, "w") as f:
         f.write(GCI_HEADER + "\n")
         for h in (0.05, 0.1, 0.2, 0.25, 0.4, 0.5, 1.0):
             f.write(f"synthetic,max_mach_ft0.08-0.13,{h},{2 * h},{4 * h},11,11.1,11.3,2,10.97,"
-                    "0.009,0.003,0.02,0.04,1.0,monotonic,0.1,1\n")
+                    "0.009,0.003,0.02,0.04,monotonic,2,0.1,0.22,1\n")
 
 
 def run_validation(shaker, workdir, report, require, gci):
@@ -144,13 +145,14 @@ def test_report_pipeline(shaker, work_dir):
     # Columns of the claims table: id, claim, units, paper, MD, continuum, band, result.
     c6, c5 = rows.get("C6", "").split(" | "), rows.get("C5", "").split(" | ")
     c6_continuum = c6[5] if len(c6) > 5 else ""
-    shown = re.search(r"([0-9.eE+-]+) ± ([0-9.eE+-]+) \(GCI 2 %", c6_continuum)
+    shown = re.search(r"([0-9.eE+-]+) ± ([0-9.eE+-]+) \(grid 2 %", c6_continuum)
     assert (shown is not None and abs(float(shown.group(2)) - 0.02 * abs(float(shown.group(1))))
             <= 0.01 * abs(float(shown.group(1)))), \
-        f"C6 continuum value carries its GCI, 2 % of the value: '{c6_continuum}'"
+        f"C6 continuum value carries its grid uncertainty, 2 % of the value: '{c6_continuum}'"
     assert len(c5) > 5 and "no shock_width_ft0.22 row" in c5[5], \
         f"C5 says its GCI row is missing: '{c5[5] if len(c5) > 5 else ''}'"
-    assert "GCI" not in (c6[4] if len(c6) > 4 else "GCI"), "the MD value carries no GCI"
+    assert "grid" not in (c6[4] if len(c6) > 4 else "grid"), \
+        "the MD value carries no grid uncertainty"
     check_units(text, rows, claims, tmp)
     check_missing_units_are_refused(os.path.join(workdir, "results.json"), tmp)
 

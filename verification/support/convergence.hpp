@@ -39,6 +39,10 @@ std::string to_string(ConvergenceKind kind);
 
 inline constexpr double safety_factor_three_grids = 1.25;
 inline constexpr double safety_factor_two_grids = 3.0;
+/// Three grids outside the asymptotic range (Oberkampf and Roy 2010), and the least order
+/// their GCI takes.
+inline constexpr double safety_factor_outside_asymptotic_range = 3.0;
+inline constexpr double least_order_outside_asymptotic_range = 0.5;
 
 /// The three-grid procedure of Celik et al. (2008): apparent order by fixed-point iteration
 /// (needed when r21 != r32), extrapolated value, relative errors, fine-grid GCI21, GCI32 and

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cmath>
 #include <fstream>
@@ -193,67 +194,79 @@ void write_orders_csv(const std::filesystem::path& path, std::span<const OrderCh
   write_text_atomically(path, orders_to_csv(checks));
 }
 
+double GciRow::observed_order() const {
+  const bool diverging = result.kind == ConvergenceKind::monotonic &&
+                         std::abs(phi3 - phi2) < std::abs(phi2 - phi1);
+  return diverging ? -result.order : result.order;
+}
+
 bool GciRow::pass() const {
   return result.kind == ConvergenceKind::monotonic &&
-         within(result.asymptotic_ratio, 1.0, asymptotic_tolerance);
+         within(observed_order(), design_order, order_tolerance);
 }
 
 namespace {
-/// |value - neighbour|, and for a triple that does not converge monotonically at least half
-/// the range of its three values.
-double non_asymptotic_uncertainty(const GciRow& row, double value, double neighbour) {
-  const double change = std::abs(value - neighbour);
-  if (row.result.kind == ConvergenceKind::monotonic) return change;
-  const auto [low, high] = std::minmax({row.phi1, row.phi2, row.phi3});
-  return std::max(change, 0.5 * (high - low));
-}
-
-/// Roache's GCI of the change `change` over refinement ratio r, the order held at `formal`.
-double capped_gci(const GciRow& row, double change, double r, double formal) {
-  const double order = std::min(row.result.order, formal);
-  return safety_factor_three_grids * std::abs(change) / (std::pow(r, order) - 1.0);
+/// The uncertainty of one grid's value given the change to its neighbour over refinement
+/// ratio r (fine_grid_uncertainty's rule).
+double grid_uncertainty(const GciRow& row, double change, double r) {
+  if (row.result.kind == ConvergenceKind::two_grids) return std::abs(row.phi1) * row.result.gci21;
+  if (row.result.kind != ConvergenceKind::monotonic) {
+    const auto [low, high] = std::minmax({row.phi1, row.phi2, row.phi3});
+    return std::max(std::abs(change), 0.5 * (high - low));
+  }
+  const double order =
+      std::clamp(row.observed_order(), least_order_outside_asymptotic_range, row.design_order);
+  const double safety =
+      row.pass() ? safety_factor_three_grids : safety_factor_outside_asymptotic_range;
+  return safety * std::abs(change) / (std::pow(r, order) - 1.0);
 }
 }  // namespace
 
-double fine_grid_uncertainty(const GciRow& row, double formal_order) {
-  return row.pass() ? capped_gci(row, row.phi1 - row.phi2, row.h2 / row.h1, formal_order)
-                    : non_asymptotic_uncertainty(row, row.phi1, row.phi2);
+double fine_grid_uncertainty(const GciRow& row) {
+  return grid_uncertainty(row, row.phi1 - row.phi2, row.h2 / row.h1);
 }
 
-double middle_grid_uncertainty(const GciRow& row, double formal_order) {
-  return row.pass() ? capped_gci(row, row.phi2 - row.phi3, row.h3 / row.h2, formal_order)
-                    : non_asymptotic_uncertainty(row, row.phi2, row.phi1);
+double middle_grid_uncertainty(const GciRow& row) {
+  // Without an order, phi2 is judged against phi1, the nearer the truth.
+  return row.result.kind == ConvergenceKind::monotonic
+             ? grid_uncertainty(row, row.phi2 - row.phi3, row.h3 / row.h2)
+             : grid_uncertainty(row, row.phi2 - row.phi1, row.h2 / row.h1);
 }
 
-CoarseLevelError coarse_level_error(const GciRow& row, double formal_order) {
-  const double change21 = row.phi2 - row.phi1, change32 = row.phi3 - row.phi2;
-  const bool converging = row.result.kind == ConvergenceKind::monotonic &&
-                          std::abs(change32) > std::abs(change21) && row.pass();
-  if (!converging)
-    return {std::max(std::abs(row.phi3 - row.phi1), std::abs(change32)),
-            CoarseLevelError::Method::largest_change};
-  const bool capped = row.result.order > formal_order;
-  const double order = capped ? formal_order : row.result.order;
-  const double extrapolated = row.phi1 - change21 / (std::pow(row.h2 / row.h1, order) - 1.0);
-  return {std::abs(row.phi3 - extrapolated),
-          capped ? CoarseLevelError::Method::extrapolated_at_formal_order
-                 : CoarseLevelError::Method::extrapolated};
+CoarseLevelError coarse_level_error(const GciRow& row) {
+  const CoarseLevelError::Method method =
+      row.result.kind != ConvergenceKind::monotonic ? CoarseLevelError::Method::no_order
+      : row.pass() ? CoarseLevelError::Method::asymptotic
+                   : CoarseLevelError::Method::outside_asymptotic_range;
+  return {std::abs(row.phi3 - row.phi1) + fine_grid_uncertainty(row), method};
 }
 
 std::string to_string(CoarseLevelError::Method method) {
   switch (method) {
-    case CoarseLevelError::Method::extrapolated: return "extrapolated";
-    case CoarseLevelError::Method::extrapolated_at_formal_order: return "extrapolated at the formal order";
-    case CoarseLevelError::Method::largest_change: return "largest change";
+    case CoarseLevelError::Method::asymptotic:
+      return "change to the finest level + its GCI with Fs 1.25";
+    case CoarseLevelError::Method::outside_asymptotic_range:
+      return "change to the finest level + its GCI with Fs 3 (not asymptotic)";
+    case CoarseLevelError::Method::no_order:
+      return "change to the finest level + at least half the range (not monotonic)";
   }
   return "unknown";
 }
 
 GciRow make_gci_row(const std::string& study, const std::string& quantity, double h1, double h2,
-                    double h3, double phi1, double phi2, double phi3,
-                    double asymptotic_tolerance) {
-  return GciRow{study, quantity, h1, h2, h3, phi1, phi2, phi3,
-                three_grid_gci(h1, h2, h3, phi1, phi2, phi3), asymptotic_tolerance};
+                    double h3, double phi1, double phi2, double phi3, double design_order,
+                    double order_tolerance) {
+  return GciRow{study,
+                quantity,
+                h1,
+                h2,
+                h3,
+                phi1,
+                phi2,
+                phi3,
+                three_grid_gci(h1, h2, h3, phi1, phi2, phi3),
+                design_order,
+                order_tolerance};
 }
 
 GciRow make_two_grid_gci_row(const std::string& study, const std::string& quantity, double h1,
@@ -271,25 +284,61 @@ GciRow make_two_grid_gci_row(const std::string& study, const std::string& quanti
   result.gci21 = two.gci21;
   result.gci32 = result.asymptotic_ratio = nan;
   result.kind = ConvergenceKind::two_grids;
-  return GciRow{study, quantity, h1, h2, nan, phi1, phi2, nan, result, nan};
+  return GciRow{study, quantity, h1, h2, nan, phi1, phi2, nan, result, assumed_order, nan};
 }
 
 std::string gci_to_csv(std::span<const GciRow> rows) {
   std::string text =
       "study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,relative_difference21,"
-      "extrapolated_error21,gci21,gci32,asymptotic_ratio,convergence,asymptotic_tolerance,pass\n";
+      "extrapolated_error21,gci21,gci32,convergence,design_order,order_tolerance,uncertainty1,"
+      "pass\n";
   for (const auto& row : rows) {
     const GciResult& r = row.result;
-    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
                         checked_name(row.study), checked_name(row.quantity), number(row.h1),
                         number(row.h2), number(row.h3), number(row.phi1), number(row.phi2),
-                        number(row.phi3), number(r.order), number(r.phi_extrapolated),
+                        number(row.phi3), number(row.observed_order()),
+                        number(r.phi_extrapolated),
                         number(r.relative_difference21), number(r.extrapolated_error21),
-                        number(r.gci21), number(r.gci32), number(r.asymptotic_ratio),
-                        to_string(r.kind), number(row.asymptotic_tolerance),
+                        number(r.gci21), number(r.gci32), to_string(r.kind),
+                        number(row.design_order), number(row.order_tolerance),
+                        number(fine_grid_uncertainty(row)),
                         row.checked() ? (row.pass() ? "1" : "0") : "nan");
   }
   return text;
+}
+
+std::vector<GciRow> gci_from_csv(const std::string& text, double design_order) {
+  std::stringstream stream(text);
+  std::string line;
+  if (!std::getline(stream, line)) throw std::runtime_error("GCI table: empty");
+  const auto header = split(line);
+  const auto column = [&](const std::string& name) {
+    const auto at = std::find(header.begin(), header.end(), name);
+    if (at == header.end()) throw std::runtime_error("GCI table: no column '" + name + "'");
+    return static_cast<std::size_t>(at - header.begin());
+  };
+  const std::size_t study = column("study"), quantity = column("quantity"),
+                    convergence = column("convergence"), pass = column("pass");
+  std::array<std::size_t, 6> grid{column("h1"),   column("h2"),   column("h3"),
+                                  column("phi1"), column("phi2"), column("phi3")};
+  std::vector<GciRow> rows;
+  for (std::size_t line_number = 2; std::getline(stream, line); ++line_number) {
+    if (line.empty()) continue;
+    const auto cells = split(line);
+    if (cells.size() != header.size())
+      throw std::runtime_error(fmt::format("GCI table line {}: expected {} columns, found {}",
+                                           line_number, header.size(), cells.size()));
+    if (cells[convergence] == "two-grids")
+      throw std::runtime_error(fmt::format(
+          "GCI table line {}: a two-grid row has no observed order to judge", line_number));
+    std::array<double, 6> x{};
+    for (std::size_t k = 0; k < grid.size(); ++k) x[k] = parse_number(cells[grid[k]], line_number);
+    rows.push_back(make_gci_row(cells[study], cells[quantity], x[0], x[1], x[2], x[3], x[4],
+                                x[5], design_order));
+    rows.back().asymptotic_range_claimed = cells[pass] != "nan";
+  }
+  return rows;
 }
 
 std::string bounds_to_csv(std::span<const BoundCheck> rows) {

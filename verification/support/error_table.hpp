@@ -6,9 +6,10 @@
 //   <name>.orders.csv  study,field,norm,fit_points,fitted_order,order_std_error,
 //                      pair_order_finest,pair_order_next,design_order,tolerance,pass
 //   <name>.gci.csv     study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,
-//                      relative_difference21,extrapolated_error21,gci21,gci32,
-//                      asymptotic_ratio,convergence,asymptotic_tolerance,pass
-//                      (two-grid rows: h3, phi3, gci32, asymptotic_ratio, pass are nan and
+//                      relative_difference21,extrapolated_error21,gci21,gci32,convergence,
+//                      design_order,order_tolerance,uncertainty1,pass
+//                      (order: GciRow::observed_order; uncertainty1: fine_grid_uncertainty,
+//                      in phi's units; two-grid rows: h3, phi3, gci32, pass are nan and
 //                      convergence is "two-grids")
 //
 // Numbers are written with 17 significant digits (exact round trip); names may not contain
@@ -79,58 +80,64 @@ std::vector<OrderCheck> check_orders(const ErrorTable& table, double design_orde
 std::string orders_to_csv(std::span<const OrderCheck> checks);
 void write_orders_csv(const std::filesystem::path& path, std::span<const OrderCheck> checks);
 
-/// A quantity of interest on three grids with its GCI analysis (or on two grids: h3, phi3 and
-/// the asymptotic ratio are NaN, the order is assumed, Fs = 3 and there is nothing to check).
+/// A quantity of interest on three grids with its GCI analysis (or on two grids: h3 and phi3
+/// are NaN, the order is assumed, Fs = 3 and there is nothing to check).
 struct GciRow {
   std::string study, quantity;
   double h1 = 0.0, h2 = 0.0, h3 = 0.0, phi1 = 0.0, phi2 = 0.0, phi3 = 0.0;
   GciResult result;
-  /// pass: the three grids converge monotonically and |asymptotic_ratio - 1| <= tolerance (an
-  /// oscillation's ratio, from the magnitudes of its changes, can fall near 1 by accident)
-  double asymptotic_tolerance = 0.1;
+  /// The order the scheme is designed for, and the band around it in which an observed order
+  /// places the triple in the asymptotic range (pass()).
+  double design_order = 2.0;
+  double order_tolerance = 0.1;
   /// False where the study reads the asymptotic ratio as a diagnostic and claims something
   /// else (a time-step study: its time error against the grid error, a BoundCheck).
   bool asymptotic_range_claimed = true;
   bool checked() const {
     return asymptotic_range_claimed && result.kind != ConvergenceKind::two_grids;
   }
+  /// The observed order, negative where the changes grow under refinement (Celik's apparent
+  /// order is a magnitude, so that a diverging triple would show a positive one).
+  double observed_order() const;
+  /// In the asymptotic range: the grids converge monotonically at an observed order within
+  /// order_tolerance of design_order. (Celik's ratio GCI32 / (r21^p GCI21) is phi1 / phi2
+  /// for a constant refinement ratio whatever p, so it would pass an order of 10 or 0.3; an
+  /// oscillation's order says nothing, whatever its value.)
   bool pass() const;
 };
 GciRow make_gci_row(const std::string& study, const std::string& quantity, double h1, double h2,
-                    double h3, double phi1, double phi2, double phi3,
-                    double asymptotic_tolerance = 0.1);
+                    double h3, double phi1, double phi2, double phi3, double design_order = 2.0,
+                    double order_tolerance = 0.1);
 GciRow make_two_grid_gci_row(const std::string& study, const std::string& quantity, double h1,
                              double h2, double phi1, double phi2, double assumed_order);
 /// The discretisation uncertainty of a three-grid study's finest value phi1, or of its middle
-/// value phi2. In the asymptotic range (pass()): Roache's GCI, Fs |phi1 - phi2| / (r21^p - 1)
-/// or Fs |phi2 - phi3| / (r32^p - 1), with the observed order p held at or below the formal
-/// one (with a constant refinement ratio the asymptotic ratio is phi1 / phi2 for any p, so it
-/// cannot tell an order of 10 from one of 2; an order above the formal one is a cancellation,
-/// as in coarse_level_error). Otherwise nothing can be extrapolated: a monotonic triple gives
-/// the change between the finest pair |phi1 - phi2|; an oscillating or stagnant one at least
-/// half the range of its three values (Stern, Wilson, Coleman and Paterson, J. Fluids Eng.
-/// 123, 793, 2001), since the finest pair of an oscillation may agree by accident (on
-/// synthetic triples with a random first-order scatter, |phi1 - phi2| alone covers the true
-/// error of phi1 in about two thirds of the oscillating draws, this rule in over nine tenths:
-/// support.GridUncertainty).
-double fine_grid_uncertainty(const GciRow& row, double formal_order);
-double middle_grid_uncertainty(const GciRow& row, double formal_order);
+/// value phi2: the GCI Fs |phi1 - phi2| / (r21^q - 1), or Fs |phi2 - phi3| / (r32^q - 1),
+/// by the factor-of-safety rule of Oberkampf and Roy (Verification and Validation in
+/// Scientific Computing, 2010, section 8.6): in the asymptotic range (pass()) Fs = 1.25;
+/// outside it Fs = 3; q is the observed order held within [0.5, design_order] (an order
+/// above the design one is a cancellation of error terms, one near 0 would make the GCI
+/// unbounded). A two-grid row gives its GCI (Fs = 3, the assumed order). An oscillating or
+/// stagnant triple has no order: its uncertainty is at least half the range of its three
+/// values (Stern, Wilson, Coleman and Paterson, J. Fluids Eng. 123, 793, 2001), since the
+/// finest pair of an oscillation may agree by accident. The coverage of both rules on
+/// synthetic triples of known truth is measured in support.GridUncertainty.
+double fine_grid_uncertainty(const GciRow& row);
+double middle_grid_uncertainty(const GciRow& row);
 
-/// The error of a three-level study's coarsest value phi3, where the study refines from the
-/// setting in production (the time-step studies: phi3 at the production step). Richardson
-/// extrapolation from the two finest levels only where the levels converge monotonically
-/// (|phi3 - phi2| > |phi2 - phi1|, exact for a constant ratio) in the asymptotic range
-/// (row.pass()), with the observed order held at or below the formal order: an order above
-/// it reads a cancellation of error terms as fast convergence and would put phi_ext too close
-/// to phi1 (Roache, Verification and Validation in Computational Science and Engineering,
-/// 1998, uses min(p, p_formal) likewise). Otherwise (oscillating, diverging or stagnant
-/// levels) nothing can be extrapolated, and the error is the largest change from phi3.
+/// A bound on the error of a three-level study's coarsest value phi3, where the study refines
+/// from the setting in production (the time-step studies: phi3 at the production step):
+/// |phi3 - phi1| + fine_grid_uncertainty(row), the change to the finest level plus that
+/// level's own uncertainty (the triangle inequality). In the asymptotic range it exceeds the
+/// Richardson estimate |phi3 - phi_ext| by at least a quarter of the finest level's
+/// extrapolated error (Fs 1.25); outside it, the extrapolation is not trusted and the margin grows (Fs 3, or half
+/// the range of a triple that does not converge monotonically). Its coverage of the true error
+/// on synthetic series of known truth: support.CoarseLevelError.
 struct CoarseLevelError {
-  enum class Method { extrapolated, extrapolated_at_formal_order, largest_change };
+  enum class Method { asymptotic, outside_asymptotic_range, no_order };
   double error = 0.0;
-  Method method = Method::largest_change;
+  Method method = Method::no_order;
 };
-CoarseLevelError coarse_level_error(const GciRow& row, double formal_order);
+CoarseLevelError coarse_level_error(const GciRow& row);
 std::string to_string(CoarseLevelError::Method method);
 
 /// A study's claim that an error lies within an uncertainty: `value` (e.g. the time error of
@@ -148,6 +155,11 @@ struct BoundCheck {
 std::string bounds_to_csv(std::span<const BoundCheck> rows);
 
 std::string gci_to_csv(std::span<const GciRow> rows);
+/// The rows of a three-grid GCI table judged anew from their grids and values (h1..h3,
+/// phi1..phi3) at `design_order`, whatever judge wrote it; a row its study did not claim
+/// (pass nan) stays unclaimed. Throws std::runtime_error on a malformed table or a two-grid
+/// row.
+std::vector<GciRow> gci_from_csv(const std::string& text, double design_order);
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows);
 
 /// Environment variable naming the directory that collects study tables for the nightly
