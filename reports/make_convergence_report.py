@@ -417,7 +417,9 @@ def plot_gci_study(study, rows, out_dir):
     lines = -(-len(rows) // columns)
     fig, axes = plt.subplots(lines, columns, figsize=(3.3 * columns, 2.9 * lines),
                              squeeze=False)
-    h_label = "step scale" if study.startswith("real-time-") else "cell size h"
+    # A time-step study refines the step; its "-grid" triple, the grid it is compared with.
+    time_steps = study.startswith("real-time-") and not study.endswith("-grid")
+    h_label = "step scale" if time_steps else "cell size h"
     for ax, r in zip(axes.flat, rows):
         gci_panel(ax, r, h_label)
     for ax in axes.flat[len(rows):]:

@@ -224,7 +224,8 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
   const std::vector<double> cells{0.4, 0.2, 0.1};
   std::vector<Quantities> reference;
   for (double h : cells) reference.push_back(run_base_case(dir, fast.transport + "-reference", h, reference_settings(fast.transport)));
-  const auto rows = three_grid_rows("real-1d-integrators-" + fast.transport, cells, reference, 2, false);
+  // The reference's grid triple, written with the study so that its bounds can be traced.
+  const auto rows = three_grid_rows("real-1d-integrator-" + label + "-grid", cells, reference, 2, false);
   std::vector<std::string> settings = model;
   settings.push_back("continuum.diffusion_integrator=" + fast.diffusion);
   settings.push_back("continuum.integrator_stages=" + std::to_string(fast.stages));
@@ -245,6 +246,9 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
                                            : "not asymptotic: GCI with Fs 3, or half the range)")});
   }
   EXPECT_FALSE(conv::write_bounds(dir, "real-1d-integrator-" + label, bounds).empty());
+  EXPECT_FALSE(
+      conv::write_study(dir, "real-1d-integrator-" + label + "-grid", conv::ErrorTable{}, {}, rows)
+          .empty());
 }
 // Measured (see the report): paper + extrapolated + SSP-RK(4,2) agrees in every quantity, and
 // so does paper with explicit diffusion and SSP-RK(s,2) for s = 4, 6 and 10 (largest
@@ -391,9 +395,10 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
   for (double h : grid_cells)
     grid_values.push_back(run_base_case(dir, "grid-" + c.transport, h, reference_settings(c.transport)));
   // The coarse column may not resolve the fitted front: such a quantity has no grid estimate
-  // at the production cell, and its time error is printed, not compared.
-  const auto grid_rows = three_grid_rows(fmt::format("real-d{}-grid-{}", c.dimension, c.transport),
-                                         grid_cells, grid_values, 2, false, true);
+  // at the production cell, and its time error is printed, not compared. The triple is
+  // written with the study so that its bounds can be traced.
+  const auto grid_rows = three_grid_rows("real-time-" + label + "-grid", grid_cells, grid_values,
+                                         2, false, true);
 
   std::vector<conv::BoundCheck> bounds;
   for (const conv::GciRow& row : rows) {
@@ -429,6 +434,9 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
   }
   EXPECT_FALSE(conv::write_study(dir, "real-time-" + label, conv::ErrorTable{}, {}, rows).empty());
   EXPECT_FALSE(conv::write_bounds(dir, "real-time-" + label, bounds).empty());
+  EXPECT_FALSE(
+      conv::write_study(dir, "real-time-" + label + "-grid", conv::ErrorTable{}, {}, grid_rows)
+          .empty());
 }
 INSTANTIATE_TEST_SUITE_P(
     NightlyRealProblem, TimeStepConvergence,
