@@ -160,5 +160,6 @@ def table_head(cells):
 
 
 def table_row(cells):
-    """One line of a markdown table."""
-    return "| " + " | ".join(str(c) for c in cells) + " |"
+    """One line of a markdown table; a '|' inside a cell (an absolute value such as
+    |3D - 1D|) is escaped, so that it does not end the cell."""
+    return "| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |"

@@ -155,7 +155,9 @@ PHASE_COLUMN = "f t [1]"
 
 
 def table_cells(line):
-    return [cell.strip() for cell in line.strip().strip("|").split("|")]
+    """The cells of a markdown table line; an escaped '\\|' stays inside its cell."""
+    cells = re.split(r"(?<!\\)\|", line.strip().strip("|"))
+    return [cell.strip().replace("\\|", "|") for cell in cells]
 
 
 def markdown_tables(text):

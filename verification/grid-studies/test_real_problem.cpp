@@ -154,15 +154,16 @@ std::vector<conv::GciRow> three_grid_rows(const std::string& study,
     rows.push_back(conv::make_gci_row(study, name, cells[fine], cells[fine - 1],
                                       cells[fine - 2], phi(fine), phi(fine - 1),
                                       phi(fine - 2), order));
-    const auto& r = rows.back().result;
+    const conv::GciRow& row = rows.back();
     std::printf("%-20s %-26s order %.3f  extrapolated %.6g  GCI21 %.3e  uncertainty %.3e  %s\n",
-                study.c_str(), name.c_str(), r.order, r.phi_extrapolated, r.gci21,
-                conv::fine_grid_uncertainty(rows.back()), conv::to_string(r.kind).c_str());
+                study.c_str(), name.c_str(), row.observed_order(), row.result.phi_extrapolated,
+                row.result.gci21, conv::fine_grid_uncertainty(row),
+                conv::to_string(row.result.kind).c_str());
     rows.back().asymptotic_range_claimed = check;
     if (check) {
-      EXPECT_TRUE(rows.back().pass()) << study << " " << name << ": observed order " << r.order
-                                      << " (" << conv::to_string(r.kind) << "), design order "
-                                      << order;
+      EXPECT_TRUE(row.pass()) << study << " " << name << ": observed order "
+                              << row.observed_order() << " (" << conv::to_string(row.result.kind)
+                              << "), design order " << order;
     }
   }
   return rows;
@@ -310,7 +311,7 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
     const double difference = std::abs(row.phi1 - row_1d->phi1);
     std::printf("3D %-26s h 0.25 %.6g (uncertainty %.2e, order %.2f)  1D h 0.05 %.6g "
                 "(uncertainty %.2e)  |diff| %.3e  allowed %.3e\n",
-                row.quantity.c_str(), row.phi1, uncertainty_3d, row.result.order, row_1d->phi1,
+                row.quantity.c_str(), row.phi1, uncertainty_3d, row.observed_order(), row_1d->phi1,
                 uncertainty_1d, difference, allowed);
     expect_within(bounds, {"real-3d-vs-1d", row.quantity, difference,
                            "|3D (cell 0.25) - 1D (cell 0.05)|", allowed,
@@ -412,7 +413,7 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
                                    conv::to_string(estimate.method) + ")";
     if (grid_row == grid_rows.end()) {
       std::printf("%-40s %-26s order %.2f  time error %.3e  no grid estimate at this cell\n",
-                  label.c_str(), row.quantity.c_str(), row.result.order, time_error);
+                  label.c_str(), row.quantity.c_str(), row.observed_order(), time_error);
       expect_within(bounds, {"real-time-" + label, row.quantity, time_error, time_basis, nan,
                              "none: the coarse column does not resolve it"});
       continue;
@@ -422,7 +423,7 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
     const double grid_error = std::max(grid_uncertainty,
                                        resolution(row.quantity, cell));
     std::printf("%-40s %-26s order %.2f  time error %.3e  grid error %.3e  ratio %.3f (%s)\n",
-                label.c_str(), row.quantity.c_str(), row.result.order, time_error, grid_error,
+                label.c_str(), row.quantity.c_str(), row.observed_order(), time_error, grid_error,
                 time_error / grid_error, conv::to_string(estimate.method).c_str());
     // <=: a quantity that changes neither with the step nor with the grid (both 0) passes.
     expect_within(bounds, {"real-time-" + label, row.quantity, time_error, time_basis, grid_error,
