@@ -334,11 +334,10 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
 // 0.5 in 3D) the time step is halved twice by scaling continuum.cfl and
 // continuum.diffusion_number together (the adaptive step is the smaller of the two limits, so
 // both scale it). Each quantity gets its observed temporal order and GCI over the steps
-// 1, 1/2, 1/4 of production, and the time error of the production step (|phi(1) - phi_ext|
-// where the three steps converge monotonically in the asymptotic range, the order held at
-// or below the formal one, else the largest change seen: conv::coarse_level_error) must lie
-// below the grid uncertainty at the production cell (1D: the transport's reference triple
-// 0.4/0.2/0.1; 3D: the column's triple 1.0/0.5/0.25, its middle grid, the same flow while it
+// 1, 1/2, 1/4 of production, and the bound on the time error of the production step (its
+// change to the finest step plus that step's uncertainty at the integrator's formal order:
+// conv::coarse_level_error) must lie below the grid uncertainty at the production cell (1D:
+// the transport's reference triple 0.4/0.2/0.1; 3D: the column's triple 1.0/0.5/0.25, its middle grid, the same flow while it
 // stays horizontally uniform, see BaseCase3DThreeGridsAgreeWithThe1DColumn). The integrators:
 // every row of the README's table. The 3D box runs the sampled cycle from the column's
 // transient at the same scaled step (run_box_from_column), so every step of the history scales.
@@ -405,8 +404,7 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
   for (const conv::GciRow& row : rows) {
     const auto grid_row = std::find_if(grid_rows.begin(), grid_rows.end(),
                                        [&](const conv::GciRow& r) { return r.quantity == row.quantity; });
-    // The production step is the coarsest "grid" (conv::coarse_level_error: extrapolated only
-    // where the steps converge at the integrator's formal order).
+    // The production step is the coarsest "grid" of the three steps.
     const conv::CoarseLevelError estimate = conv::coarse_level_error(row);
     const double time_error = estimate.error;
     const std::string time_basis = "time error of the production step (" +
