@@ -41,8 +41,8 @@ allowed); names contain no commas.
       reference's grid uncertainty. The judge passes it when value <= bound; a row without a
       bound (nan) is "not checked". A time-step study's GCI rows are diagnostics there (their
       order sets the safety factor of the time error), shown as "not checked". Bound tables
-      in the subfolder awaiting-rerun/ were computed by a former rule: they are shown apart,
-      with their former verdicts, and are not checks of the report.
+      in the subfolder awaiting-rerun/ were computed by a former rule or protocol: they are
+      shown apart, with their former verdicts, and are not checks of the report.
   *.sampling.csv      study,quantity,phase,K,blocks,degrees_of_freedom,effective_K,missing,
                       standard_error
       MD sampling convergence (verification/sampling/md_sampling.hpp): the standard error
@@ -583,7 +583,9 @@ def awaiting_section(data):
               "value / bound [1] | former verdict |")
     lines = ["## Bound checks awaiting a rerun", "",
              f"Tables in {AWAITING_RERUN}/: computed with a former rule for the grid uncertainty "
-             "and the time error, and not counted in this report's checks. The nightly rerun "
+             "and the time error, or under the studies' former protocol (5 transient cycles "
+             "before the sampled one, where the layer was still relaxing; verification/README.md), "
+             "and not counted in this report's checks. The nightly rerun "
              "of their studies replaces them; until then their former verdicts are shown for "
              "information.", "", header, "|---" * (header.count("|") - 1) + "|"]
     lines += [bound_line(r, former.get(r["pass"], "not checked")) for r in rows]

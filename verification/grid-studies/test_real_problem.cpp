@@ -6,11 +6,14 @@
 // grids against the 1D column; and the temporal convergence of both at the production cell.
 // Nightly only (minutes; the 3D tests an hour or more).
 //
-// Cost (measured on the 2-core machine, see the report): the run protocol is shortened to
-// 5 transient cycles and one sampled cycle (at the case's 50 phases, so that the phase windows
-// of the claims are the validation study's), so that the four
-// resolutions fit in about half an hour. The quantities are then those of the cycle after the
-// transient, the same cycle at every resolution, which is what a grid study compares.
+// Protocol: the case's own transient (run.transient_cycles of base.toml, the validation study's)
+// and one sampled cycle (at the case's 50 phases, so that the phase windows of the claims are the
+// validation study's). The transient must reach the periodic state: after 5 cycles the column
+// was still relaxing (the centre of mass at f t = 0 of the `full` column at cell 0.1 lay 0.16
+// from its periodic value, more than its grid uncertainty, and a perturbation of the first
+// landing grew twentyfold before it decayed), so a grid or time step changed the cycle's place
+// on that relaxation, not only the periodic cycle. Each run's periodicity (the change of the
+// centre of mass over the last cycle) is printed with its quantities.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>  // getpid
@@ -38,7 +41,6 @@ namespace analysis = shaker::analysis;
 
 namespace {
 
-constexpr int transient_cycles = 5;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 /// The continuum scheme's spatial order, against which a grid triple's observed order places
 /// it in the asymptotic range (conv::GciRow).
@@ -98,14 +100,17 @@ Quantities run_base_case(const std::filesystem::path& dir, const std::string& la
   const auto output = dir / (label + "-h" + std::to_string(h) + ".h5");
   std::vector<std::string> settings{
       "continuum.cell_size=" + std::to_string(h),
-      "run.transient_cycles=" + std::to_string(transient_cycles), "run.sampled_cycles=1",
+      "run.sampled_cycles=1",
       "run.output=" + output.string()};
   settings.insert(settings.end(), extra.begin(), extra.end());
   const auto config = shaker::config::Config::load(SHAKER_BASE_CASE, settings);
   EXPECT_EQ(shaker::continuum::run(config), 0) << label << ", cell size " << h;
-  Quantities q = quantities(shaker::read_run_file(output));
+  const shaker::RunRecord run = shaker::read_run_file(output);
+  Quantities q = quantities(run);
   for (const auto& [name, v] : q)
     std::printf("%s h %.3f %-26s %.6g\n", label.c_str(), h, name.c_str(), v);
+  std::printf("%s h %.3f periodicity (last two cycles) %.3e\n", label.c_str(), h,
+              run.series.column("periodicity_last_two_cycles").back());
   return q;
 }
 
@@ -122,6 +127,8 @@ Quantities run_box_from_column(const std::filesystem::path& dir, const std::stri
                                const std::vector<std::string>& extra = {}) {
   const auto checkpoint = dir / fmt::format("{}-column-h{}.ckpt.h5", label, h);
   std::vector<std::string> column = extra;
+  const std::int64_t transient_cycles =
+      shaker::config::Config::load(SHAKER_BASE_CASE, {}).integer("run.transient_cycles");
   column.insert(column.end(), {fmt::format("run.transient_cycles={}", transient_cycles - 1),
                                "run.sampled_cycles=1", "run.checkpoint=" + checkpoint.string()});
   run_base_case(dir, label + "-column", h, column);
@@ -169,9 +176,13 @@ std::vector<conv::GciRow> three_grid_rows(const std::string& study,
   return rows;
 }
 
-/// Asserts a study's claim with the judge the report shows (BoundCheck::pass; a claim without
-/// a bound asserts nothing) and records it for the study's bounds table.
-void expect_within(std::vector<conv::BoundCheck>& bounds, conv::BoundCheck claim) {
+/// Asserts a study's claim with the judge the report shows (BoundCheck::pass) and records it
+/// for the study's bounds table. A claim without a bound asserts nothing, so only a claim
+/// declared `without_bound` may lack one: a NaN bound elsewhere is a defect of the estimate.
+void expect_within(std::vector<conv::BoundCheck>& bounds, conv::BoundCheck claim,
+                   bool without_bound = false) {
+  EXPECT_TRUE(without_bound || claim.checked())
+      << claim.study << " " << claim.quantity << ": no bound (" << claim.bound_basis << ")";
   EXPECT_TRUE(!claim.checked() || claim.pass())
       << claim.study << " " << claim.quantity << ": " << claim.value << " (" << claim.value_basis
       << ") above " << claim.bound << " (" << claim.bound_basis << ")";
@@ -251,7 +262,8 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
       conv::write_study(dir, "real-1d-integrator-" + label + "-grid", conv::ErrorTable{}, {}, rows)
           .empty());
 }
-// Measured (see the report): paper + extrapolated + SSP-RK(4,2) agrees in every quantity, and
+// Measured under the former judge and the former 5-cycle protocol (to be remeasured; the
+// README's table says so): paper + extrapolated + SSP-RK(4,2) agrees in every quantity, and
 // so does paper with explicit diffusion and SSP-RK(s,2) for s = 4, 6 and 10 (largest
 // difference over allowance 0.06, 0.12, 0.24: d/xi; the error grows about like s - 1, the
 // step). The others are known-failure: backward Euler's first-order time error exceeds the grid
@@ -413,7 +425,8 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
       std::printf("%-40s %-26s order %.2f  time error %.3e  no grid estimate at this cell\n",
                   label.c_str(), row.quantity.c_str(), row.observed_order(), time_error);
       expect_within(bounds, {"real-time-" + label, row.quantity, time_error, time_basis, nan,
-                             "none: the coarse column does not resolve it"});
+                             "none: the coarse column does not resolve it"},
+                    true);
       continue;
     }
     const double grid_uncertainty = box ? conv::middle_grid_uncertainty(*grid_row)

@@ -107,7 +107,9 @@ GciResult three_grid_gci(double h1, double h2, double h3, double phi1, double ph
   const double eps32 = phi3 - phi2;
   result.relative_difference21 = std::abs(eps21 / phi1);
   result.relative_difference32 = std::abs(eps32 / phi2);
-  if (eps21 == 0.0 || eps32 == 0.0) {
+  const double scale = std::max({std::abs(phi1), std::abs(phi2), std::abs(phi3)});
+  const auto no_change = [&](double eps) { return std::abs(eps) <= round_off_change * scale; };
+  if (no_change(eps21) || no_change(eps32)) {
     result.kind = ConvergenceKind::stagnant;
     result.order = result.phi_extrapolated = result.extrapolated_error21 = not_a_number;
     result.gci21 = result.gci32 = result.asymptotic_ratio = not_a_number;

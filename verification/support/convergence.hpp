@@ -33,11 +33,16 @@ double richardson_extrapolate(double phi_fine, double phi_coarse, double refinem
                               double order);
 
 /// Sign pattern of eps32 / eps21 (eps21 = phi2 - phi1, eps32 = phi3 - phi2); two_grids: only
-/// two levels, so the order is assumed and nothing about the pattern is known.
+/// two levels, so the order is assumed and nothing about the pattern is known. A change within
+/// round-off of the values (`round_off_change`) is no change: stagnant.
 enum class ConvergenceKind { monotonic, oscillatory, stagnant, two_grids };
 std::string to_string(ConvergenceKind kind);
 
 inline constexpr double safety_factor_three_grids = 1.25;
+/// A change between two levels at most this fraction of the largest |phi| is round-off: a
+/// quantity assembled from cell centres (the shock width 3.7 = 3.7000000000000028 on one grid
+/// and 3.6999999999999993 on the next) would otherwise converge "monotonically" at order 45.
+inline constexpr double round_off_change = 1e-12;
 inline constexpr double safety_factor_two_grids = 3.0;
 /// Three grids outside the asymptotic range (Oberkampf and Roy 2010), and the least order
 /// their GCI takes.

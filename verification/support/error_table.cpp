@@ -214,8 +214,12 @@ double grid_uncertainty(const GciRow& row, double change, double r) {
     const auto [low, high] = std::minmax({row.phi1, row.phi2, row.phi3});
     return std::max(std::abs(change), 0.5 * (high - low));
   }
+  // Equal changes (an order of 0) leave the order equation without a root: the least order.
+  const double observed = row.observed_order();
   const double order =
-      std::clamp(row.observed_order(), least_order_outside_asymptotic_range, row.design_order);
+      std::isfinite(observed)
+          ? std::clamp(observed, least_order_outside_asymptotic_range, row.design_order)
+          : least_order_outside_asymptotic_range;
   const double safety =
       row.pass() ? safety_factor_three_grids : safety_factor_outside_asymptotic_range;
   return safety * std::abs(change) / (std::pow(r, order) - 1.0);

@@ -161,6 +161,18 @@ TEST(Gci, StagnantAndBadOrderingAreReported) {
   EXPECT_THROW(cv::three_grid_gci(0.2, 0.1, 0.4, 1.0, 1.1, 1.2), std::invalid_argument);
 }
 
+TEST(Gci, AChangeWithinRoundOffIsNoChange) {
+  // The 1D base case's shock width d (a difference of cell centres) on cells 0.05, 0.1, 0.2.
+  const cv::GciResult g =
+      cv::three_grid_gci(0.05, 0.1, 0.2, 3.7000000000000028, 3.6999999999999993, 3.5999999999999979);
+  EXPECT_EQ(g.kind, cv::ConvergenceKind::stagnant);
+  EXPECT_TRUE(std::isnan(g.order));
+  // A change of 1e-9 of the value is a change.
+  const cv::GciResult h = cv::three_grid_gci(0.05, 0.1, 0.2, 3.7, 3.7 + 3.7e-9, 3.7 + 5 * 3.7e-9);
+  EXPECT_EQ(h.kind, cv::ConvergenceKind::monotonic);
+  EXPECT_NEAR(h.order, 2.0, 1e-5);
+}
+
 TEST(Gci, TwoGridsUseSafetyFactorThree) {
   const cv::TwoGridGci g = cv::two_grid_gci(0.05, 0.1, 1.01, 1.04, 2.0);
   EXPECT_NEAR(g.gci21, 3.0 * (0.03 / 1.01) / 3.0, 1e-15);
@@ -537,6 +549,19 @@ TEST(GridUncertainty, AnOrderAboveTheDesignOneIsHeldAtIt) {
   const cv::GciRow row = triple_of_order(9.886);
   EXPECT_NEAR(cv::fine_grid_uncertainty(row), 1e-3, 1e-15);
   EXPECT_NEAR(cv::middle_grid_uncertainty(row), 1e-3 * std::pow(2.0, 9.886), 1e-12);
+}
+
+// The 3D box's shock width d on cells 0.25, 0.5, 1.0: 2, 2.5, 3, one cell per refinement. The
+// order equation has no root for equal changes; the order is 0, held at the least order 0.5
+// with Fs 3. (A NaN here once made the time-step study's bound on d unchecked.)
+TEST(GridUncertainty, EqualChangesTakeTheLeastOrder) {
+  const cv::GciRow row = cv::make_gci_row("d", "shock_width", 0.25, 0.5, 1.0, 2.0, 2.5, 3.0);
+  EXPECT_EQ(row.result.kind, cv::ConvergenceKind::monotonic);
+  EXPECT_FALSE(row.pass());
+  const double expected = 3.0 * 0.5 / (std::sqrt(2.0) - 1.0);
+  EXPECT_NEAR(cv::fine_grid_uncertainty(row), expected, 1e-12);
+  EXPECT_NEAR(cv::middle_grid_uncertainty(row), expected, 1e-12);
+  EXPECT_NEAR(cv::coarse_level_error(row).error, 1.0 + expected, 1e-12);
 }
 
 // Synthetic triples of known truth 10 with smooth second- and third-order errors of random
