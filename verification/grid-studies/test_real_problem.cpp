@@ -236,8 +236,10 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
   const std::vector<double> cells{0.4, 0.2, 0.1};
   std::vector<Quantities> reference;
   for (double h : cells) reference.push_back(run_base_case(dir, fast.transport + "-reference", h, reference_settings(fast.transport)));
-  // The reference's grid triple, written with the study so that its bounds can be traced.
-  const auto rows = three_grid_rows("real-1d-integrator-" + label + "-grid", cells, reference, 2, false);
+  // The reference's grid triple, written with the study so that its bounds can be traced. The
+  // coarse column does not resolve the fitted front: that quantity has no row.
+  const auto rows =
+      three_grid_rows("real-1d-integrator-" + label + "-grid", cells, reference, 2, false, true);
   std::vector<std::string> settings = model;
   settings.push_back("continuum.diffusion_integrator=" + fast.diffusion);
   settings.push_back("continuum.integrator_stages=" + std::to_string(fast.stages));
@@ -255,22 +257,17 @@ TEST_P(FastIntegrators, AgreeWithTheReferenceWithinTheGridUncertainty) {
                            "|this integrator - the reference| at cell 0.1", allowed,
                            std::string("grid uncertainty of the reference at cell 0.1 (") +
                                (asymptotic ? "GCI, Fs 1.25)"
-                                           : "not asymptotic: GCI with Fs 3, or half the range)")});
+                                           : "not asymptotic: GCI with Fs 3 or half the range)")});
   }
   EXPECT_FALSE(conv::write_bounds(dir, "real-1d-integrator-" + label, bounds).empty());
   EXPECT_FALSE(
       conv::write_study(dir, "real-1d-integrator-" + label + "-grid", conv::ErrorTable{}, {}, rows)
           .empty());
 }
-// Measured under the former judge and the former 5-cycle protocol (to be remeasured; the
-// README's table says so): paper + extrapolated + SSP-RK(4,2) agrees in every quantity, and
-// so does paper with explicit diffusion and SSP-RK(s,2) for s = 4, 6 and 10 (largest
-// difference over allowance 0.06, 0.12, 0.24: d/xi; the error grows about like s - 1, the
-// step). The others are known-failure: backward Euler's first-order time error exceeds the grid
-// uncertainty even at Heun's step for `full` (6 of 9 quantities; it was the full default until
-// this measurement made implicit_extrapolated the default) and in d/xi for `paper`; the
-// extrapolated step with `full` at SSP-RK(4,2) in 3 (centre of mass at f t = 0 and 0.25, shock
-// speed); SSP-RK(10,2) in 2 (paper) and 7 (full).
+// Measured (the README's table; the bound tables in reports/convergence-tables): paper with
+// explicit diffusion and SSP-RK(s,2), s = 4, 6, 10, and paper backward Euler at s = 2 agree in
+// every quantity; the others are known-failure, most of them in max Mach (paper) or in the
+// centre of mass at f t = 0 and the shock speed (full).
 INSTANTIATE_TEST_SUITE_P(
     NightlyRealProblem, FastIntegrators,
     ::testing::Values(FastIntegrator{"paper", "implicit", 2}, FastIntegrator{"paper", "implicit_extrapolated", 4},
