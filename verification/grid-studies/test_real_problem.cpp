@@ -346,8 +346,9 @@ TEST(NightlyRealProblem, BaseCase3DThreeGridsAgreeWithThe1DColumn) {
 // 1, 1/2, 1/4 of production, and the bound on the time error of the production step (its
 // change to the finest step plus that step's uncertainty at the integrator's formal order:
 // conv::coarse_level_error) must lie below the grid uncertainty at the production cell (1D:
-// the transport's reference triple 0.4/0.2/0.1; 3D: the column's triple 1.0/0.5/0.25, its middle grid, the same flow while it
-// stays horizontally uniform, see BaseCase3DThreeGridsAgreeWithThe1DColumn). The integrators:
+// the transport's reference triple 0.4/0.2/0.1; 3D: the column's triple 1.0/0.5/0.25, its
+// middle grid, the same flow while it stays horizontally uniform, see
+// BaseCase3DThreeGridsAgreeWithThe1DColumn). The integrators:
 // every row of the README's table. The 3D box runs the sampled cycle from the column's
 // transient at the same scaled step (run_box_from_column), so every step of the history scales.
 struct TimeStepCase {
@@ -423,7 +424,7 @@ TEST_P(TimeStepConvergence, TimeErrorBelowTheGridError) {
                   label.c_str(), row.quantity.c_str(), row.observed_order(), time_error);
       expect_within(bounds, {"real-time-" + label, row.quantity, time_error, time_basis, nan,
                              "none: the coarse column does not resolve it"},
-                    true);
+                    /*without_bound=*/true);
       continue;
     }
     const double grid_uncertainty = box ? conv::middle_grid_uncertainty(*grid_row)
