@@ -552,9 +552,29 @@ def bound_line(r, mark):
          r["value_basis"], rc.fmt(r["bound"], 4), r["bound_basis"], rc.fmt(ratio, 3), mark])
 
 
-def bound_failure(r):
-    return (f"bound {r['study']} / {r['quantity']}: {rc.fmt(r['value'], 4)} "
+def bound_failure(r, gci_rows=()):
+    text = (f"bound {r['study']} / {r['quantity']}: {rc.fmt(r['value'], 4)} "
             f"({r['value_basis']}) above {rc.fmt(r['bound'], 4)} ({r['bound_basis']})")
+    return text + step_to_meet_the_bound(r, gci_rows)
+
+
+def step_to_meet_the_bound(r, gci_rows):
+    """What a failing time-step bound would take: the fraction of the production step at which
+    the time error, shrinking at the order of the study's step triple (the observed one where
+    the triple converges monotonically below the integrator's formal order, the formal one
+    otherwise), would equal the bound. Empty for the other studies."""
+    triple = next((g for g in gci_rows if r["study"].startswith("real-time-")
+                   and g["study"] == r["study"] and g["quantity"] == r["quantity"]), None)
+    if triple is None or not r["bound"] > 0:
+        return ""
+    formal = triple["design_order"]
+    observed = triple["order"]
+    slower = triple["convergence"] == "monotonic" and 0 < observed < formal
+    order = observed if slower else formal
+    fraction = (r["bound"] / r["value"]) ** (1.0 / order)
+    return (f"; it would take a step of {rc.fmt(fraction, 2)} of the production step "
+            f"(the error shrinking at the {'observed' if slower else 'formal'} temporal order "
+            f"{rc.fmt(order, 3)})")
 
 
 def bound_section(data, failures):
@@ -564,8 +584,8 @@ def bound_section(data, failures):
         return [], 0
     table, checks = judged_table(
         "| study | quantity | units | value | value basis | bound | bound basis | "
-        "value / bound [1] | result |", rows, bound_line, bound_failure, failures,
-        "no bound checks found")
+        "value / bound [1] | result |", rows, bound_line,
+        lambda r: bound_failure(r, data["gci"]), failures, "no bound checks found")
     return ["## Errors within their uncertainty", "",
             "Each row: an error of the study (value) and the uncertainty it must not exceed "
             "(bound), in the units of the row; the time-step studies compare the time error of "
@@ -583,8 +603,9 @@ def awaiting_section(data):
               "value / bound [1] | former verdict |")
     lines = ["## Bound checks awaiting a rerun", "",
              f"Tables in {AWAITING_RERUN}/: computed with a former rule for the grid uncertainty "
-             "and the time error, or under the studies' former protocol (5 transient cycles "
-             "before the sampled one, where the layer was still relaxing; verification/README.md), "
+             "and the time error, or under a former protocol of the studies (a transient too short "
+             "for the periodic state, so that the sampled cycle was still relaxing; "
+             "verification/README.md), "
              "and not counted in this report's checks. The nightly rerun "
              "of their studies replaces them; until then their former verdicts are shown for "
              "information.", "", header, "|---" * (header.count("|") - 1) + "|"]

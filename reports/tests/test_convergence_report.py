@@ -594,3 +594,34 @@ def test_bounds_awaiting_a_rerun_are_shown_apart_and_not_counted(work_dir):
     refused = run("--input", inputs, "--output", report, "--commit", "abc")
     assert refused.returncode == 2 and "only bound checks can await a rerun" in refused.stderr, \
         f"a GCI table awaiting a rerun must be refused: {refused.returncode} {refused.stderr}"
+
+
+def test_a_failing_time_bound_says_what_step_would_meet_it(work_dir):
+    """A time-step study's failing bound gives the fraction of the production step at which
+    the time error would equal the bound: (bound / value)^(1/p), p the observed order of the
+    study's step triple where it converges monotonically below the formal order, the formal
+    order otherwise; bounds of other studies get no such text."""
+    inputs = os.path.join(work_dir, "input")
+    os.makedirs(inputs)
+    write(os.path.join(inputs, "t.bounds.csv"), BOUNDS_HEADER, [
+        ("real-time-d1-x", "max_mach", 0.09, "time error", 0.01, "grid uncertainty", 0),
+        ("real-time-d1-x", "shock_speed", 0.04, "time error", 0.01, "grid uncertainty", 0),
+        ("real-1d-integrator-x", "max_mach", 0.09, "difference", 0.01, "grid uncertainty", 0)])
+    steps = (0.25, 0.5, 1.0)
+    write(os.path.join(inputs, "t.gci.csv"), GCI_HEADER, [
+        ("real-time-d1-x", "max_mach", *steps, 3.0, 3.01, 3.03, 1.0, 2.99, 0.003, 0.003, 0.01,
+         0.02, "monotonic", 2, 0.1, 0.03, float("nan")),
+        ("real-time-d1-x", "shock_speed", *steps, 4.0, 4.1, 4.0, 1.0, 4.1, 0.02, 0.02, 0.05,
+         0.05, "oscillatory", 2, 0.1, 0.05, float("nan"))])
+    report = os.path.join(work_dir, "out", "convergence.md")
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 0, result.stderr
+    failures = failure_list(open(report).read())
+    observed = next(f for f in failures if "real-time-d1-x / max_mach" in f)
+    assert "a step of 0.11 of the production step" in observed and "observed temporal order 1" \
+        in observed, f"order-1 step not given: '{observed}'"  # (0.01 / 0.09)^1
+    formal = next(f for f in failures if "real-time-d1-x / shock_speed" in f)
+    assert "a step of 0.5 of the production step" in formal and "formal temporal order 2" \
+        in formal, f"formal-order step not given: '{formal}'"  # (0.01 / 0.04)^(1/2)
+    other = next(f for f in failures if "real-1d-integrator-x" in f)
+    assert "production step" not in other, f"a step given for another study: '{other}'"
