@@ -525,9 +525,9 @@ def claims_section(results):
              "half the range of an oscillating triple) of the 1D base-case grid study "
              f"(verification/grid-studies/test_real_problem.cpp, tables in {gci_source}) at "
              "the validation run's cell size, for the claims whose continuum value that "
-             "study computes (field continuum_gci of the claim); the study's runs (the case's "
-             "transient cycles, then one sampled cycle) estimate the discretisation error "
-             "only. "
+             "study computes (field continuum_gci of the claim); the study's runs (a transient "
+             "until the column is periodic to 1e-6, then one sampled cycle) estimate the "
+             "discretisation error only. "
              "Other continuum values carry no uncertainty here.",
              "",
              "Verdicts: **pass** when the value lies inside the band by more than 2 standard "
