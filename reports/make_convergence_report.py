@@ -569,6 +569,8 @@ def step_to_meet_the_bound(r, gci_rows):
         return ""
     formal = triple["design_order"]
     observed = triple["order"]
+    if triple["convergence"] == "monotonic" and observed < 0:
+        return "; no step is estimated: its changes grow as the step shrinks"
     slower = triple["convergence"] == "monotonic" and 0 < observed < formal
     order = observed if slower else formal
     fraction = (r["bound"] / r["value"]) ** (1.0 / order)
@@ -611,6 +613,23 @@ def awaiting_section(data):
              "information.", "", header, "|---" * (header.count("|") - 1) + "|"]
     lines += [bound_line(r, former.get(r["pass"], "not checked")) for r in rows]
     return lines + [""]
+
+
+def known_failure_section(repository):
+    """Why each failing study fails: the reason of every known-failure line of the status
+    files beside the tests (verification/README.md, "status.txt"), with its test pattern."""
+    lines = [(os.path.relpath(path, repository), pattern, reason)
+             for path, _, pattern, labels, reason in rc.status_lines(repository)
+             if labels and "known-failure" in labels]
+    if not lines:
+        return []
+    out = ["## Known failures and why", "",
+           "The tests that fail on purpose, as their status files state it: which claim the "
+           "project does not meet, by how much, and why (details in verification/README.md).",
+           "", "| status file | tests | why |", "|---|---|---|"]
+    out += [rc.table_row([f"`{path}`", f"`{pattern}`", reason])
+            for path, pattern, reason in lines]
+    return out + [""]
 
 
 def order_section(data, failures):
@@ -792,6 +811,7 @@ def main(argv=None):
     if failures:
         lines += ["", "Failing checks (measured values):", ""] + [f"- {f}" for f in failures]
     lines.append("")
+    lines += known_failure_section(repository)
     lines += (order_lines + gci_lines + bound_lines + awaiting_section(data) + sampling_lines +
               term_share_tables(data["term-shares"]) + error_tables(series) + plot_lines)
     tables = os.path.join(out_dir, TABLES_DIRECTORY)

@@ -7,6 +7,7 @@ name in the same directory and are renamed into place.
 import datetime
 import os
 import platform
+import re
 import subprocess
 import tempfile
 
@@ -163,3 +164,29 @@ def table_row(cells):
     """One line of a markdown table; a '|' inside a cell (an absolute value such as
     |3D - 1D|) is escaped, so that it does not end the cell."""
     return "| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |"
+
+
+STATUS_LINE = re.compile(r"^(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S.*)$")
+
+
+def status_lines(source_dir):
+    """Every line of every status.txt under source_dir (verification/README.md, "status.txt"),
+    in file order, as (path, line number, pattern, labels, reason); pattern, labels and reason
+    are None for a line that does not have the five fields. Labels: sorted, [] for default."""
+    lines = []
+    for root, dirs, files in os.walk(source_dir):
+        dirs[:] = sorted(d for d in dirs if not d.startswith(".") and not d.startswith("build"))
+        if "status.txt" not in files:
+            continue
+        path = os.path.join(root, "status.txt")
+        with open(path) as f:
+            for number, text in enumerate(f, 1):
+                if not text.strip() or text.lstrip().startswith("#"):
+                    continue
+                match = STATUS_LINE.match(text.rstrip("\n"))
+                if not match:
+                    lines.append((path, number, None, None, None))
+                    continue
+                labels = [] if match[2] == "default" else sorted(match[2].split(","))
+                lines.append((path, number, match[1], labels, match[5]))
+    return lines

@@ -600,19 +600,23 @@ def test_a_failing_time_bound_says_what_step_would_meet_it(work_dir):
     """A time-step study's failing bound gives the fraction of the production step at which
     the time error would equal the bound: (bound / value)^(1/p), p the observed order of the
     study's step triple where it converges monotonically below the formal order, the formal
-    order otherwise; bounds of other studies get no such text."""
+    order otherwise, none where the changes grow; bounds of other studies get no such
+    text."""
     inputs = os.path.join(work_dir, "input")
     os.makedirs(inputs)
     write(os.path.join(inputs, "t.bounds.csv"), BOUNDS_HEADER, [
         ("real-time-d1-x", "max_mach", 0.09, "time error", 0.01, "grid uncertainty", 0),
         ("real-time-d1-x", "shock_speed", 0.04, "time error", 0.01, "grid uncertainty", 0),
+        ("real-time-d1-x", "shock_width_ft0.22", 0.04, "time error", 0.01, "grid uncertainty", 0),
         ("real-1d-integrator-x", "max_mach", 0.09, "difference", 0.01, "grid uncertainty", 0)])
     steps = (0.25, 0.5, 1.0)
     write(os.path.join(inputs, "t.gci.csv"), GCI_HEADER, [
         ("real-time-d1-x", "max_mach", *steps, 3.0, 3.01, 3.03, 1.0, 2.99, 0.003, 0.003, 0.01,
          0.02, "monotonic", 2, 0.1, 0.03, float("nan")),
         ("real-time-d1-x", "shock_speed", *steps, 4.0, 4.1, 4.0, 1.0, 4.1, 0.02, 0.02, 0.05,
-         0.05, "oscillatory", 2, 0.1, 0.05, float("nan"))])
+         0.05, "oscillatory", 2, 0.1, 0.05, float("nan")),
+        ("real-time-d1-x", "shock_width_ft0.22", *steps, 3.0, 3.1, 3.11, -3.0, 3.1, 0.02, 0.02, 0.05,
+         0.05, "monotonic", 2, 0.1, 0.05, float("nan"))])
     report = os.path.join(work_dir, "out", "convergence.md")
     result = run("--input", inputs, "--output", report, "--commit", "abc")
     assert result.returncode == 0, result.stderr
@@ -623,5 +627,31 @@ def test_a_failing_time_bound_says_what_step_would_meet_it(work_dir):
     formal = next(f for f in failures if "real-time-d1-x / shock_speed" in f)
     assert "a step of 0.5 of the production step" in formal and "formal temporal order 2" \
         in formal, f"formal-order step not given: '{formal}'"  # (0.01 / 0.04)^(1/2)
+    growing = next(f for f in failures if "real-time-d1-x / shock_width_ft0.22:" in f)
+    assert "no step is estimated: its changes grow" in growing and "a step of" not in growing, \
+        f"a step estimated for a triple whose changes grow: '{growing}'"
     other = next(f for f in failures if "real-1d-integrator-x" in f)
     assert "production step" not in other, f"a step given for another study: '{other}'"
+
+
+def test_known_failures_are_listed_with_their_reasons(work_dir):
+    """The report gives, beside the failing checks, every known-failure line of the
+    repository's status files: its test pattern and its reason, one table row each."""
+    from reports import report_common
+    repository = os.path.dirname(REPORTS)
+    known = [(pattern, reason) for _, _, pattern, labels, reason
+             in report_common.status_lines(repository) if labels and "known-failure" in labels]
+    assert known, "the repository declares no known failure: nothing to test"
+    inputs = os.path.join(work_dir, "input")
+    os.makedirs(inputs)
+    synthetic_study(inputs)
+    report = os.path.join(work_dir, "out", "convergence.md")
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 0, result.stderr
+    section = open(report).read().split("## Known failures and why")[-1].split("\n## ")[0]
+    rows = [line for line in section.splitlines() if line.startswith("| `")]
+    assert len(rows) == len(known), f"{len(rows)} rows for {len(known)} known failures"
+    for (pattern, reason), row in zip(known, rows):
+        cells = table_cells(row)
+        assert cells[1] == f"`{pattern}`" and cells[2] == reason, \
+            f"row '{row}' is not the status line {pattern}: {reason}"

@@ -10,36 +10,14 @@ matching line's labels are the labels the test carries.
 import fnmatch
 import json
 import os
-import re
 import subprocess
 import sys
-
-LINE = re.compile(r"^(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S.*)$")
-
-
-def status_lines(source_dir):
-    """(file, line number, pattern, labels) of every status line, in file order."""
-    lines = []
-    for root, dirs, files in os.walk(source_dir):
-        dirs[:] = [d for d in dirs if not d.startswith(".") and not d.startswith("build")]
-        if "status.txt" not in files:
-            continue
-        path = os.path.join(root, "status.txt")
-        with open(path) as f:
-            for number, text in enumerate(f, 1):
-                if not text.strip() or text.lstrip().startswith("#"):
-                    continue
-                match = LINE.match(text.rstrip("\n"))
-                if not match:
-                    lines.append((path, number, None, None))
-                    continue
-                labels = [] if match[2] == "default" else sorted(match[2].split(","))
-                lines.append((path, number, match[1], labels))
-    return lines
 
 
 def main():
     ctest, source_dir, build_dir = sys.argv[1], sys.argv[2], sys.argv[3]
+    sys.path.insert(0, source_dir)
+    from reports.report_common import status_lines
     listed = subprocess.run([ctest, "--test-dir", build_dir, "--show-only=json-v1"],
                             capture_output=True, text=True)
     if listed.returncode != 0:
@@ -52,7 +30,7 @@ def main():
     lines = status_lines(source_dir)
     problems = []
     decided = set()
-    for path, number, pattern, labels in lines:
+    for path, number, pattern, labels, _ in lines:
         where = f"{os.path.relpath(path, source_dir)}:{number}"
         if pattern is None:
             problems.append(f"{where}: not PATTERN LABELS TIMEOUT ENVIRONMENT REASON")
