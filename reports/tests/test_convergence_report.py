@@ -615,8 +615,8 @@ def test_a_failing_time_bound_says_what_step_would_meet_it(work_dir):
          0.02, "monotonic", 2, 0.1, 0.03, float("nan")),
         ("real-time-d1-x", "shock_speed", *steps, 4.0, 4.1, 4.0, 1.0, 4.1, 0.02, 0.02, 0.05,
          0.05, "oscillatory", 2, 0.1, 0.05, float("nan")),
-        ("real-time-d1-x", "shock_width_ft0.22", *steps, 3.0, 3.1, 3.11, -3.0, 3.1, 0.02, 0.02, 0.05,
-         0.05, "monotonic", 2, 0.1, 0.05, float("nan"))])
+        ("real-time-d1-x", "shock_width_ft0.22", *steps, 3.0, 3.1, 3.11, -3.0, 3.1, 0.02, 0.02,
+         0.05, 0.05, "monotonic", 2, 0.1, 0.05, float("nan"))])
     report = os.path.join(work_dir, "out", "convergence.md")
     result = run("--input", inputs, "--output", report, "--commit", "abc")
     assert result.returncode == 0, result.stderr
