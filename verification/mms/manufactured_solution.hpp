@@ -34,6 +34,9 @@ struct ManufacturedSolution {
   double Lx = 11.0, Ly = 11.0;    ///< horizontal periods (the continuum box)
   double Lz = 10.0;               ///< height of the column
   bool wall_compatible = true;
+  /// With wall_compatible: n also has a normal gradient and u_z a curvature at the walls, which
+  /// the wall conditions allow and the mirror symmetry of the ghost cells does not have.
+  bool wall_gradients = false;
   double n0 = 0.4;                ///< mean number density
   double T0 = 1.0;                ///< mean temperature
   double U0 = 0.3;                ///< velocity amplitude
@@ -47,15 +50,20 @@ struct ManufacturedSolution {
     // Vertical shapes: j half-wavelengths across the column.
     const auto c = [&](int j) { return cos(static_cast<double>(j) * pi / Lz * z + wall_phase); };
     const auto s = [&](int j) { return sin(static_cast<double>(j) * pi / Lz * z + wall_phase); };
+    const double density_phase = wall_gradients ? 0.37 : wall_phase;
+    const auto c_n = [&](int j) { return cos(static_cast<double>(j) * pi / Lz * z + density_phase); };
+    // zero with its slope at z = 0 and Lz, curvature 2 (2 pi / Lz)^2 there
+    S bowl = 0.0 * z;
+    if (wall_gradients) bowl = 1.0 - cos(2.0 * pi / Lz * z);
     const double kx = 2.0 * pi / Lx, ky = 2.0 * pi / Ly;
     const double d = dimension == 3 ? 1.0 : 0.0;  // switches the horizontal variation on
 
     Fields<S> f;
-    f.n = n0 * (1.0 + 0.2 * c(density_mode) * (1.0 + 0.4 * sin(omega * t)) +
+    f.n = n0 * (1.0 + 0.2 * c_n(density_mode) * (1.0 + 0.4 * sin(omega * t)) +
                 d * 0.1 * sin(kx * x + 0.3) * cos(ky * y - 0.2 + 0.5 * omega * t) * c(2));
     f.T = T0 * (1.0 + 0.3 * c(3) * cos(omega * t + 0.5) +
                 d * 0.1 * cos(kx * x - ky * y + omega * t) * c(5));
-    f.u[2] = U0 * (s(4) * (0.6 + 0.4 * cos(omega * t)) +
+    f.u[2] = U0 * ((s(4) + 0.5 * bowl) * (0.6 + 0.4 * cos(omega * t)) +
                    d * 0.3 * cos(kx * x) * sin(ky * y + 0.3 - omega * t) * s(2));
     f.u[0] = d * U0 * (0.5 * sin(kx * x + ky * y + 0.2 * omega * t) * c(2) +
                        0.2 * cos(ky * y) * c(3));

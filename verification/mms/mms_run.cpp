@@ -151,6 +151,7 @@ ManufacturedSolution solution_for(const MmsCase& c) {
   s.wall_compatible = c.boundary == continuum::ZBoundary::walls;
   s.U0 = c.velocity_amplitude;
   s.density_mode = c.density_mode;
+  s.wall_gradients = c.wall_gradients;
   s.Lz = 10.0;
   s.Lx = s.Ly = 5.0;  // a smaller 3D box: half the cells of a cube, same resolution
   return s;

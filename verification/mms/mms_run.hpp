@@ -52,6 +52,7 @@ struct MmsCase {
   SourceRule source_rule = SourceRule::gauss_average;
   double velocity_amplitude = 0.3;     ///< ManufacturedSolution::U0
   int density_mode = 4;                ///< ManufacturedSolution::density_mode
+  bool wall_gradients = false;         ///< ManufacturedSolution::wall_gradients
 };
 
 /// The cell average of the source to O(h^4) from one evaluation per cell: the centre value
