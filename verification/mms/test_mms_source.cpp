@@ -235,6 +235,24 @@ TEST(ManufacturedSolution, SatisfiesTheWallConditionsAtBothWalls) {
   EXPECT_GT(std::abs(shifted(1.0, 2.0, 3.0, 0.0).u[2]), 1e-2);
 }
 
+// wall_gradients keeps the wall conditions (u_z = 0, zero normal gradient of T) and adds what
+// they allow and a mirror ghost lacks: n' != 0 and u_z'' != 0 at both walls.
+TEST(ManufacturedSolution, WallGradientsKeepTheWallConditions) {
+  mms::ManufacturedSolution s = solution_of(1, true);
+  s.wall_gradients = true;
+  const double delta = 1e-4;
+  for (double t : {0.0, 2.1, 8.6})
+    for (double z : {0.0, s.Lz}) {
+      const auto at = [&](double dz) { return s(t, 0.0, 0.0, z + dz); };
+      const auto centre = at(0.0), up = at(delta), down = at(-delta);
+      EXPECT_LE(std::abs(centre.u[2]), 1e-15) << "t " << t << ", z " << z;
+      EXPECT_LE(std::abs(up.T - down.T) / (2.0 * delta), 1e-9) << "T', t " << t << ", z " << z;
+      EXPECT_GT(std::abs(up.n - down.n) / (2.0 * delta), 1e-2) << "n', t " << t << ", z " << z;
+      EXPECT_GT(std::abs(up.u[2] - 2.0 * centre.u[2] + down.u[2]) / (delta * delta), 1e-2)
+          << "u_z'', t " << t << ", z " << z;
+    }
+}
+
 TEST(ManufacturedSolution, StaysInsideTheModelDomain) {
   for (int dimension : {1, 3}) {
     const auto solution = solution_of(dimension);
