@@ -266,6 +266,28 @@ shaker::continuum::PhysicsSettings column_check_physics(bool inviscid) {
   return physics;
 }
 
+// The right-hand side of a column of `cells` cells over [0, Lz] under column_check_physics,
+// cell k holding primitive(grid, k).
+struct ColumnRhs {
+  shaker::continuum::Grid grid;
+  shaker::continuum::State dUdt;
+};
+template <class CellState>
+ColumnRhs column_rhs(int cells, double Lz, bool inviscid, CellState primitive) {
+  namespace cont = shaker::continuum;
+  ColumnRhs r;
+  r.grid.h = Lz / cells;
+  r.grid.nz = cells;
+  cont::Operator op(r.grid, column_check_physics(inviscid));
+  cont::State U;
+  U.resize(r.grid.size());
+  r.dUdt.resize(r.grid.size());
+  for (int k = 0; k < r.grid.nz; ++k)
+    cont::store_primitive(U, static_cast<std::size_t>(r.grid.index(0, 0, k)), primitive(r.grid, k));
+  op.rhs(0.0, U, r.dUdt);
+  return r;
+}
+
 // Wall cell reconstruction: a state at rest with n and T even about both walls (the mirror
 // symmetry the wall conditions impose) has exact fluxes zero, so the mass right-hand side is
 // the truncation error. It must fall at least like h^2 in the wall cells (measured: 2.08,
@@ -277,24 +299,15 @@ TEST(MmsWallCell, TruncationErrorFallsAtSecondOrder) {
   namespace cont = shaker::continuum;
   const double Lz = 10.0;
   std::vector<double> wall_error;
+  const double pi = std::acos(-1.0), a = 4.0 * pi / Lz, b = 3.0 * pi / Lz;
   for (int cells : {20, 40, 80, 160}) {
-    cont::Grid g;
-    g.h = Lz / cells;
-    g.nz = cells;
-    cont::Operator op(g, column_check_physics(true));
-    cont::State U, dUdt;
-    U.resize(g.size());
-    dUdt.resize(g.size());
-    const double pi = std::acos(-1.0);
-    for (int k = 0; k < g.nz; ++k) {
-      const double z0 = k * g.h, z1 = z0 + g.h, a = 4.0 * pi / Lz, b = 3.0 * pi / Lz;
+    const auto [g, dUdt] = column_rhs(cells, Lz, true, [&](const cont::Grid& grid, int k) {
+      const double z0 = k * grid.h, z1 = z0 + grid.h;
       // exact cell averages of n = 0.4 (1 + 0.2 cos(a z)), T = 1 + 0.3 cos(b z)
-      const double n = 0.4 * (1.0 + 0.2 * (std::sin(a * z1) - std::sin(a * z0)) / (a * g.h));
-      const double nT = 0.4 * (1.0 + 0.3 * (std::sin(b * z1) - std::sin(b * z0)) / (b * g.h));
-      cont::store_primitive(U, static_cast<std::size_t>(g.index(0, 0, k)),
-                            cont::Primitive{n, 0.0, 0.0, 0.0, nT / n});
-    }
-    op.rhs(0.0, U, dUdt);
+      const double n = 0.4 * (1.0 + 0.2 * (std::sin(a * z1) - std::sin(a * z0)) / (a * grid.h));
+      const double nT = 0.4 * (1.0 + 0.3 * (std::sin(b * z1) - std::sin(b * z0)) / (b * grid.h));
+      return cont::Primitive{n, 0.0, 0.0, 0.0, nT / n};
+    });
     double wall = 0.0, interior = 0.0;
     for (int k = 0; k < g.nz; ++k) {
       const double r = std::abs(dUdt.q[cont::density][g.index(0, 0, k)]);
@@ -343,19 +356,10 @@ TEST_P(WallViscousStress, WallForceFallsAtSecondOrder) {
   const double exact = stress(Lz) - stress(0.0);
   std::vector<double> error;
   for (int cells : {20, 40, 80, 160, 320}) {
-    cont::Grid g;
-    g.h = Lz / cells;
-    g.nz = cells;
-    cont::Operator op(g, column_check_physics(false));
-    cont::State U, dUdt;
-    U.resize(g.size());
-    dUdt.resize(g.size());
-    for (int k = 0; k < g.nz; ++k) {
-      const double z = g.center(k);
-      cont::store_primitive(U, static_cast<std::size_t>(g.index(0, 0, k)),
-                            cont::Primitive{n_at(z), 0.0, 0.0, u_at(z), 1.0});
-    }
-    op.rhs(0.0, U, dUdt);
+    const auto [g, dUdt] = column_rhs(cells, Lz, false, [&](const cont::Grid& grid, int k) {
+      const double z = grid.center(k);
+      return cont::Primitive{n_at(z), 0.0, 0.0, u_at(z), 1.0};
+    });
     double total = 0.0;
     for (int k = 0; k < g.nz; ++k) total += dUdt.q[cont::momentum_z][g.index(0, 0, k)] * g.h;
     error.push_back(std::abs(total - exact));
