@@ -72,7 +72,8 @@ std::string to_string(ConvergenceKind kind) {
 namespace {
 // Celik et al. (2008), eqs. (5a-c): p = |ln|eps32/eps21| + q(p)| / ln r21,
 // q(p) = ln((r21^p - s) / (r32^p - s)), s = sign(eps32 / eps21). Solved by fixed-point
-// iteration from q = 0 (exact in one step when r21 == r32).
+// iteration from q = 0 (exact in one step when r21 == r32). Equal monotonic changes give
+// p = 0, where q takes its limit ln(ln r21 / ln r32).
 struct ApparentOrder {
   double p;
   bool converged;
@@ -81,11 +82,14 @@ struct ApparentOrder {
 ApparentOrder apparent_order(double r21, double r32, double eps21, double eps32) {
   const double s = std::copysign(1.0, eps32 / eps21);
   const double log_ratio = std::log(std::abs(eps32 / eps21));
+  const auto q = [&](double p) {
+    if (p == 0.0 && s > 0.0) return std::log(std::log(r21) / std::log(r32));
+    return std::log((std::pow(r21, p) - s) / (std::pow(r32, p) - s));
+  };
   double p = std::abs(log_ratio) / std::log(r21);
   constexpr int max_iterations = 500;
   for (int iteration = 1; iteration <= max_iterations; ++iteration) {
-    const double q = std::log((std::pow(r21, p) - s) / (std::pow(r32, p) - s));
-    const double next = std::abs(log_ratio + q) / std::log(r21);
+    const double next = std::abs(log_ratio + q(p)) / std::log(r21);
     if (!std::isfinite(next)) return {not_a_number, false, iteration};
     const bool done = std::abs(next - p) <= 1e-14 * std::max(1.0, std::abs(next));
     p = next;
@@ -120,6 +124,11 @@ GciResult three_grid_gci(double h1, double h2, double h3, double phi1, double ph
   result.order = p.p;
   result.order_converged = p.converged;
   result.iterations = p.iterations;
+  if (result.order == 0.0) {  // the changes do not shrink: no extrapolation, no finite bound
+    result.phi_extrapolated = result.extrapolated_error21 = result.asymptotic_ratio = not_a_number;
+    result.gci21 = result.gci32 = std::numeric_limits<double>::infinity();
+    return result;
+  }
   result.phi_extrapolated = richardson_extrapolate(phi1, phi2, result.r21, result.order);
   result.extrapolated_error21 =
       std::abs((result.phi_extrapolated - phi1) / result.phi_extrapolated);

@@ -173,6 +173,23 @@ TEST(Gci, AChangeWithinRoundOffIsNoChange) {
   EXPECT_NEAR(h.order, 2.0, 1e-5);
 }
 
+// Equal changes on two refinements: the observed order is 0 (the fixed-point iteration used
+// to stop on 0 / 0 with order NaN), and the GCI has no finite bound.
+TEST(Gci, EqualChangesGiveOrderZeroAndNoBound) {
+  const cv::GciResult g = cv::three_grid_gci(0.1, 0.2, 0.4, 1.0, 1.25, 1.5);
+  EXPECT_EQ(g.kind, cv::ConvergenceKind::monotonic);
+  EXPECT_EQ(g.order, 0.0);
+  EXPECT_TRUE(g.order_converged);
+  EXPECT_TRUE(std::isinf(g.gci21));
+  EXPECT_TRUE(std::isnan(g.phi_extrapolated));
+  // Equal changes over h 0.1, 0.2, 0.3 are what phi = a + b h gives: order 1, reached through
+  // q's limit at p = 0.
+  const cv::GciResult h = cv::three_grid_gci(0.1, 0.2, 0.3, 1.0, 1.25, 1.5);
+  EXPECT_TRUE(h.order_converged);
+  EXPECT_NEAR(h.order, 1.0, 1e-9);
+  std::printf("equal changes: order %.3f (ratios 2, 2); %.6f (ratios 2, 1.5)\n", g.order, h.order);
+}
+
 TEST(Gci, TwoGridsUseSafetyFactorThree) {
   const cv::TwoGridGci g = cv::two_grid_gci(0.05, 0.1, 1.01, 1.04, 2.0);
   EXPECT_NEAR(g.gci21, 3.0 * (0.03 / 1.01) / 3.0, 1e-15);
