@@ -1,19 +1,16 @@
 #include "continuum/implicit_diffusion.hpp"
 
 #include <Eigen/IterativeLinearSolvers>
-#include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 #include "common/errors.hpp"
 #include "continuum/halo.hpp"
-#include "continuum/wall_stress.hpp"
 
 namespace shaker::continuum {
 
@@ -29,22 +26,13 @@ inline double coefficient(const Operator::Closure& cl, std::ptrdiff_t c, int com
   if (component == 3) return cl.kappa[c];
   return direction == component ? cl.lambda[c] + 4.0 / 3.0 * cl.mu[c] : cl.mu[c];
 }
-
-/// u_z's coefficient on a wall face (wall_stress.hpp) from the cells a, b, c (storage indices,
-/// counted from the wall inwards): as on an interior face, with the ghost cell's.
-inline double wall_coefficient(const Operator::Closure& cl, std::ptrdiff_t a, std::ptrdiff_t b, std::ptrdiff_t c) {
-  const auto at = [&](std::ptrdiff_t cell) { return coefficient(cl, cell, 2, 2); };
-  return harmonic_mean(at(a), wall::ghost_coefficient(at(a), at(b), at(c)));
-}
 /// CG preconditioner for the 3D systems: Jacobi plus an exact solve of the horizontally
 /// uniform part (two-level, additive: z = D^-1 r + P Ac^-1 P^T r, P the constant prolongation
 /// from the nz planes of cells, Ac = P^T A P, tridiagonal). The base case is nearly flat and
 /// stiff where the gas is dilute: the slow modes of Jacobi-preconditioned CG are the
 /// horizontally uniform, vertically smooth ones (a column is 80 / h cells tall), and the
 /// coarse solve removes exactly those. Rows are cells m = i + nx (j + ny k): plane k is the
-/// rows plane k .. plane (k + 1) - 1. Symmetric positive definite, as CG needs; for u_z's
-// non-symmetric wall rows (BiCGSTAB) Ac takes the entries of plane k - 1's rows in plane k's
-// columns for both off-diagonals.
+/// rows plane k .. plane (k + 1) - 1. Symmetric positive definite, as CG needs.
 class PlaneAveragedColumn {
  public:
   using StorageIndex = int;
@@ -141,14 +129,13 @@ template <class Visit> void for_each_face(const Grid& g, Visit visit) {
       }
 }
 
-// The column's system: tridiagonal (sub/super-diagonals -face_[m], diagonal the mass term plus
-// the faces of the cell), except for u_z, whose wall rows carry the wall's normal stress
-// (wall_stress.hpp), c_w (w_0 u_a + w_1 u_b + w_2 u_c) / h^2 for the cells a, b, c from the
-// wall inwards. Its entries at a and b join the tridiagonal T; the two at c (one per wall)
-// make A = T + U V^T of rank 2, solved exactly by the Sherman-Morrison-Woodbury formula from
-// three solves with T. T is diagonally dominant (the mass term; the wall row's off-diagonals
-// sum to less than its wall term) with non-positive off-diagonals, so elimination without
-// pivoting is stable, T^-1 >= 0, and the 2 x 2 system 1 + V^T T^-1 U has a diagonal >= 1.
+// Tridiagonal solve for the column: sub/super-diagonals -face_[m], diagonal the mass term
+// plus the faces of the cell (plus the mirrored wall for u_z). The mass term makes the matrix
+// strictly diagonally dominant, so elimination without pivoting is stable. Twisted
+// (two-sided) elimination: rows from the top and from the bottom are eliminated together,
+// meeting at the middle row, then substituted back outwards. The same work as the Thomas
+// algorithm, but two independent chains of divisions of half the length, which a core
+// overlaps (the one-sided sweep was bound by the latency of its chain).
 void ImplicitDiffusion::solve_column(const Operator& op, int component, double dt, Eigen::VectorXd& x) {
   const double* n = op.primitives()[0].data();
   const auto& cl = op.closure();
@@ -161,81 +148,46 @@ void ImplicitDiffusion::solve_column(const Operator& op, int component, double d
   face_[M - 1] = 0.0;
   for (std::size_t m = 0; m < M; ++m)
     diagonal_[m] = mass_factor * n[storage_[m]] + face_[m] + (m > 0 ? face_[m - 1] : 0.0);
-  double top = face_[0], bottom = face_[M - 2];  // minus T's entries (0, 1) and (M - 1, M - 2)
-  double top_far = 0.0, bottom_far = 0.0;       // A's entries (0, 2) and (M - 1, M - 3)
-  const Eigen::Index far[2] = {2, static_cast<Eigen::Index>(M) - 3};
+  // wall: only u_z has a condition (u_z = 0, mirror ghost), the rest no flux
   if (component == 2) {
-    const auto wall = [&](std::size_t a, std::size_t b, std::size_t c, double& coupling, double& entry_at_c) {
-      const double c_w = wall_coefficient(cl, storage_[a], storage_[b], storage_[c]) * inv_h2;
-      diagonal_[a] += wall::slope_weight[0] * c_w;
-      coupling -= wall::slope_weight[1] * c_w;
-      entry_at_c = wall::slope_weight[2] * c_w;
-    };
-    wall(0, 1, 2, top, top_far);
-    wall(M - 1, M - 2, M - 3, bottom, bottom_far);
+    diagonal_[0] += 2.0 * coefficient(cl, storage_[0], 2, 2) * inv_h2;
+    if (M > 1) diagonal_[M - 1] += 2.0 * coefficient(cl, storage_[M - 1], 2, 2) * inv_h2;
   }
-  factorize_column(top, bottom);
-  x = rhs_;
-  substitute_column(x);
-  if (top_far == 0.0 && bottom_far == 0.0) return;
-  // x -= T^-1 U (1 + V^T T^-1 U)^-1 V^T x, U's columns top_far e_0 and bottom_far e_(M - 1),
-  // V's e_2 and e_(M - 3).
-  Eigen::VectorXd& y_top = wall_response_[0];
-  Eigen::VectorXd& y_bottom = wall_response_[1];
-  y_top.setZero(static_cast<Eigen::Index>(M));
-  y_bottom.setZero(static_cast<Eigen::Index>(M));
-  y_top[0] = top_far;
-  y_bottom[static_cast<Eigen::Index>(M) - 1] = bottom_far;
-  substitute_column(y_top);
-  substitute_column(y_bottom);
-  Eigen::Matrix2d capacitance;
-  capacitance << 1.0 + y_top[far[0]], y_bottom[far[0]], y_top[far[1]], 1.0 + y_bottom[far[1]];
-  const Eigen::Vector2d weights = capacitance.inverse() * Eigen::Vector2d(x[far[0]], x[far[1]]);
-  x -= weights[0] * y_top + weights[1] * y_bottom;
-}
-
-// Twisted (two-sided) elimination of T: rows from the top and from the bottom are eliminated
-// together, meeting at the middle row k. The same work as the Thomas algorithm, but two
-// independent chains of divisions of half the length, which a core overlaps (the one-sided
-// sweep was bound by the latency of its chain). Row m < k becomes x[m] + forward_[m] x[m + 1],
-// row m > k x[m] + backward_[m] x[m - 1]; diagonal_ then holds the inverse pivots.
-// `top` / `bottom`: minus row 0's super-diagonal / row M - 1's sub-diagonal.
-void ImplicitDiffusion::factorize_column(double top, double bottom) {
-  const std::size_t M = storage_.size(), k = (M - 1) / 2;  // k >= 1: a column has >= 4 cells
-  const auto from_top = [&](std::size_t m, double coupling) {
-    diagonal_[m] = 1.0 / (m > 0 ? diagonal_[m] + face_[m - 1] * forward_[m - 1] : diagonal_[m]);
-    forward_[m] = -coupling * diagonal_[m];
+  // Rows 0 .. k - 1 from the top: x[m] + forward_[m] x[m + 1] = x[m] (the reduced right-hand
+  // side, kept in x); rows M - 1 .. k + 1 from the bottom: x[m] + backward_[m] x[m - 1] = x[m].
+  const std::size_t k = (M - 1) / 2;
+  const auto top = [&](std::size_t m) {
+    const double inverse_pivot =
+        1.0 / (m > 0 ? diagonal_[m] + face_[m - 1] * forward_[m - 1] : diagonal_[m]);
+    forward_[m] = -face_[m] * inverse_pivot;
+    x[m] = (m > 0 ? rhs_[m] + face_[m - 1] * x[m - 1] : rhs_[m]) * inverse_pivot;
   };
-  const auto from_bottom = [&](std::size_t m, double coupling) {
-    diagonal_[m] = 1.0 / (m + 1 < M ? diagonal_[m] + face_[m] * backward_[m + 1] : diagonal_[m]);
-    backward_[m] = -coupling * diagonal_[m];
+  const auto bottom = [&](std::size_t m) {
+    const double inverse_pivot =
+        1.0 / (m + 1 < M ? diagonal_[m] + face_[m] * backward_[m + 1] : diagonal_[m]);
+    backward_[m] = -face_[m - 1] * inverse_pivot;
+    x[m] = (m + 1 < M ? rhs_[m] + face_[m] * x[m + 1] : rhs_[m]) * inverse_pivot;
   };
-  from_top(0, top);
-  from_bottom(M - 1, bottom);
-  for (std::size_t i = 1; i < k; ++i) {
-    from_top(i, face_[i]);
-    from_bottom(M - 1 - i, face_[M - 2 - i]);
+  for (std::size_t i = 0; i < k; ++i) {
+    top(i);
+    bottom(M - 1 - i);
   }
-  if (M - 1 - k > k) from_bottom(k + 1, face_[k]);  // an even M has one more row below the middle
-  diagonal_[k] = 1.0 / (diagonal_[k] + face_[k - 1] * forward_[k - 1] + face_[k] * backward_[k + 1]);
-}
-
-// Solves T v = v with the factors of factorize_column.
-void ImplicitDiffusion::substitute_column(Eigen::VectorXd& v) const {
-  const std::size_t M = storage_.size(), k = (M - 1) / 2;
-  v[0] *= diagonal_[0];
-  v[M - 1] *= diagonal_[M - 1];
-  for (std::size_t i = 1; i < k; ++i) {
-    v[i] = (v[i] + face_[i - 1] * v[i - 1]) * diagonal_[i];
-    v[M - 1 - i] = (v[M - 1 - i] + face_[M - 1 - i] * v[M - i]) * diagonal_[M - 1 - i];
+  if (M - 1 - k > k) bottom(k + 1);  // an even M has one more row below the middle
+  double pivot = diagonal_[k], right = rhs_[k];
+  if (k > 0) {
+    pivot += face_[k - 1] * forward_[k - 1];
+    right += face_[k - 1] * x[k - 1];
   }
-  if (M - 1 - k > k) v[k + 1] = (v[k + 1] + face_[k + 1] * v[k + 2]) * diagonal_[k + 1];
-  v[k] = (v[k] + face_[k - 1] * v[k - 1] + face_[k] * v[k + 1]) * diagonal_[k];
+  if (k + 1 < M) {
+    pivot += face_[k] * backward_[k + 1];
+    right += face_[k] * x[k + 1];
+  }
+  x[k] = right / pivot;
   for (std::size_t i = 1; i <= k; ++i) {
-    v[k - i] -= forward_[k - i] * v[k - i + 1];
-    v[k + i] -= backward_[k + i] * v[k + i - 1];
+    x[k - i] -= forward_[k - i] * x[k - i + 1];
+    x[k + i] -= backward_[k + i] * x[k + i - 1];
   }
-  if (M - 1 - k > k) v[M - 1] -= backward_[M - 1] * v[M - 2];
+  if (M - 1 - k > k) x[M - 1] -= backward_[M - 1] * x[M - 2];
 }
 
 void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
@@ -250,11 +202,8 @@ void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
   }
   for_each_face(grid_, [&](Eigen::Index a, Eigen::Index b, int direction) {
     const auto ca = storage_[a];
-    if (b < 0) {  // wall: only u_z has a condition (u_z = 0, the stress of wall_stress.hpp), the rest no flux
-      if (component != 2) return;
-      const auto cells = wall_cells(a);
-      const double c_w = wall_coefficient(cl, ca, storage_[cells[1]], storage_[cells[2]]) * inv_h2;
-      for (int i = 0; i < 3; ++i) triplets_.emplace_back(a, cells[i], wall::slope_weight[i] * c_w);
+    if (b < 0) {  // wall: only u_z has a condition (u_z = 0, mirror ghost), the rest no flux
+      if (component == 2) triplets_.emplace_back(a, a, 2.0 * coefficient(cl, ca, component, direction) * inv_h2);
       return;
     }
     if (a == b) return;  // a single cell across a periodic direction
@@ -268,13 +217,7 @@ void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
   matrix_.setFromTriplets(triplets_.begin(), triplets_.end());
 }
 
-std::array<Eigen::Index, 3> ImplicitDiffusion::wall_cells(Eigen::Index a) const {
-  const Eigen::Index plane = Eigen::Index{grid_.nx} * grid_.ny;
-  const Eigen::Index step = a < plane ? plane : -plane;
-  return {a, a + step, a + 2 * step};
-}
-
-void ImplicitDiffusion::solve_sparse(Eigen::VectorXd& x, bool symmetric) {
+void ImplicitDiffusion::solve_sparse(Eigen::VectorXd& x) {
   if (grid_.dimension == 1) {
     if (!banded_) {
       banded_ = std::make_unique<Banded>();
@@ -285,40 +228,27 @@ void ImplicitDiffusion::solve_sparse(Eigen::VectorXd& x, bool symmetric) {
     x = banded_->solve(rhs_);
     return;
   }
+  Eigen::ConjugateGradient<Matrix, Eigen::Lower | Eigen::Upper, PlaneAveragedColumn> solver;
+  solver.setTolerance(1e-13);
+  solver.preconditioner().set_planes(static_cast<Eigen::Index>(grid_.nx) * grid_.ny, grid_.nz);
+  solver.compute(matrix_);
   // Started from the state before the step (x on entry): the step changes it little except in
-  // the stiff dilute gas, and the solver then needs far fewer iterations than from zero.
-  const auto solve_with = [&](auto& solver, const char* name) {
-    solver.setTolerance(1e-13);
-    solver.preconditioner().set_planes(static_cast<Eigen::Index>(grid_.nx) * grid_.ny, grid_.nz);
-    solver.compute(matrix_);
-    x = solver.solveWithGuess(rhs_, x);
-    if (solver.info() != Eigen::Success) throw DomainError(std::string("implicit diffusion: ") + name + " did not converge");
-  };
-  if (symmetric) {
-    Eigen::ConjugateGradient<Matrix, Eigen::Lower | Eigen::Upper, PlaneAveragedColumn> solver;
-    solve_with(solver, "CG");
-  } else {
-    Eigen::BiCGSTAB<Matrix, PlaneAveragedColumn> solver;
-    solve_with(solver, "BiCGSTAB");
-  }
+  // the stiff dilute gas, and CG then needs far fewer iterations than from zero.
+  x = solver.solveWithGuess(rhs_, x);
+  if (solver.info() != Eigen::Success) throw DomainError("implicit diffusion: CG did not converge");
 }
 
 void ImplicitDiffusion::solve(const Operator& op, int component, double dt, Eigen::VectorXd& x) {
   if (column_) return solve_column(op, component, dt, x);
   assemble(op, component, dt);
-  solve_sparse(x, component != 2 || grid_.z_boundary != ZBoundary::walls);
+  solve_sparse(x);
 }
 
 void ImplicitDiffusion::add_dissipation(const Operator& op, int component, const Eigen::VectorXd& u) {
   const auto& cl = op.closure();
   const double inv_h2 = 1.0 / (grid_.h * grid_.h);
-  // The work of the wall stress on the wall cell's velocity (the wall itself is at rest).
   const auto wall = [&](Eigen::Index a) {
-    if (component != 2) return;
-    const auto cells = wall_cells(a);
-    double stress = 0.0;
-    for (int i = 0; i < 3; ++i) stress += wall::slope_weight[i] * u[cells[i]];
-    dissipation_[a] += wall_coefficient(cl, storage_[a], storage_[cells[1]], storage_[cells[2]]) * inv_h2 * u[a] * stress;
+    if (component == 2) dissipation_[a] += 2.0 * coefficient(cl, storage_[a], 2, 2) * u[a] * u[a] * inv_h2;
   };
   if (column_) {  // face_ still holds this component's coefficients
     const auto M = static_cast<Eigen::Index>(storage_.size());
@@ -437,31 +367,15 @@ template <int count, class Term> void plane_sums(const Grid& g, std::vector<doub
     std::copy(sum.begin(), sum.end(), sums.begin() + static_cast<std::ptrdiff_t>(k) * count);
   });
 }
-
-/// body(c, step) for every interior cell c of the two wall planes, step the stride inwards.
-template <class Body> void for_wall_cells(const Grid& g, Body body) {
-  for (const int k : {0, g.nz - 1}) {
-    const std::ptrdiff_t step = k == 0 ? g.stride(2) : -g.stride(2);
-    for (int j = 0; j < g.ny; ++j)
-      for (std::ptrdiff_t c = g.index(0, j, k); c < g.index(0, j, k) + g.nx; ++c) body(c, step);
-  }
-}
-
-/// Sums over the box of term(c)[s], s < count: per plane, over the ranks, then over the planes
-/// in order.
-template <int count, class Term>
-std::array<double, count> box_sums(const Grid& g, const Halo& halo, std::vector<double>& scratch, Term term) {
-  plane_sums<count>(g, scratch, [&](std::ptrdiff_t c, int) { return term(c); });
-  halo.sum(scratch);
-  std::array<double, count> total{};
-  for (std::size_t k = 0; k < static_cast<std::size_t>(g.nz); ++k)
-    for (int s = 0; s < count; ++s) total[s] += scratch[k * count + s];
-  return total;
-}
 }  // namespace
 
 double ImplicitDiffusion::box_sum_of_products(const std::vector<double>& a, const std::vector<double>& b) {
-  return box_sums<1>(grid_, *halo_, decomposed_.plane_sums, [&](std::ptrdiff_t c) { return std::array<double, 1>{a[c] * b[c]}; })[0];
+  std::vector<double>& sums = decomposed_.plane_sums;
+  plane_sums<1>(grid_, sums, [&](std::ptrdiff_t c, int) { return std::array<double, 1>{a[c] * b[c]}; });
+  halo_->sum(sums);
+  double total = 0.0;
+  for (const double s : sums) total += s;
+  return total;
 }
 
 void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, double dt) {
@@ -487,33 +401,23 @@ void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, d
         if (i >= 0 && j >= 0 && k + 1 < g.nz) face(c, 2);
       }
   });
-  // u_z's wall rows (wall_stress.hpp): c_w / h^2 per wall cell, w_0 of it on the diagonal, w_1
-  // and w_2 at the next two cells inwards (apply_decomposed).
-  d.wall_rows = component == 2;
-  if (d.wall_rows)
-    for_wall_cells(g, [&](std::ptrdiff_t c, std::ptrdiff_t step) {
-      d.wall_coefficient[c] = wall_coefficient(cl, c, c + step, c + 2 * step) * inv_h2;
-    });
-  const auto wall_term = [&](std::ptrdiff_t c, int k) {
-    return d.wall_rows && (k == 0 || k + 1 == g.nz) ? wall::slope_weight[0] * d.wall_coefficient[c] : 0.0;
+  const auto wall = [&](std::ptrdiff_t c, int k) {
+    const bool at_wall = component == 2 && (k == 0 || k + 1 == g.nz);
+    return at_wall ? 2.0 * coefficient(cl, c, 2, 2) * inv_h2 : 0.0;
   };
   for_interior(g, [&](std::ptrdiff_t c, int k) {
-    double diagonal = mass_factor * n[c] / dt + wall_term(c, k);
+    double diagonal = mass_factor * n[c] / dt + wall(c, k);
     for (int direction = 0; direction < 3; ++direction)
       diagonal += d.face[direction][c] + d.face[direction][c - strides[direction]];
     d.diagonal[c] = diagonal;
     d.inverse_diagonal[c] = 1.0 / diagonal;
   });
   // The coarse system Ac = P^T A P: per plane the mass, wall and z-face terms (the horizontal
-  // faces cancel) and the coupling to the plane below, taken as the Eigen path takes it from
-  // the matrix: the entries of the rows of plane k - 1 in the columns of plane k (for u_z at
-  // the plate: with the wall rows' entries in plane 1), used for both off-diagonals.
+  // faces cancel) and the coupling to the plane below.
   std::vector<double>& sums = d.plane_sums;
   plane_sums<2>(g, sums, [&](std::ptrdiff_t c, int k) {
     const double below = d.face[2][c - strides[2]];
-    const double wall_row_above = d.wall_rows && k == 1 ? wall::slope_weight[1] * d.wall_coefficient[c - strides[2]] : 0.0;
-    return std::array<double, 2>{mass_factor * n[c] / dt + wall_term(c, k) + d.face[2][c] + below,
-                                 wall_row_above - below};
+    return std::array<double, 2>{mass_factor * n[c] / dt + wall(c, k) + d.face[2][c] + below, -below};
   });
   halo_->sum(sums);
   const auto planes = static_cast<std::size_t>(g.nz);
@@ -538,10 +442,6 @@ void ImplicitDiffusion::apply_decomposed(const std::vector<double>& x, std::vect
   for_interior(g, [&](std::ptrdiff_t c, int) {
     out[c] = d.diagonal[c] * x[c] - fx[c] * x[c + 1] - fx[c - 1] * x[c - 1] - fy[c] * x[c + sy] -
              fy[c - sy] * x[c - sy] - fz[c] * x[c + sz] - fz[c - sz] * x[c - sz];
-  });
-  if (!d.wall_rows) return;
-  for_wall_cells(g, [&](std::ptrdiff_t c, std::ptrdiff_t step) {
-    out[c] += d.wall_coefficient[c] * (wall::slope_weight[1] * x[c + step] + wall::slope_weight[2] * x[c + 2 * step]);
   });
 }
 
@@ -610,72 +510,11 @@ void ImplicitDiffusion::solve_decomposed(std::vector<double>& x) {
   throw DomainError("implicit diffusion: CG did not converge");
 }
 
-// Preconditioned BiCGSTAB as Eigen's (the same recurrences, restart and stopping rule), for
-// u_z, whose wall rows make the system non-symmetric; from the first guess in x.
-void ImplicitDiffusion::solve_decomposed_bicgstab(std::vector<double>& x) {
+void ImplicitDiffusion::add_dissipation_decomposed(const Operator& op, int component, std::vector<double>& u) {
   const Grid& g = grid_;
   Decomposed& d = decomposed_;
-  std::vector<double>& r = d.residual;
-  std::vector<double>& r0 = d.shadow;
-  std::vector<double>& p = d.search;
-  std::vector<double>& v = d.product;
-  std::vector<double>& y = d.preconditioned;
-  std::vector<double>& s = d.stage;
-  std::vector<double>& z = d.stage_preconditioned;
-  std::vector<double>& t = d.stage_product;
-  const double rhs_norm2 = box_sum_of_products(d.rhs, d.rhs);
-  if (rhs_norm2 == 0.0) {
-    for_interior(g, [&](std::ptrdiff_t c, int) { x[c] = 0.0; });
-    return;
-  }
-  const auto restart = [&] {
-    halo_->exchange({x.data()});
-    apply_decomposed(x, v);
-    for_interior(g, [&](std::ptrdiff_t c, int) { r0[c] = r[c] = d.rhs[c] - v[c]; });
-    return box_sum_of_products(r, r);
-  };
-  // (r.r, r0.r) in one reduction
-  const auto residual_sums = [&] {
-    return box_sums<2>(g, *halo_, d.plane_sums, [&](std::ptrdiff_t c) { return std::array<double, 2>{r[c] * r[c], r0[c] * r[c]}; });
-  };
-  double r0_norm2 = restart();
-  for_interior(g, [&](std::ptrdiff_t c, int) { v[c] = p[c] = 0.0; });
-  constexpr double tolerance = 1e-13, eps = std::numeric_limits<double>::epsilon();
-  const double threshold = tolerance * tolerance * rhs_norm2;
-  const double most = 2.0 * static_cast<double>(halo_->box().interior_cells());  // Eigen's default
-  double rho = 1.0, alpha = 1.0, w = 1.0;
-  std::array<double, 2> sums = residual_sums();  // r.r, r0.r
-  for (double iteration = 0, restarts = 0; sums[0] > threshold && iteration < most; ++iteration) {
-    const double rho_old = rho;
-    rho = sums[1];
-    if (std::abs(rho) < eps * eps * r0_norm2) {  // r has become orthogonal to r0: a new r0
-      rho = r0_norm2 = restart();
-      if (restarts++ == 0) iteration = 0;
-    }
-    const double beta = (rho / rho_old) * (alpha / w);
-    for_interior(g, [&](std::ptrdiff_t c, int) { p[c] = r[c] + beta * (p[c] - w * v[c]); });
-    precondition_decomposed(p, y);
-    halo_->exchange({y.data()});
-    apply_decomposed(y, v);
-    alpha = rho / box_sum_of_products(r0, v);
-    for_interior(g, [&](std::ptrdiff_t c, int) { s[c] = r[c] - alpha * v[c]; });
-    precondition_decomposed(s, z);
-    halo_->exchange({z.data()});
-    apply_decomposed(z, t);
-    const auto [tt, ts] = box_sums<2>(g, *halo_, d.plane_sums, [&](std::ptrdiff_t c) { return std::array<double, 2>{t[c] * t[c], t[c] * s[c]}; });
-    w = tt > 0.0 ? ts / tt : 0.0;
-    for_interior(g, [&](std::ptrdiff_t c, int) {
-      x[c] += alpha * y[c] + w * z[c];
-      r[c] = s[c] - w * t[c];
-    });
-    sums = residual_sums();
-  }
-  if (sums[0] > threshold) throw DomainError("implicit diffusion: BiCGSTAB did not converge");
-}
-
-void ImplicitDiffusion::add_dissipation_decomposed(std::vector<double>& u) {
-  const Grid& g = grid_;
-  Decomposed& d = decomposed_;
+  const auto& cl = op.closure();
+  const double inv_h2 = 1.0 / (g.h * g.h);
   const std::ptrdiff_t strides[3] = {g.stride(0), g.stride(1), g.stride(2)};
   halo_->exchange({u.data()});
   // Each cell takes half of every one of its faces' dissipation, from its own side.
@@ -686,11 +525,7 @@ void ImplicitDiffusion::add_dissipation_decomposed(std::vector<double>& u) {
       const double up = u[c] - u[c + s], down = u[c] - u[c - s];
       sum += 0.5 * d.face[direction][c] * up * up + 0.5 * d.face[direction][c - s] * down * down;
     }
-    if (d.wall_rows && (k == 0 || k + 1 == g.nz)) {  // the wall stress's work (the wall is at rest)
-      const std::ptrdiff_t step = k == 0 ? strides[2] : -strides[2];
-      sum += d.wall_coefficient[c] * u[c] *
-             (wall::slope_weight[0] * u[c] + wall::slope_weight[1] * u[c + step] + wall::slope_weight[2] * u[c + 2 * step]);
-    }
+    if (component == 2 && (k == 0 || k + 1 == g.nz)) sum += 2.0 * coefficient(cl, c, 2, 2) * u[c] * u[c] * inv_h2;
     d.dissipation[c] += sum;
   });
 }
@@ -701,8 +536,7 @@ void ImplicitDiffusion::advance_decomposed(Operator& op, State& U, double dt, bo
   Decomposed& d = decomposed_;
   if (d.rhs.size() != g.size()) {
     for (auto* v : {&d.rhs, &d.dissipation, &d.residual, &d.preconditioned, &d.search, &d.product,
-                    &d.diagonal, &d.inverse_diagonal, &d.shadow, &d.stage, &d.stage_preconditioned,
-                    &d.stage_product, &d.wall_coefficient})
+                    &d.diagonal, &d.inverse_diagonal})
       v->assign(g.size(), 0.0);
     for (auto& v : d.solution) v.assign(g.size(), 0.0);
     for (auto& v : d.face) v.assign(g.size(), 0.0);
@@ -723,13 +557,12 @@ void ImplicitDiffusion::advance_decomposed(Operator& op, State& U, double dt, bo
       continue;
     }
     assemble_decomposed(op, component, dt);
-    if (d.wall_rows) solve_decomposed_bicgstab(u);
-    else solve_decomposed(u);
+    solve_decomposed(u);
     for_interior(g, [&](std::ptrdiff_t c, int) {
       const double change = u[c] - u0[c];
       d.dissipation[c] += 0.5 * n[c] * change * change / dt;
     });
-    add_dissipation_decomposed(u);
+    add_dissipation_decomposed(op, component, u);
   }
   const double* T = w[4].data();
   std::vector<double>& temperature = d.solution[3];

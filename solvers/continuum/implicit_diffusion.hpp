@@ -6,20 +6,17 @@
 //   (3/2) n (T* - T) / dt = div(kappa grad T*) + Phi,
 // Phi the viscous dissipation of the implicit momentum step (discrete, face by face, plus
 // n |u* - u|^2 / (2 dt)), which makes the step conserve total energy exactly (to the linear
-// solver's tolerance). Each system is diagonally dominant, and symmetric positive definite but
-// for u_z between walls: its wall rows carry the wall's normal stress (wall_stress.hpp), the
-// explicit kernels' own, which reaches two cells in. A 1D column between walls gives a
-// tridiagonal system (plus, for u_z, one entry per wall, taken by the Sherman-Morrison-Woodbury
-// formula), solved directly by two-sided (twisted) Gaussian elimination (O(n), no pivoting
-// needed, nothing allocated per step); other grids use Eigen (LDLT for a periodic column; in 3D
-// conjugate gradients, BiCGSTAB for u_z, preconditioned by Jacobi plus an exact solve of the
-// horizontally uniform part). Mass is untouched.
+// solver's tolerance). Each system is symmetric positive definite and diagonally dominant.
+// A 1D column between walls gives a tridiagonal system, solved directly by two-sided
+// (twisted) Gaussian elimination (O(n), no pivoting needed, nothing allocated per step); other grids use Eigen
+// (LDLT for a periodic column; in 3D conjugate gradients preconditioned by Jacobi plus an exact
+// solve of the horizontally uniform part). Mass is untouched.
 // A 3D box run under an MPI launcher (any number of ranks, one included) is decomposed
-// (halo.hpp) and uses a distributed CG and BiCGSTAB of its own instead of Eigen's, with the
-// same recurrences and preconditioner (the second half of implicit_diffusion.cpp): Eigen's
-// solvers cannot span ranks, and one algorithm for every rank count makes the results differ
-// between rank counts only by the order of the dot products' sums. A plain run keeps Eigen's
-// solvers, so its results stay those it always had.
+// (halo.hpp) and uses a distributed CG of its own instead of Eigen's, with the same
+// preconditioner (the second half of implicit_diffusion.cpp): Eigen's CG cannot span ranks, and one
+// algorithm for every rank count makes the results differ between rank counts only by the
+// order of the dot products' sums. A plain run keeps Eigen's CG, so its results stay those it
+// always had.
 // The mixed-derivative viscous terms of 3D (d_i (mu d_j u_i), i != j) are not part of this
 // operator; in 3D the full variant keeps only the terms above (stated in the report).
 #include <Eigen/Sparse>
@@ -46,14 +43,8 @@ class ImplicitDiffusion {
   /// Solves the system of `component` (0..2: u, 3: T) for rhs_ into x and adds nothing else.
   void solve(const Operator& op, int component, double dt, Eigen::VectorXd& x);
   void solve_column(const Operator& op, int component, double dt, Eigen::VectorXd& x);
-  /// The column's tridiagonal part: its elimination, and a solve with it (in place).
-  void factorize_column(double top, double bottom);
-  void substitute_column(Eigen::VectorXd& v) const;
   void assemble(const Operator& op, int component, double dt);
-  /// CG for a symmetric matrix_, else BiCGSTAB (u_z between walls), both preconditioned alike.
-  void solve_sparse(Eigen::VectorXd& x, bool symmetric);
-  /// A wall cell (its index m) and the next two cells inwards.
-  std::array<Eigen::Index, 3> wall_cells(Eigen::Index a) const;
+  void solve_sparse(Eigen::VectorXd& x);
   /// Adds the discrete viscous dissipation of velocity component `component` to dissipation_.
   void add_dissipation(const Operator& op, int component, const Eigen::VectorXd& u);
 
@@ -64,19 +55,14 @@ class ImplicitDiffusion {
   void apply_decomposed(const std::vector<double>& x, std::vector<double>& out) const;
   /// z = M^-1 r (Jacobi plus the plane-averaged column); returns (r.r, r.z) over the box.
   std::pair<double, double> precondition_decomposed(const std::vector<double>& r, std::vector<double>& z);
-  void solve_decomposed(std::vector<double>& x);  ///< CG
-  void solve_decomposed_bicgstab(std::vector<double>& x);
-  /// The dissipation of the system assembled last (its face and wall coefficients).
-  void add_dissipation_decomposed(std::vector<double>& u);
+  void solve_decomposed(std::vector<double>& x);
+  void add_dissipation_decomposed(const Operator& op, int component, std::vector<double>& u);
   double box_sum_of_products(const std::vector<double>& a, const std::vector<double>& b);
 
   Grid grid_;
   std::shared_ptr<const Halo> halo_;
   struct Decomposed {
     std::vector<double> rhs, dissipation, residual, preconditioned, search, product, diagonal, inverse_diagonal;
-    std::vector<double> shadow, stage, stage_preconditioned, stage_product;  ///< BiCGSTAB's further vectors
-    std::vector<double> wall_coefficient;  ///< u_z: c_w / h^2 of each wall cell (wall_stress.hpp)
-    bool wall_rows = false;                ///< the system assembled is u_z's
     std::array<std::vector<double>, 4> solution;  ///< u_x, u_y, u_z, T
     std::array<std::vector<double>, 3> face;  ///< coefficient of the face to the +x, +y, +z neighbour
     /// The coarse system: Ac(k, k - 1), its elimination, and the work vectors of the sums.
@@ -90,7 +76,6 @@ class ImplicitDiffusion {
   /// column: face coefficients (face m between m, m + 1), diagonal, and the eliminated
   /// off-diagonals from the top (forward_) and from the bottom (backward_)
   std::vector<double> face_, diagonal_, forward_, backward_;
-  std::array<Eigen::VectorXd, 2> wall_response_;  ///< column: T^-1 of the two walls' far entries
   // Sparse path.
   std::vector<Eigen::Triplet<double>> triplets_;
   Matrix matrix_;

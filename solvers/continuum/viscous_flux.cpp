@@ -7,13 +7,11 @@
 // below twice the smaller coefficient and is second order all the same. In 1D the
 // tangential derivatives are zero, which is exactly what the 3D kernel computes for a
 // horizontally uniform state. At walls the heat, energy and tangential momentum fluxes are
-// zero (no heat through the walls, zero normal gradient of the tangential velocity); the
-// normal stress there takes an extrapolated ghost cell (wall_stress.hpp).
+// zero (no heat through the walls, zero normal gradient of the tangential velocity).
 #include <algorithm>
 
 #include "continuum/operator.hpp"
 #include "continuum/simd_pair.hpp"
-#include "continuum/wall_stress.hpp"
 
 namespace shaker::continuum {
 
@@ -25,18 +23,6 @@ inline double harmonic_mean(double a, double b) {
 inline Pair harmonic_mean(Pair a, Pair b) {  // per lane the above
   const Pair sum = a + b, zero = {0.0, 0.0};
   return sum > 0.0 ? 2.0 * a * b / sum : zero;
-}
-
-/// tau_zz at a wall (wall_stress.hpp) from the first three cells inwards (u, mu, lambda at
-/// cells 0, 1, 2); `side` +1 at the plate, -1 at the ceiling; `tangential_divergence` the
-/// face's d u_x / dx + d u_y / dy.
-template <class S>
-S wall_normal_stress(const S (&u)[3], const S (&mu)[3], const S (&lambda)[3],
-                     S tangential_divergence, double side, double inv_h) {
-  const S slope = wall::normal_slope(u, side, inv_h);
-  const S mu_w = harmonic_mean(mu[0], wall::ghost_coefficient(mu[0], mu[1], mu[2]));
-  const S lambda_w = harmonic_mean(lambda[0], wall::ghost_coefficient(lambda[0], lambda[1], lambda[2]));
-  return mu_w * (slope + slope) + (lambda_w - 2.0 / 3.0 * mu_w) * (tangential_divergence + slope);
 }
 }  // namespace
 
@@ -94,16 +80,6 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
     for (; paired < f1 - f0; ++paired) faces(paired, 0.0);
     if (walls && f0 == 0) change[0][0] = change[1][0] = change[3][0] = 0.0;
     if (walls && f1 == length + 1) change[0][f1 - 1 - f0] = change[1][f1 - 1 - f0] = change[3][f1 - 1 - f0] = 0.0;
-    const auto wall_stress = [&](std::ptrdiff_t c0, std::ptrdiff_t step, double side) {
-      const std::ptrdiff_t c1 = c0 + step, c2 = c1 + step;
-      const double u_in[3] = {u[2][c0], u[2][c1], u[2][c2]};
-      const double mu_in[3] = {mu[c0], mu[c1], mu[c2]};
-      const double lambda_in[3] = {lambda[c0], lambda[c1], lambda[c2]};
-      return wall_normal_stress(u_in, mu_in, lambda_in, 0.0 + 0.0, side, inv_h);
-    };
-    if (walls && f0 == 0) change[2][0] = -wall_stress(base, 1, 1.0) * inv_h;
-    if (walls && f1 == length + 1)
-      change[2][f1 - 1 - f0] = -wall_stress(base + length - 1, -1, -1.0) * inv_h;
     // Face f adds to cell f (its high side) and subtracts from cell f - 1. Each cell
     // receives its low face first, then its high face (in this block or the next), as in a
     // face-by-face loop; the two loops have no dependence from one face to the next.
@@ -140,8 +116,7 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
   // (S = Pair: x-neighbours, either two pencils side by side or two faces of an x pencil),
   // every lane doing the scalar arithmetic. `add` / `subtract`: the face adds to its high
   // cell / subtracts from its low cell (not both at the ends of a pencil).
-  // wall: 0 inside, +1 at the plate (cR beside it), -1 at the ceiling (cL beside it).
-  const auto face = [&](std::ptrdiff_t cR, bool add, bool subtract, int wall, auto lanes) {
+  const auto face = [&](std::ptrdiff_t cR, bool add, bool subtract, bool wall, auto lanes) {
     using S = decltype(lanes);
     const auto at = [](const double* x) { return load_lanes<S>(x); };
     const std::ptrdiff_t cL = cR - s;
@@ -174,13 +149,6 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
       flux[energy] = S{};
       for (int i = 0; i < 3; ++i)
         if (i != d) flux[momentum_x + i] = S{};
-      const std::ptrdiff_t c0 = wall > 0 ? cR : cL, c1 = c0 + wall * s, c2 = c1 + wall * s;
-      const S u_in[3] = {at(u[d] + c0), at(u[d] + c1), at(u[d] + c2)};
-      const S mu_in[3] = {at(mu + c0), at(mu + c1), at(mu + c2)};
-      const S lambda_in[3] = {at(lambda + c0), at(lambda + c1), at(lambda + c2)};
-      // walls are normal to z (d = 2): the tangential divergence is d u_x / dx + d u_y / dy
-      flux[momentum_x + d] = -wall_normal_stress(u_in, mu_in, lambda_in, grad[0][0] + grad[1][1],
-                                                 static_cast<double>(wall), inv_h);
     }
     for (int v = momentum_x; v < variable_count; ++v) {
       const S change = flux[v] * inv_h;
@@ -199,15 +167,15 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
     const int pencil = paired ? 2 * group : group;
     const int a = pencil % n_a, b = pencil / n_a;
     const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
-    const auto wall_face = [&](int f) { return !walls ? 0 : f == 0 ? 1 : f == length ? -1 : 0; };
+    const auto wall_face = [&](int f) { return walls && (f == 0 || f == length); };
     if (paired) {
       for (int f = 0; f <= length; ++f) face(base + f * s, f < length, f > 0, wall_face(f), Pair{});
       continue;
     }
     int f = 0;
     if (d == 0) {
-      face(base, true, false, 0, 0.0);
-      for (f = 1; f + 1 < length; f += 2) face(base + f, true, true, 0, Pair{});
+      face(base, true, false, false, 0.0);
+      for (f = 1; f + 1 < length; f += 2) face(base + f, true, true, false, Pair{});
     }
     for (; f <= length; ++f) face(base + f * s, f < length, f > 0, wall_face(f), 0.0);
   }
