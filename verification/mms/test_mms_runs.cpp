@@ -269,23 +269,38 @@ shaker::continuum::PhysicsSettings column_check_physics(bool inviscid) {
 
 // The right-hand side of a column of `cells` cells over [0, Lz] under column_check_physics,
 // cell k holding primitive(grid, k).
+// A column of `cells` cells over [0, Lz] (`dimension` 3: a 4 x 4 box of such columns), cell
+// k of every column holding primitive(grid, k).
+struct ColumnState {
+  shaker::continuum::Grid grid;
+  shaker::continuum::State U;
+};
+template <class CellState>
+ColumnState column_state(int cells, double Lz, int dimension, CellState primitive) {
+  ColumnState c;
+  c.grid.h = Lz / cells;
+  c.grid.nz = cells;
+  c.grid.dimension = dimension;
+  c.grid.nx = c.grid.ny = dimension == 3 ? 4 : 1;
+  c.U.resize(c.grid.size());
+  for (int k = 0; k < c.grid.nz; ++k)
+    for (int j = 0; j < c.grid.ny; ++j)
+      for (int i = 0; i < c.grid.nx; ++i)
+        shaker::continuum::store_primitive(c.U, static_cast<std::size_t>(c.grid.index(i, j, k)), primitive(c.grid, k));
+  return c;
+}
+
 struct ColumnRhs {
   shaker::continuum::Grid grid;
   shaker::continuum::State dUdt;
 };
 template <class CellState>
 ColumnRhs column_rhs(int cells, double Lz, bool inviscid, CellState primitive) {
-  namespace cont = shaker::continuum;
-  ColumnRhs r;
-  r.grid.h = Lz / cells;
-  r.grid.nz = cells;
-  cont::Operator op(r.grid, column_check_physics(inviscid));
-  cont::State U;
-  U.resize(r.grid.size());
+  ColumnState c = column_state(cells, Lz, 1, primitive);
+  ColumnRhs r{c.grid, {}};
+  shaker::continuum::Operator op(r.grid, column_check_physics(inviscid));
   r.dUdt.resize(r.grid.size());
-  for (int k = 0; k < r.grid.nz; ++k)
-    cont::store_primitive(U, static_cast<std::size_t>(r.grid.index(0, 0, k)), primitive(r.grid, k));
-  op.rhs(0.0, U, r.dUdt);
+  op.rhs(0.0, c.U, r.dUdt);
   return r;
 }
 
@@ -424,18 +439,9 @@ TEST_P(WallViscousStress, ImplicitStepGivesTheWallForce) {
   for (const int dimension : {1, 3}) {
     std::vector<double> error;
     for (int cells : wall_force_levels) {
-      cont::Grid g;
-      g.h = profile.Lz / cells;
-      g.nz = cells;
-      g.dimension = dimension;
-      g.nx = g.ny = dimension == 3 ? 4 : 1;
+      auto [g, U] = column_state(cells, profile.Lz, dimension,
+                                 [&](const cont::Grid& grid, int k) { return profile.cell(grid, k); });
       cont::Operator op(g, column_check_physics(false));
-      cont::State U;
-      U.resize(g.size());
-      for (int k = 0; k < g.nz; ++k)
-        for (int j = 0; j < g.ny; ++j)
-          for (int i = 0; i < g.nx; ++i)
-            cont::store_primitive(U, static_cast<std::size_t>(g.index(i, j, k)), profile.cell(g, k));
       const std::vector<double> before = U.q[cont::momentum_z];
       cont::ImplicitDiffusion implicit(g);
       implicit.advance(op, U, dt);
@@ -640,4 +646,3 @@ TEST(MmsWallClosure, SecondCellExcessOfTheDensityErrorIsThirdOrder) {
 }
 
 }  // namespace
-
