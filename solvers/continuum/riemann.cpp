@@ -96,7 +96,6 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
     const int normal = momentum_x + d;
     const int tangential1 = momentum_x + (d + 1) % 3, tangential2 = momentum_x + (d + 2) % 3;
-    const int total = P.count_a * P.count_b;
     // Block of faces f0 .. f1 - 1 of W pencils whose first cells are base, base + 1, ...
     const auto block = [&](auto pencils, std::ptrdiff_t base, int f0, int f1) {
       constexpr int W = decltype(pencils)::value;
@@ -228,21 +227,24 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
         }
       }
     };
-    // Pencils across x (y and z faces) go two at a time when nx is even: side by side in
-    // storage, one Pair holds both (bit for bit the scalar arithmetic of each).
+    // Pencils across x (y and z faces) go two at a time: side by side in storage, one Pair
+    // holds both (bit for bit the scalar arithmetic of each); an odd row's last pencil goes
+    // alone (a decomposed box's blocks are often odd in x).
     // Dynamic scheduling: on a shared machine a thread that is held up does not hold up the
     // other (pencils touch disjoint cells, so the result does not depend on the order). A
     // chunk is a whole row or plane of pencils, so that two threads never write into the
     // same cache line.
-    const bool paired = s != 1 && P.count_a % 2 == 0;
-    const int groups = paired ? total / 2 : total;
-#pragma omp parallel for schedule(dynamic, paired ? P.count_a / 2 : P.count_a) if (g.threaded())
+    const bool paired = s != 1;
+    const int per_row = paired ? (P.count_a + 1) / 2 : P.count_a;
+    const int groups = per_row * P.count_b;
+#pragma omp parallel for schedule(dynamic, per_row) if (g.threaded())
     for (int group = 0; group < groups; ++group) {
-      const int pencil = paired ? 2 * group : group;
-      const std::ptrdiff_t base = P.base(g, d, pencil % P.count_a, pencil / P.count_a);
+      const int a = paired ? 2 * (group % per_row) : group % per_row, b = group / per_row;
+      const bool pair = paired && a + 1 < P.count_a;
+      const std::ptrdiff_t base = P.base(g, d, a, b);
       for (int f0 = 0; f0 <= P.length; f0 += face_block) {
         const int f1 = std::min(f0 + face_block, P.length + 1);
-        if (paired)
+        if (pair)
           block(std::integral_constant<int, 2>{}, base, f0, f1);
         else
           block(std::integral_constant<int, 1>{}, base, f0, f1);

@@ -157,18 +157,18 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
       if (subtract) store_lanes(dU + cL, at(dU + cL) - change);
     }
   };
-  // y and z faces: two pencils side by side when nx is even; x faces: two faces at a time
-  // between the pencil's end faces. Either way each cell receives its low face before its
-  // high face, as in the face-by-face loop, so the sums are the same bit for bit.
-  const bool paired = d != 0 && n_a % 2 == 0;
-  const int total = paired ? n_a * n_b / 2 : n_a * n_b;
-#pragma omp parallel for schedule(dynamic, paired ? n_a / 2 : n_a) if (g.threaded())
-  for (int group = 0; group < total; ++group) {
-    const int pencil = paired ? 2 * group : group;
-    const int a = pencil % n_a, b = pencil / n_a;
+  // y and z faces: two pencils side by side (an odd row's last pencil alone); x faces: two
+  // faces at a time between the pencil's end faces. Either way each cell receives its low
+  // face before its high face, as in the face-by-face loop, so the sums are the same bit for
+  // bit.
+  const bool paired = d != 0;
+  const int per_row = paired ? (n_a + 1) / 2 : n_a;
+#pragma omp parallel for schedule(dynamic, per_row) if (g.threaded())
+  for (int group = 0; group < per_row * n_b; ++group) {
+    const int a = paired ? 2 * (group % per_row) : group % per_row, b = group / per_row;
     const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
     const auto wall_face = [&](int f) { return walls && (f == 0 || f == length); };
-    if (paired) {
+    if (paired && a + 1 < n_a) {
       for (int f = 0; f <= length; ++f) face(base + f * s, f < length, f > 0, wall_face(f), Pair{});
       continue;
     }
