@@ -1,8 +1,8 @@
 // Grid convergence of the real problem:
-// the 1D base case (H = 9, e = 0.9, validation/cases/base.toml) at cell sizes 0.4 to 0.025
+// the 1D base case (H = 9, e = 0.9, validation/cases/base.toml) at cell sizes 0.4 to 0.0125
 // with the quantities of interest of docs/analysis.md computed by solvers/analysis. For each:
-// the observed order, Richardson extrapolation and Roache's GCI (Fs = 1.25) on its finest,
-// middle and coarsest grid triples, and the asymptotic-range check; and the 3D base case on
+// the observed order, Richardson extrapolation and Roache's GCI (Fs = 1.25) on each of its
+// consecutive grid triples, and the asymptotic-range check; and the 3D base case on
 // three grids against the 1D column; and the temporal convergence of both at the production cell.
 // Nightly only (minutes; the 3D tests an hour or more).
 //
@@ -210,16 +210,16 @@ const std::vector<double> cells_1d{0.4, 0.2, 0.1, 0.05};  // coarse to fine
 
 TEST(NightlyRealProblem, BaseCase1DGridConvergence) {
   const auto dir = test_directory("real-problem-1d");
-  // A fifth level, 0.025, beyond the 3D study's column: does the finest triple approach the
-  // asymptotic range the coarser ones miss?
+  // Two levels beyond the 3D study's column, 0.025 and 0.0125 (half an hour of the study's
+  // hour): does the finest triple approach the asymptotic range the coarser ones miss?
   std::vector<double> cells = cells_1d;
-  cells.push_back(0.025);
+  cells.insert(cells.end(), {0.025, 0.0125});
   std::vector<Quantities> values;
   for (double h : cells) values.push_back(run_base_case(dir, "1d", h));
-  // Triples (h1 < h2 < h3) by the index of their finest cell: finest 0.025/0.05/0.1, fine
-  // 0.05/0.1/0.2, coarse 0.1/0.2/0.4.
+  // Triples (h1 < h2 < h3) by the index of their finest cell: finest 0.0125/0.025/0.05, finer
+  // 0.025/0.05/0.1, fine 0.05/0.1/0.2 (the 3D study's 1D rows), coarse 0.1/0.2/0.4.
   std::vector<conv::GciRow> rows;
-  for (const auto& [study, fine] : {std::pair{"real-1d-base-finest", 4},
+  for (const auto& [study, fine] : {std::pair{"real-1d-base-finest", 5}, {"real-1d-base-finer", 4},
                                     {"real-1d-base-fine", 3}, {"real-1d-base-coarse", 2}}) {
     const auto triple = three_grid_rows(study, cells, values, fine);
     rows.insert(rows.end(), triple.begin(), triple.end());

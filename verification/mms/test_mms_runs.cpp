@@ -348,7 +348,7 @@ TEST(MmsWallCell, TruncationErrorFallsAtSecondOrder) {
 // column, so it moves the centre of mass at its own order; claimed: second order. The cells
 // hold averages (of n and of the momentum n u_z), as in the solver: a ghost that treats them as
 // point values is first order wherever u_z'' != 0 at the wall, even where it is exact for
-// point values (verification/README.md, the 1D base case on five grids).
+// point values (verification/README.md, the 1D base case on six grids).
 struct WallState {
   const char* name;
   bool density_gradient, velocity_curvature;
