@@ -109,13 +109,23 @@ double Operator::diffusive_step() const {
   const double* mu = closure_.mu.data();
   const double* lambda = closure_.lambda.data();
   const double* kappa = closure_.kappa.data();
-  double largest = interior_maximum(g, [&](std::ptrdiff_t c) {
+  const auto diffusivity = [&](std::ptrdiff_t c) {
     const double momentum = (lambda[c] + 4.0 / 3.0 * mu[c]);
     const double heat = kappa[c] / 1.5;
     return std::max(momentum, heat) / n[c];
-  });
-  if (halo_) largest = halo_->max(largest);
+  };
+  double largest = interior_maximum(g, diffusivity);
   const int dims = g.dimension == 3 ? 3 : 1;
+  if (settings_.wall_stress == WallStress::second_order && g.z_boundary == ZBoundary::walls) {
+    // The wall row of u_z: diagonal c_1 + 7/2 c_w, off-diagonal c_1 + c_w / 2 (c_w <= 3/2 c_0,
+    // viscous_flux.cpp), so its Gershgorin radius is at most (2 + 6) c against the interior's
+    // 4 c per direction: the wall cells count with their diffusivity times 1 + 1 / dims.
+    const double factor = 1.0 + 1.0 / dims;
+    for (int k : {0, g.nz - 1})
+      for (int j = 0; j < g.ny; ++j)
+        for (int i = 0; i < g.nx; ++i) largest = std::max(largest, factor * diffusivity(g.index(i, j, k)));
+  }
+  if (halo_) largest = halo_->max(largest);
   return largest > 0.0 ? g.h * g.h / (2.0 * dims * largest) : std::numeric_limits<double>::infinity();
 }
 

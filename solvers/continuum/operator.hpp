@@ -42,6 +42,13 @@ struct ArtificialDissipation {
   double volume_fraction = 0.01;
 };
 
+/// The walls' normal viscous stress. `mirror`: the mirror ghost's, the wall cell's coefficients
+/// and the slope 2 u_0 / h, first order where n' or u_z'' is not zero at the wall (every layer
+/// under gravity). `second_order`: the coefficients extrapolated linearly to the wall and
+/// u_z' = m' / n there, m = n u_z, from the cells' averages (viscous_flux.cpp,
+/// wall_normal_stress; docs/models.md); the explicit diffusion paths only.
+enum class WallStress { mirror, second_order };
+
 struct PhysicsSettings {
   EquationOfState eos = EquationOfState::granular;
   double e = 0.9;  ///< the continuum's restitution coefficient
@@ -49,6 +56,7 @@ struct PhysicsSettings {
   ArtificialDissipation artificial;
   Limiter limiter = Limiter::mc;
   RiemannSolver riemann = RiemannSolver::hllc;
+  WallStress wall_stress = WallStress::mirror;
   Terms terms;
   ShakerKinematics shaker{3.0, 0.095};
 };

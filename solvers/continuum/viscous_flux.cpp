@@ -24,6 +24,32 @@ inline Pair harmonic_mean(Pair a, Pair b) {  // per lane the above
   const Pair sum = a + b, zero = {0.0, 0.0};
   return sum > 0.0 ? 2.0 * a * b / sum : zero;
 }
+
+/// A coefficient at the wall from the wall cell's value x0 and the next cell's x1 (centres at
+/// h / 2 and 3 h / 2): the linear extrapolation, or x0 where that leaves [x0 / 2, 3 x0 / 2]
+/// (the layer's edge beside the wall; the cap also bounds the wall row's stiffness, which
+/// Operator::diffusive_step allows for).
+template <class S> S extrapolated_to_wall(S x0, S x1) {
+  const S wall = 1.5 * x0 - 0.5 * x1;
+  return (wall >= 0.5 * x0) & (wall <= 1.5 * x0) ? wall : x0;
+}
+
+/// tau_zz at a wall, WallStress::second_order: cell 0 is the wall cell, cell 1 the next one
+/// away from the wall, `toward` +1 at the bottom wall and -1 at the top (z runs away from the
+/// bottom wall and towards the top one). u_z' at the wall is m' / n there, m = n u_z: the cells
+/// hold averages of n and m, and (7 m_0 - m_1) / (2 h) is the slope at the wall of the
+/// quadratic with m = 0 there whose cell averages they are, second order (the same formula in
+/// u_z = m / n would be first order where n' u_z' != 0 at the wall: the average of a product is
+/// not the product of the averages, by O(h^2), which the slope divides by h); the tangential
+/// divergence (d u_x / dx + d u_y / dy, 0 in a column) extrapolated as the coefficients.
+template <class S>
+S wall_normal_stress(S n0, S n1, S mu0, S mu1, S lambda0, S lambda1, S u0, S u1, S tangential0,
+                     S tangential1, double toward, double inv_h) {
+  const S mu = extrapolated_to_wall(mu0, mu1), lambda = extrapolated_to_wall(lambda0, lambda1);
+  const S normal = toward * (7.0 * (n0 * u0) - n1 * u1) * (0.5 * inv_h) / extrapolated_to_wall(n0, n1);
+  const S tangential = 1.5 * tangential0 - 0.5 * tangential1;
+  return (4.0 / 3.0 * mu + lambda) * normal + (lambda - 2.0 / 3.0 * mu) * tangential;
+}
 }  // namespace
 
 namespace {
@@ -32,7 +58,7 @@ namespace {
 /// bit for bit), face fluxes first as simple loops over a block of faces, then added to the
 /// cells.
 void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
-                             const Operator::Closure& closure, State& dUdt) {
+                             const Operator::Closure& closure, WallStress wall_stress, State& dUdt) {
   constexpr int block = 64;
   const double inv_h = 1.0 / g.h;
   const double* u[3] = {w[1].data(), w[2].data(), w[3].data()};
@@ -78,6 +104,16 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
     int paired = 0;
     for (; paired + 2 <= f1 - f0; paired += 2) faces(paired, Pair{});
     for (; paired < f1 - f0; ++paired) faces(paired, 0.0);
+    if (walls && wall_stress == WallStress::second_order) {
+      // The same arithmetic as the 3D kernel's wall faces, whose tangential divergence is 0
+      // in a horizontally uniform state.
+      const auto wall_change = [&](std::ptrdiff_t c0, std::ptrdiff_t c1, double toward) {
+        return -wall_normal_stress(w[0][c0], w[0][c1], mu[c0], mu[c1], lambda[c0], lambda[c1], u[2][c0],
+                                   u[2][c1], 0.0, 0.0, toward, inv_h) * inv_h;
+      };
+      if (f0 == 0) change[2][0] = wall_change(base, base + 1, 1.0);
+      if (f1 == length + 1) change[2][f1 - 1 - f0] = wall_change(base + length - 1, base + length - 2, -1.0);
+    }
     if (walls && f0 == 0) change[0][0] = change[1][0] = change[3][0] = 0.0;
     if (walls && f1 == length + 1) change[0][f1 - 1 - f0] = change[1][f1 - 1 - f0] = change[3][f1 - 1 - f0] = 0.0;
     // Face f adds to cell f (its high side) and subtracts from cell f - 1. Each cell
@@ -99,7 +135,7 @@ namespace {
 /// resolved at compile time).
 template <int d>
 void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
-                            const Operator::Closure& closure, State& dUdt) {
+                            const Operator::Closure& closure, WallStress wall_stress, State& dUdt) {
   const double inv_h = 1.0 / g.h;
   const bool three_d = g.dimension == 3;
   const double* u[3] = {w[1].data(), w[2].data(), w[3].data()};
@@ -149,6 +185,20 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
       flux[energy] = S{};
       for (int i = 0; i < 3; ++i)
         if (i != d) flux[momentum_x + i] = S{};
+      if (wall_stress == WallStress::second_order) {
+        // `add`: the bottom wall, whose wall cell is cR; else the top wall's, cL.
+        const std::ptrdiff_t c0 = add ? cR : cL, c1 = add ? cR + s : cL - s;
+        const auto tangential_divergence = [&](std::ptrdiff_t c) {
+          if (!three_d) return S{};
+          return 0.5 * inv_h * (at(u[0] + c + strides[0]) - at(u[0] + c - strides[0])) +
+                 0.5 * inv_h * (at(u[1] + c + strides[1]) - at(u[1] + c - strides[1]));
+        };
+        const double* n = w[0].data();
+        flux[momentum_z] = -wall_normal_stress(at(n + c0), at(n + c1), at(mu + c0), at(mu + c1),
+                                               at(lambda + c0), at(lambda + c1),
+                                               at(u[2] + c0), at(u[2] + c1), tangential_divergence(c0),
+                                               tangential_divergence(c1), add ? 1.0 : -1.0, inv_h);
+      }
     }
     for (int v = momentum_x; v < variable_count; ++v) {
       const S change = flux[v] * inv_h;
@@ -184,12 +234,14 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
 
 void Operator::add_diffusive_fluxes(State& dUdt) {
   const Grid& g = grid_;
-  if (g.dimension != 3 && g.nx == 1 && g.ny == 1) return column_diffusive_fluxes(g, w_, closure_, dUdt);
+  const WallStress wall_stress = settings_.wall_stress;
+  if (g.dimension != 3 && g.nx == 1 && g.ny == 1)
+    return column_diffusive_fluxes(g, w_, closure_, wall_stress, dUdt);
   if (g.first_direction() == 0) {
-    diffusive_fluxes_along<0>(g, w_, closure_, dUdt);
-    diffusive_fluxes_along<1>(g, w_, closure_, dUdt);
+    diffusive_fluxes_along<0>(g, w_, closure_, wall_stress, dUdt);
+    diffusive_fluxes_along<1>(g, w_, closure_, wall_stress, dUdt);
   }
-  diffusive_fluxes_along<2>(g, w_, closure_, dUdt);
+  diffusive_fluxes_along<2>(g, w_, closure_, wall_stress, dUdt);
 }
 
 }  // namespace shaker::continuum

@@ -169,6 +169,7 @@ continuum::PhysicsSettings physics_for(const MmsCase& c) {
   p.e = c.e;
   p.transport = c.transport;
   p.limiter = continuum::Limiter::none;
+  p.wall_stress = c.wall_stress;
   p.terms.advection = t.advection;
   p.terms.pressure = t.pressure;
   p.terms.shear_viscosity = t.shear_viscosity;

@@ -53,6 +53,7 @@ struct MmsCase {
   double velocity_amplitude = 0.3;     ///< ManufacturedSolution::U0
   int density_mode = 4;                ///< ManufacturedSolution::density_mode
   bool wall_gradients = false;         ///< ManufacturedSolution::wall_gradients
+  continuum::WallStress wall_stress = continuum::WallStress::mirror;
 };
 
 /// The cell average of the source to O(h^4) from one evaluation per cell: the centre value
