@@ -6,6 +6,10 @@
       ranks as without a launcher, bit for bit, every dataset and attribute but the creation
       date; only the energy budget's accumulators, summed over the ranks' shares, may differ,
       within 1e-12 of the budget's scale.
+  check_continuum_ranks.py SHAKER wall_stress P [P ...] [--mpirun CMD]
+      The explicit check with continuum.wall_stress = "second_order": the wall faces' stress
+      reads the next cell above the wall and the tangential divergence of both cells, whose x
+      and y neighbours lie in the halo at a block's edge.
   check_continuum_ranks.py SHAKER hybrid [--mpirun CMD]
       The explicit check on a box of 16 x 16 x 40 cells, on 2 ranks of 2 OpenMP threads each
       (blocks large enough to be shared between threads) against the plain run on one thread.
@@ -423,8 +427,8 @@ def check_refused(shaker, work, launcher):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
-    parser.add_argument("check", choices=["explicit", "hybrid", "implicit", "restart", "column",
-                                          "failure", "signal", "refused"])
+    parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit", "restart",
+                                          "column", "failure", "signal", "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -434,6 +438,9 @@ def main():
     if args.check in ("explicit", "implicit"):
         failures = compare_rank_counts(args.shaker, work, args.mpirun, args.ranks,
                                        args.check == "explicit")
+    elif args.check == "wall_stress":
+        failures = compare_rank_counts(args.shaker, work, args.mpirun, args.ranks, True,
+                                       ["continuum.wall_stress=second_order"])
     elif args.check == "hybrid":
         failures = compare_rank_counts(args.shaker, work, args.mpirun, [2], True,
                                        ["continuum.box_width=8", "continuum.ceiling=20"], 2)
