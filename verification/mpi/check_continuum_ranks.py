@@ -427,8 +427,8 @@ def check_refused(shaker, work, launcher):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
-    parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit", "restart",
-                                          "column", "failure", "signal", "refused"])
+    parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit",
+                                          "restart", "column", "failure", "signal", "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
