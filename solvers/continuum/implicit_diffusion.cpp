@@ -11,6 +11,7 @@
 
 #include "common/errors.hpp"
 #include "continuum/halo.hpp"
+#include "continuum/wall_stress.hpp"
 
 namespace shaker::continuum {
 
@@ -26,6 +27,29 @@ inline double coefficient(const Operator::Closure& cl, std::ptrdiff_t c, int com
   if (component == 3) return cl.kappa[c];
   return direction == component ? cl.lambda[c] + 4.0 / 3.0 * cl.mu[c] : cl.mu[c];
 }
+/// The u_z row of wall cell c0 (c1 the next cell away from the wall) holds the wall's normal
+/// stress as diagonal * u_z*(c0) - lagged, both per unit volume and velocity or momentum. The
+/// mirror wall: 2 (lambda + 4 mu / 3)(c0) / h^2, nothing lagged. The second-order wall
+/// (viscous_flux.cpp, wall_normal_stress): C (7 m_0 - m_1) / (2 h^2 n_w), C = 4 mu_w / 3 +
+/// lambda_w, with m_0 = n_0 u_z*(c0) implicit and m_1 = n_1 u_z(c1) at the step's start, so
+/// the matrix stays symmetric (as CG needs) and keeps its positive diagonal; the lag is an
+/// O(dt) error of the step like backward Euler's own, which the extrapolated integrator's
+/// half steps cancel with it. The tangential divergence of the wall stress is one of the
+/// mixed-derivative terms this operator leaves out.
+struct WallRow {
+  double diagonal = 0.0, lagged = 0.0;
+};
+WallRow wall_row(const Operator& op, std::ptrdiff_t c0, std::ptrdiff_t c1, double inv_h2) {
+  const auto& cl = op.closure();
+  if (op.settings().wall_stress == WallStress::mirror) return {2.0 * coefficient(cl, c0, 2, 2) * inv_h2, 0.0};
+  const double* n = op.primitives()[0].data();
+  const double* u = op.primitives()[3].data();
+  const double c = 4.0 / 3.0 * extrapolated_to_wall(cl.mu[c0], cl.mu[c1]) +
+                   extrapolated_to_wall(cl.lambda[c0], cl.lambda[c1]);
+  const double scale = c * 0.5 * inv_h2 / extrapolated_to_wall(n[c0], n[c1]);
+  return {7.0 * n[c0] * scale, n[c1] * u[c1] * scale};
+}
+
 /// CG preconditioner for the 3D systems: Jacobi plus an exact solve of the horizontally
 /// uniform part (two-level, additive: z = D^-1 r + P Ac^-1 P^T r, P the constant prolongation
 /// from the nz planes of cells, Ac = P^T A P, tridiagonal). The base case is nearly flat and
@@ -129,6 +153,20 @@ template <class Visit> void for_each_face(const Grid& g, Visit visit) {
       }
 }
 
+Eigen::Index ImplicitDiffusion::wall_neighbour(Eigen::Index m) const {
+  const Eigen::Index plane = static_cast<Eigen::Index>(grid_.nx) * grid_.ny;
+  if (grid_.nz == 1) return m;  // one plane between the walls: no other cell
+  return m < plane ? m + plane : m - plane;
+}
+
+template <class Visit> void ImplicitDiffusion::for_each_wall_cell(Visit visit) const {
+  if (grid_.z_boundary != ZBoundary::walls) return;
+  const Eigen::Index plane = static_cast<Eigen::Index>(grid_.nx) * grid_.ny;
+  const auto cells = static_cast<Eigen::Index>(storage_.size());
+  for (Eigen::Index m = 0; m < plane; ++m) visit(m, wall_neighbour(m));
+  for (Eigen::Index m = std::max(plane, cells - plane); m < cells; ++m) visit(m, wall_neighbour(m));
+}
+
 // Tridiagonal solve for the column: sub/super-diagonals -face_[m], diagonal the mass term
 // plus the faces of the cell (plus the mirrored wall for u_z). The mass term makes the matrix
 // strictly diagonally dominant, so elimination without pivoting is stable. Twisted
@@ -148,11 +186,11 @@ void ImplicitDiffusion::solve_column(const Operator& op, int component, double d
   face_[M - 1] = 0.0;
   for (std::size_t m = 0; m < M; ++m)
     diagonal_[m] = mass_factor * n[storage_[m]] + face_[m] + (m > 0 ? face_[m - 1] : 0.0);
-  // wall: only u_z has a condition (u_z = 0, mirror ghost), the rest no flux
-  if (component == 2) {
-    diagonal_[0] += 2.0 * coefficient(cl, storage_[0], 2, 2) * inv_h2;
-    if (M > 1) diagonal_[M - 1] += 2.0 * coefficient(cl, storage_[M - 1], 2, 2) * inv_h2;
-  }
+  // wall: only u_z has a condition (u_z = 0), the rest no flux
+  if (component == 2)
+    for_each_wall_cell([&](Eigen::Index m, Eigen::Index next) {
+      diagonal_[static_cast<std::size_t>(m)] += wall_row(op, storage_[m], storage_[next], inv_h2).diagonal;
+    });
   // Rows 0 .. k - 1 from the top: x[m] + forward_[m] x[m + 1] = x[m] (the reduced right-hand
   // side, kept in x); rows M - 1 .. k + 1 from the bottom: x[m] + backward_[m] x[m - 1] = x[m].
   const std::size_t k = (M - 1) / 2;
@@ -202,8 +240,8 @@ void ImplicitDiffusion::assemble(const Operator& op, int component, double dt) {
   }
   for_each_face(grid_, [&](Eigen::Index a, Eigen::Index b, int direction) {
     const auto ca = storage_[a];
-    if (b < 0) {  // wall: only u_z has a condition (u_z = 0, mirror ghost), the rest no flux
-      if (component == 2) triplets_.emplace_back(a, a, 2.0 * coefficient(cl, ca, component, direction) * inv_h2);
+    if (b < 0) {  // wall: only u_z has a condition (u_z = 0), the rest no flux
+      if (component == 2) triplets_.emplace_back(a, a, wall_row(op, ca, storage_[wall_neighbour(a)], inv_h2).diagonal);
       return;
     }
     if (a == b) return;  // a single cell across a periodic direction
@@ -248,7 +286,9 @@ void ImplicitDiffusion::add_dissipation(const Operator& op, int component, const
   const auto& cl = op.closure();
   const double inv_h2 = 1.0 / (grid_.h * grid_.h);
   const auto wall = [&](Eigen::Index a) {
-    if (component == 2) dissipation_[a] += 2.0 * coefficient(cl, storage_[a], 2, 2) * u[a] * u[a] * inv_h2;
+    if (component != 2) return;
+    const WallRow row = wall_row(op, storage_[a], storage_[wall_neighbour(a)], inv_h2);
+    dissipation_[a] += (row.diagonal * u[a] - row.lagged) * u[a];
   };
   if (column_) {  // face_ still holds this component's coefficients
     const auto M = static_cast<Eigen::Index>(storage_.size());
@@ -297,6 +337,10 @@ void ImplicitDiffusion::advance(Operator& op, State& U, double dt, bool closure_
   for (int component = 0; component < 3; ++component) {
     const double* u0 = w[1 + component].data();
     for_cells([&](std::size_t m, std::ptrdiff_t c) { rhs_[m] = n[c] * u0[c] / dt; });
+    if (component == 2)
+      for_each_wall_cell([&](Eigen::Index m, Eigen::Index next) {
+        rhs_[m] += wall_row(op, storage_[m], storage_[next], 1.0 / (grid_.h * grid_.h)).lagged;
+      });
     Eigen::VectorXd& u = velocity_[component];
     // A component that vanishes everywhere stays zero exactly (e.g. u_x, u_y of a 1D column).
     if (rhs_.isZero(0.0)) {
@@ -403,7 +447,7 @@ void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, d
   });
   const auto wall = [&](std::ptrdiff_t c, int k) {
     const bool at_wall = component == 2 && (k == 0 || k + 1 == g.nz);
-    return at_wall ? 2.0 * coefficient(cl, c, 2, 2) * inv_h2 : 0.0;
+    return at_wall ? wall_row(op, c, c + (k == 0 ? strides[2] : -strides[2]), inv_h2).diagonal : 0.0;
   };
   for_interior(g, [&](std::ptrdiff_t c, int k) {
     double diagonal = mass_factor * n[c] / dt + wall(c, k);
@@ -513,7 +557,6 @@ void ImplicitDiffusion::solve_decomposed(std::vector<double>& x) {
 void ImplicitDiffusion::add_dissipation_decomposed(const Operator& op, int component, std::vector<double>& u) {
   const Grid& g = grid_;
   Decomposed& d = decomposed_;
-  const auto& cl = op.closure();
   const double inv_h2 = 1.0 / (g.h * g.h);
   const std::ptrdiff_t strides[3] = {g.stride(0), g.stride(1), g.stride(2)};
   halo_->exchange({u.data()});
@@ -525,7 +568,10 @@ void ImplicitDiffusion::add_dissipation_decomposed(const Operator& op, int compo
       const double up = u[c] - u[c + s], down = u[c] - u[c - s];
       sum += 0.5 * d.face[direction][c] * up * up + 0.5 * d.face[direction][c - s] * down * down;
     }
-    if (component == 2 && (k == 0 || k + 1 == g.nz)) sum += 2.0 * coefficient(cl, c, 2, 2) * u[c] * u[c] * inv_h2;
+    if (component == 2 && (k == 0 || k + 1 == g.nz)) {
+      const WallRow row = wall_row(op, c, c + (k == 0 ? strides[2] : -strides[2]), inv_h2);
+      sum += (row.diagonal * u[c] - row.lagged) * u[c];
+    }
     d.dissipation[c] += sum;
   });
 }
@@ -547,8 +593,11 @@ void ImplicitDiffusion::advance_decomposed(Operator& op, State& U, double dt, bo
   for (int component = 0; component < 3; ++component) {
     const double* u0 = w[1 + component].data();
     std::vector<double>& u = d.solution[static_cast<std::size_t>(component)];
-    for_interior(g, [&](std::ptrdiff_t c, int) {
+    const double inv_h2 = 1.0 / (g.h * g.h);
+    for_interior(g, [&](std::ptrdiff_t c, int k) {
       d.rhs[c] = n[c] * u0[c] / dt;
+      if (component == 2 && (k == 0 || k + 1 == g.nz))
+        d.rhs[c] += wall_row(op, c, c + (k == 0 ? g.stride(2) : -g.stride(2)), inv_h2).lagged;
       u[c] = u0[c];  // CG's first guess
     });
     // A component that vanishes everywhere stays zero exactly, on every rank alike.

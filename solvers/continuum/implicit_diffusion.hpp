@@ -47,6 +47,10 @@ class ImplicitDiffusion {
   void solve_sparse(Eigen::VectorXd& x);
   /// Adds the discrete viscous dissipation of velocity component `component` to dissipation_.
   void add_dissipation(const Operator& op, int component, const Eigen::VectorXd& u);
+  /// The wall cell m's next cell away from its wall (m in the first or the last plane).
+  Eigen::Index wall_neighbour(Eigen::Index m) const;
+  /// visit(m, wall_neighbour(m)) for every wall cell m, when z has walls.
+  template <class Visit> void for_each_wall_cell(Visit visit) const;
 
   // The decomposed box (the second half of implicit_diffusion.cpp); vectors in the block's storage.
   void advance_decomposed(Operator& op, State& U, double dt, bool closure_is_current);

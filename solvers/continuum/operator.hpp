@@ -46,7 +46,8 @@ struct ArtificialDissipation {
 /// and the slope 2 u_0 / h, first order where n' or u_z'' is not zero at the wall (every layer
 /// under gravity). `second_order`: the coefficients extrapolated linearly to the wall and
 /// u_z' = m' / n there, m = n u_z, from the cells' averages (viscous_flux.cpp,
-/// wall_normal_stress; docs/models.md); the explicit diffusion paths only.
+/// wall_normal_stress; docs/models.md); the implicit diffusion takes m_1 from the step's start
+/// (implicit_diffusion.cpp, wall_row).
 enum class WallStress { mirror, second_order };
 
 struct PhysicsSettings {

@@ -40,8 +40,8 @@ std::vector<ParameterSpec> continuum_parameters() {
       text("continuum.wall_stress", "mirror", {"mirror", "second_order"},
            "normal viscous stress at the walls: mirror = the mirror ghost's (first order where "
            "n' or u_z'' is not zero at the wall); second_order = coefficients extrapolated to the "
-           "wall and u_z' = m' / n with m = n u_z, m' = (7 m_0 - m_1) / (2 h); explicit or rkl2 "
-           "diffusion only").in("-"),
+           "wall and u_z' = m' / n with m = n u_z, m' = (7 m_0 - m_1) / (2 h) (implicit diffusion: "
+           "m_1 from the step's start)").in("-"),
       real("continuum.temperature_floor", 1e-12, positive(1.0),
            "lowest temperature; every raise to it is counted and reported").in("g sigma"),
       real("continuum.artificial_viscosity", 0.5, at_least(0.0, 100.0),

@@ -92,12 +92,6 @@ ContinuumCase continuum_case(const config::Config& config) {
     i.diffusion = DiffusionIntegrator::explicit_rk;
   p.wall_stress = config.text("continuum.wall_stress") == "second_order" ? WallStress::second_order
                                                                           : WallStress::mirror;
-  if (p.wall_stress == WallStress::second_order &&
-      (i.diffusion == DiffusionIntegrator::implicit || i.diffusion == DiffusionIntegrator::implicit_extrapolated))
-    throw InputError(fmt::format(
-        "continuum.wall_stress = \"second_order\" with continuum.diffusion_integrator = \"{}\"{}: the "
-        "implicit diffusion keeps the mirror wall; allowed with second_order: explicit, rkl2",
-        diffusion, diffusion == "auto" ? " (implicit_extrapolated for full transport)" : ""));
   LayerSpecification& l = c.layer;
   l.mass_per_area = c.parameters.mass_per_area();
   l.volume_fraction = config.real("continuum.initial_volume_fraction");

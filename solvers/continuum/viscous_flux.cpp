@@ -12,6 +12,7 @@
 
 #include "continuum/operator.hpp"
 #include "continuum/simd_pair.hpp"
+#include "continuum/wall_stress.hpp"
 
 namespace shaker::continuum {
 
@@ -23,15 +24,6 @@ inline double harmonic_mean(double a, double b) {
 inline Pair harmonic_mean(Pair a, Pair b) {  // per lane the above
   const Pair sum = a + b, zero = {0.0, 0.0};
   return sum > 0.0 ? 2.0 * a * b / sum : zero;
-}
-
-/// A coefficient at the wall from the wall cell's value x0 and the next cell's x1 (centres at
-/// h / 2 and 3 h / 2): the linear extrapolation, or x0 where that leaves [x0 / 2, 3 x0 / 2]
-/// (the layer's edge beside the wall; the cap also bounds the wall row's stiffness, which
-/// Operator::diffusive_step allows for).
-template <class S> S extrapolated_to_wall(S x0, S x1) {
-  const S wall = 1.5 * x0 - 0.5 * x1;
-  return (wall >= 0.5 * x0) & (wall <= 1.5 * x0) ? wall : x0;
 }
 
 /// tau_zz at a wall, WallStress::second_order: cell 0 is the wall cell, cell 1 the next one

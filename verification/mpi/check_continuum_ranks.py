@@ -19,6 +19,10 @@
       dataset within 1e-12 of its largest magnitude (a field's velocity components of the
       largest component: the horizontal ones, seeded by the 1e-3 perturbation, are four orders
       below u_z and take its round-off; the budget's accumulators of the budget's scale).
+  check_continuum_ranks.py SHAKER implicit_wall_stress P [P ...] [--mpirun CMD]
+      The implicit check with continuum.wall_stress = "second_order": the wall rows' lagged
+      part (the next cell's momentum at the step's start) in the right-hand side and their
+      heating, on every rank's block.
   check_continuum_ranks.py SHAKER restart [--mpirun CMD]
       A checkpoint written on 2 ranks after 1 of 2 cycles, continued on 1 and on 4 ranks: the
       final checkpoint and the time-series rows after the restart equal the straight run's
@@ -428,18 +432,22 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
     parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit",
-                                          "restart", "column", "failure", "signal", "refused"])
+                                          "implicit_wall_stress", "restart", "column", "failure",
+                                          "signal", "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
     work = keep_on_failure.work_folder(f"continuum-ranks-{args.check}-")
     with open(os.path.join(work, "case.toml"), "w") as f:
-        f.write(IMPLICIT_CASE if args.check == "implicit" else EXPLICIT_CASE)
+        f.write(IMPLICIT_CASE if args.check.startswith("implicit") else EXPLICIT_CASE)
     if args.check in ("explicit", "implicit"):
         failures = compare_rank_counts(args.shaker, work, args.mpirun, args.ranks,
                                        args.check == "explicit")
     elif args.check == "wall_stress":
         failures = compare_rank_counts(args.shaker, work, args.mpirun, args.ranks, True,
+                                       ["continuum.wall_stress=second_order"])
+    elif args.check == "implicit_wall_stress":
+        failures = compare_rank_counts(args.shaker, work, args.mpirun, args.ranks, False,
                                        ["continuum.wall_stress=second_order"])
     elif args.check == "hybrid":
         failures = compare_rank_counts(args.shaker, work, args.mpirun, [2], True,
