@@ -122,10 +122,11 @@ INSTANTIATE_TEST_SUITE_P(
 
 /// The transport and the walls' normal viscous stress: the mirror wall (the default), or
 /// continuum.wall_stress = "second_order" (coefficients extrapolated to the wall and the
-/// momentum's one-sided slope), which takes away the first-order part of n's error at the wall
-/// cell, the mirror wall's bulk-viscous stress (verification/README.md, "The viscous effect at
-/// the wall found"). Its stiffer wall rows double the explicit steps: with it the study takes
-/// about 100 minutes, the 640-cell run almost all of it.
+/// momentum's one-sided slope), which takes away one first-order part of n's error at the wall
+/// cell, the mirror wall's bulk-viscous stress, but not all of it (verification/README.md, "A
+/// viscous effect at the wall found"). Its stiffer wall rows double the explicit steps: with it
+/// the study takes
+/// 28 (paper) to 33 (full) minutes on one core, the 640-cell run most of it.
 struct WallGradientCase {
   Transport transport;
   shaker::continuum::WallStress wall_stress;
