@@ -49,6 +49,12 @@ WallRow wall_row(const Operator& op, std::ptrdiff_t c0, std::ptrdiff_t c1, doubl
   const double scale = c * 0.5 * inv_h2 / extrapolated_to_wall(n[c0], n[c1]);
   return {7.0 * n[c0] * scale, n[c1] * u[c1] * scale};
 }
+/// A decomposed block's wall cells are its first and last planes (z is not decomposed); the
+/// wall row of cell c of such a plane k.
+bool wall_plane(const Grid& g, int k) { return k == 0 || k + 1 == g.nz; }
+WallRow plane_wall_row(const Operator& op, const Grid& g, std::ptrdiff_t c, int k, double inv_h2) {
+  return wall_row(op, c, c + (k == 0 ? g.stride(2) : -g.stride(2)), inv_h2);
+}
 
 /// CG preconditioner for the 3D systems: Jacobi plus an exact solve of the horizontally
 /// uniform part (two-level, additive: z = D^-1 r + P Ac^-1 P^T r, P the constant prolongation
@@ -446,8 +452,7 @@ void ImplicitDiffusion::assemble_decomposed(const Operator& op, int component, d
       }
   });
   const auto wall = [&](std::ptrdiff_t c, int k) {
-    const bool at_wall = component == 2 && (k == 0 || k + 1 == g.nz);
-    return at_wall ? wall_row(op, c, c + (k == 0 ? strides[2] : -strides[2]), inv_h2).diagonal : 0.0;
+    return component == 2 && wall_plane(g, k) ? plane_wall_row(op, g, c, k, inv_h2).diagonal : 0.0;
   };
   for_interior(g, [&](std::ptrdiff_t c, int k) {
     double diagonal = mass_factor * n[c] / dt + wall(c, k);
@@ -568,8 +573,8 @@ void ImplicitDiffusion::add_dissipation_decomposed(const Operator& op, int compo
       const double up = u[c] - u[c + s], down = u[c] - u[c - s];
       sum += 0.5 * d.face[direction][c] * up * up + 0.5 * d.face[direction][c - s] * down * down;
     }
-    if (component == 2 && (k == 0 || k + 1 == g.nz)) {
-      const WallRow row = wall_row(op, c, c + (k == 0 ? strides[2] : -strides[2]), inv_h2);
+    if (component == 2 && wall_plane(g, k)) {
+      const WallRow row = plane_wall_row(op, g, c, k, inv_h2);
       sum += (row.diagonal * u[c] - row.lagged) * u[c];
     }
     d.dissipation[c] += sum;
@@ -596,8 +601,7 @@ void ImplicitDiffusion::advance_decomposed(Operator& op, State& U, double dt, bo
     const double inv_h2 = 1.0 / (g.h * g.h);
     for_interior(g, [&](std::ptrdiff_t c, int k) {
       d.rhs[c] = n[c] * u0[c] / dt;
-      if (component == 2 && (k == 0 || k + 1 == g.nz))
-        d.rhs[c] += wall_row(op, c, c + (k == 0 ? g.stride(2) : -g.stride(2)), inv_h2).lagged;
+      if (component == 2 && wall_plane(g, k)) d.rhs[c] += plane_wall_row(op, g, c, k, inv_h2).lagged;
       u[c] = u0[c];  // CG's first guess
     });
     // A component that vanishes everywhere stays zero exactly, on every rank alike.
