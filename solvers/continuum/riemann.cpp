@@ -30,8 +30,10 @@ Pencils pencils_of(const Grid& g, int d) {
   return {g.nx, g.ny, g.nz};
 }
 
-/// Faces handled per block of a pencil: the block's face states and fluxes stay in L1.
-constexpr int face_block = 64;
+/// Slots (cells x pencils) of a block: its face states (2 x 7 x slots doubles) stay in L1/L2.
+constexpr int block_slots = 384;
+/// Most pencils side by side in one block (a longer row is cut into balanced runs).
+constexpr int max_lanes = 32;
 
 template <Limiter L, RiemannSolver R>
 void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
@@ -42,12 +44,6 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
                              w[2].data(),  w[3].data(),
                              pressure ? closure.p.data() : w[4].data(),
                              closure.chi.data(), closure.c.data()};
-  // First-order face state: n, u, T, p, c of the cell itself.
-  const auto cell_state = [&](std::ptrdiff_t c, double* state) {
-    for (int v = 0; v < 5; ++v) state[v] = w[v][c];
-    state[5] = closure.p[c];
-    state[6] = closure.c[c];
-  };
   // Characteristic limiting of (n, u_n, p): the differences are projected on the acoustic
   // and entropy waves of the primitive Euler system (valid for any equation of state, with c
   // the isentropic sound speed, which model::sound_speed is), limited wave by wave and
@@ -58,11 +54,11 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
   const double* fp = closure.p.data();
   const double* fc = closure.c.data();
   // minus[v][slot], plus[v][slot]: face states at the low and high face of the block's cell q
-  // of pencil `lane`, slot = q W + lane, for W pencils at once (W = 2: two pencils side by side
-  // in x, whose cells are adjacent in storage).
-  using FaceStates = double[7][(face_block + 1) * 2];
+  // of pencil `lane`, slot = q W + lane, for W pencils side by side in x at once (their cells
+  // are adjacent in storage).
+  using FaceStates = double[7][block_slots];
   // S = double: cell c; S = Pair: cells c and c + 1, either of a contiguous pencil (s = 1,
-  // slots q and q + 1) or of two pencils side by side (W = 2, the two lanes of cell q), every
+  // slots q and q + 1) or of two pencils side by side (lanes l and l + 1 of cell q), every
   // lane doing the scalar arithmetic, the early returns of the scalar code as a mask.
   const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, int q,
                                   FaceStates& minus, FaceStates& plus, auto lanes) {
@@ -96,159 +92,186 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
     const int normal = momentum_x + d;
     const int tangential1 = momentum_x + (d + 1) % 3, tangential2 = momentum_x + (d + 2) % 3;
+    // Beside a wall the mirror ghost makes every even field a local extremum, and the limiter
+    // would flatten the wall cell to first order (a hydrostatic layer would then carry O(h)
+    // spurious velocities there). Even fields take a one-sided interior slope instead (zero if
+    // a face value would leave [x/2, 2x]); u_z, odd, keeps the mirror. The wall's own Riemann
+    // problem is the exact mirror image of the wall cell's face state, so its mass and energy
+    // fluxes vanish by symmetry too.
+    // The slope is the second-order one-sided difference (-3 x0 + 4 x1 - x2) / 2, exact for
+    // quadratics like the interior central slope: the wall cell's face values then carry the
+    // interior's O(h^2) error, and the jump at its interior face stays O(h^3). The plain
+    // difference x1 - x0 is the slope at that face, not at the cell centre (twice the centre
+    // slope of an even field): its O(h^2) jump, times the sound speed in the Riemann flux's
+    // dissipation, was an O(h) truncation error in the wall cell and a first-order density
+    // error there (MMS full_walls, n Linf pair orders 80 -> 640 cells: 1.58 1.46 1.11 with
+    // x1 - x0; 1.97 2.00 to 320 cells with this slope).
+    // sign: +1 when the wanted face lies on the interior side of the cell centre.
+    const auto wall_cell = [&](std::ptrdiff_t c, std::ptrdiff_t interior_step, double sign, auto& face, int slot) {
+      for (int v = 0; v < 7; ++v) {
+        if (v == un_index) continue;
+        const double x0 = fields[v][c];
+        const double half_slope =
+            0.25 * (4.0 * fields[v][c + interior_step] - 3.0 * x0 - fields[v][c + 2 * interior_step]);
+        const double value = x0 + sign * half_slope, other = x0 - sign * half_slope;
+        const bool keep = value >= 0.5 * x0 && value <= 2.0 * x0 && other >= 0.5 * x0 && other <= 2.0 * x0;
+        face[v][slot] = keep ? value : x0;
+      }
+    };
+    const auto mirror = [&](const auto& from, int from_slot, auto& to, int to_slot) {
+      for (int v = 0; v < 7; ++v) to[v][to_slot] = v == un_index ? -from[v][from_slot] : from[v][from_slot];
+    };
+    // The face states of wall face f (0 or P.length) and of the wall cells' interior faces
+    // (1, P.length - 1) of the pencil whose first cell is `first`; the face's left state is
+    // plus[.][left], its right one minus[.][left + W].
+    const auto wall_face = [&](std::ptrdiff_t first, int f, int left, int W, auto& minus, auto& plus) {
+      const int right = left + W;
+      const std::ptrdiff_t cR = first + f * s, cL = cR - s;
+      if (f == 0) {
+        wall_cell(cR, s, -1.0, minus, right);
+        mirror(minus, right, plus, left);
+      } else if (f == P.length) {
+        wall_cell(cL, -s, -1.0, plus, left);
+        mirror(plus, left, minus, right);
+      } else {
+        if (f == 1) wall_cell(cL, s, +1.0, plus, left);
+        if (f == P.length - 1) wall_cell(cR, -s, +1.0, minus, right);
+      }
+    };
+    // Pressureful face states hold p in x[4] and chi in x[5]; this makes them (T, p), with
+    // T = p / (n chi). Near vacuum the independently limited n, p and chi can combine into a
+    // face temperature far outside the neighbouring cells' range; such a face state falls back
+    // to its cell's average (first order there). The band is a factor of 2 around the range,
+    // so smooth flow (where p / (n chi) differs from T by O(h)) never triggers it.
+    const auto face_temperature = [&](std::ptrdiff_t c, int slot, auto& x, auto lanes) {
+      using S = decltype(lanes);
+      using pair_detail::larger;
+      using pair_detail::smaller;
+      const double* T = w[4].data();
+      const auto at = [](const double* y) { return load_lanes<S>(y); };
+      const S p = at(&x[4][slot]), T_face = p / (at(&x[0][slot]) * at(&x[5][slot]));
+      const S Tb = at(T + c - s), Tc = at(T + c), Tf = at(T + c + s);
+      const S low = 0.5 * smaller(smaller(Tb, Tc), Tf), high = 2.0 * larger(larger(Tb, Tc), Tf);
+      const auto inside = (T_face >= low) & (T_face <= high);
+      for (int v : {0, 1, 2, 3, 6}) store_lanes(&x[v][slot], inside ? at(&x[v][slot]) : at(fields[v] + c));
+      store_lanes(&x[4][slot], inside ? T_face : Tc);
+      store_lanes(&x[5][slot], inside ? p : at(closure.p.data() + c));
+    };
     // Block of faces f0 .. f1 - 1 of W pencils whose first cells are base, base + 1, ...
-    const auto block = [&](auto pencils, std::ptrdiff_t base, int f0, int f1) {
-      constexpr int W = decltype(pencils)::value;
+    // (W = 1 along x: a pencil is a row, contiguous).
+    const auto block = [&](int W, std::ptrdiff_t base, int f0, int f1) {
       // Face f lies between cells f - 1 and f. The block first reconstructs both face states
       // of its cells f0 - 1 .. f1 - 1 (each cell's slopes once, field by field: simple loops
       // without a dependence from one cell to the next), then solves the faces' Riemann
       // problems.
       const int cells = f1 - f0 + 1;
-      const std::ptrdiff_t c0 = base + (f0 - 1) * s;  // the block's cell q is c0 + q s
+      const std::ptrdiff_t c0 = base + (f0 - 1) * s;  // the block's cell q of pencil l is c0 + q s + l
+      // Calls step(c, slot, Pair{}) for two adjacent cells and step(c, slot, 0.0) for one, over
+      // every cell of the block, the lanes of a cell in pairs (W > 1) or the run in pairs (W = 1).
+      const auto over_cells = [&](auto step) {
+        if (W == 1 && s == 1) {
+          int q = 0;
+          for (; q + 2 <= cells; q += 2) step(c0 + q, q, Pair{});
+          for (; q < cells; ++q) step(c0 + q, q, 0.0);
+          return;
+        }
+        for (int q = 0; q < cells; ++q) {
+          const std::ptrdiff_t c = c0 + q * s;
+          int lane = 0;
+          for (; lane + 2 <= W; lane += 2) step(c + lane, q * W + lane, Pair{});
+          for (; lane < W; ++lane) step(c + lane, q * W + lane, 0.0);
+        }
+      };
       FaceStates minus, plus;
       for (int v = 0; v < 7; ++v) {
         const double* x = fields[v];
-        if (W == 2) {  // two pencils side by side: their cells are one Pair
-          for (int q = 0; q < cells; ++q) reconstruct_pair<L>(x + c0 + q * s, s, minus[v] + 2 * q, plus[v] + 2 * q);
-        } else if (s == 1) {  // a contiguous pencil: two cells per instruction
-          reconstruct_run<L>(x + c0, cells, minus[v], plus[v]);
-        } else {
-          for (int q = 0; q < cells; ++q) {
-            const std::ptrdiff_t c = c0 + q * s;
-            reconstruct<L>(x[c - s], x[c], x[c + s], minus[v][q], plus[v][q]);
-          }
-        }
+        over_cells([&](std::ptrdiff_t c, int slot, auto lanes) {
+          if constexpr (std::is_same_v<decltype(lanes), Pair>)
+            reconstruct_pair<L>(x + c, s, minus[v] + slot, plus[v] + slot);
+          else
+            reconstruct<L>(x[c - s], x[c], x[c + s], minus[v][slot], plus[v][slot]);
+        });
       }
-      double change[variable_count][face_block * 2];  // flux / h of face f0 + b, pencil l: b W + l
-      if (pressure) {
-        int q = 0;
-        if (W == 2)
-          for (; q < cells; ++q) characteristic(c0 + q * s, s, un_index, 2 * q, minus, plus, Pair{});
-        if (s == 1)
-          for (; q + 2 <= cells; q += 2) characteristic(c0 + q, s, un_index, q, minus, plus, Pair{});
-        for (; q < cells; ++q) characteristic(c0 + q * s, s, un_index, q, minus, plus, 0.0);
-      }
-      for (int f = f0; f < f1; ++f) {
-        for (int lane = 0; lane < W; ++lane) {
-          const int q = f - f0 + 1;  // the block index of cell f
-          const std::ptrdiff_t cR = base + lane + f * s, cL = cR - s;
-          double left[7], right[7];
-          for (int v = 0; v < 7; ++v) {
-            left[v] = plus[v][(q - 1) * W + lane];
-            right[v] = minus[v][q * W + lane];
-          }
-          if (walls) {
-            // Beside a wall the mirror ghost makes every even field a local extremum, and the
-            // limiter would flatten the wall cell to first order (a hydrostatic layer would then
-            // carry O(h) spurious velocities there). Even fields take a one-sided interior
-            // slope instead (zero if a face value would leave [x/2, 2x]); u_z, odd, keeps the
-            // mirror. The wall's own Riemann problem is the exact mirror image of the wall
-            // cell's face state, so its mass and energy fluxes vanish by symmetry too.
-            // The slope is the second-order one-sided difference (-3 x0 + 4 x1 - x2) / 2, exact
-            // for quadratics like the interior central slope: the wall cell's face values then
-            // carry the interior's O(h^2) error, and the jump at its interior face stays O(h^3).
-            // The plain difference x1 - x0 is the slope at that face, not at the cell centre
-            // (twice the centre slope of an even field): its O(h^2) jump, times the sound speed
-            // in the Riemann flux's dissipation, was an O(h) truncation error in the wall cell
-            // and a first-order density error there (MMS full_walls, n Linf pair orders 80 ->
-            // 640 cells: 1.58 1.46 1.11 with x1 - x0; 1.97 2.00 to 320 cells with this slope).
-            const int un = 1 + d;
-            const auto wall_cell = [&](std::ptrdiff_t c, std::ptrdiff_t interior_step, double sign,
-                                       double* face) {
-              for (int v = 0; v < 7; ++v) {
-                if (v == un) continue;
-                const double x0 = fields[v][c];
-                const double half_slope =
-                    0.25 * (4.0 * fields[v][c + interior_step] - 3.0 * x0 -
-                            fields[v][c + 2 * interior_step]);
-                const double value = x0 + sign * half_slope, other = x0 - sign * half_slope;
-                const bool keep = value >= 0.5 * x0 && value <= 2.0 * x0 && other >= 0.5 * x0 &&
-                                  other <= 2.0 * x0;
-                face[v] = keep ? value : x0;
-              }
-            };
-            const auto mirror = [&](const double* from, double* to) {
-              for (int v = 0; v < 7; ++v) to[v] = v == un ? -from[v] : from[v];
-            };
-            // sign: +1 when the wanted face lies on the interior side of the cell centre
-            if (f == 0) {
-              wall_cell(cR, s, -1.0, right);
-              mirror(right, left);
-            } else if (f == P.length) {
-              wall_cell(cL, -s, -1.0, left);
-              mirror(left, right);
-            } else {
-              if (f == 1) wall_cell(cL, s, +1.0, left);
-              if (f == P.length - 1) wall_cell(cR, -s, +1.0, right);
-            }
-          }
-          if (pressure) {
-            std::swap(left[4], left[5]);  // left[5] = p, left[4] = chi
-            std::swap(right[4], right[5]);
-            left[4] = left[5] / (left[0] * left[4]);
-            right[4] = right[5] / (right[0] * right[4]);
-            // Near vacuum the independently limited n, p and chi can combine into a face
-            // temperature far outside the neighbouring cells' range; such a side falls back to
-            // its cell average (first order there). The band is a factor of 2 around the range,
-            // so smooth flow (where p / (n chi) differs from T by O(h)) never triggers it.
-            const double* T = w[4].data();
-            const auto outside = [](double x, double a, double b, double c) {
-              return !(x >= 0.5 * std::min({a, b, c}) && x <= 2.0 * std::max({a, b, c}));
-            };
-            if (outside(left[4], T[cL - s], T[cL], T[cR])) cell_state(cL, left);
-            if (outside(right[4], T[cL], T[cR], T[cR + s])) cell_state(cR, right);
-          } else {
-            left[5] = right[5] = 0.0;
-          }
-          const int un = 1 + d, u1 = 1 + (d + 1) % 3, u2 = 1 + (d + 2) % 3;
-          const FaceState SL{left[0], left[un], left[u1], left[u2], left[4], left[5], left[6]};
-          const FaceState SR{right[0], right[un], right[u1], right[u2], right[4], right[5], right[6]};
-          double F[5];
-          riemann_flux<R>(SL, SR, F);
-          if (walls && (f == 0 || f == P.length)) F[0] = F[2] = F[3] = F[4] = 0.0;
-          const int b = (f - f0) * W + lane;
-          change[density][b] = F[0] * inv_h;
-          change[energy][b] = F[4] * inv_h;
-          change[normal][b] = F[1] * inv_h;
-          change[tangential1][b] = F[2] * inv_h;
-          change[tangential2][b] = F[3] * inv_h;
-        }
-      }
+      if (pressure)
+        over_cells([&](std::ptrdiff_t c, int slot, auto lanes) {
+          characteristic(c, s, un_index, slot, minus, plus, lanes);
+        });
+      // Face f0 + b of pencil `lane` has its left state in plus[.][b W + lane] and its right
+      // one in minus[.][(b + 1) W + lane]: consecutive slots are consecutive faces (W = 1) or
+      // the same face of neighbouring pencils, two at a time in a Pair either way.
+      if (walls)
+        for (int f = f0; f < f1; ++f)
+          if (f <= 1 || f >= P.length - 1)
+            for (int lane = 0; lane < W; ++lane) wall_face(base + lane, f, (f - f0) * W + lane, W, minus, plus);
+      if (pressure)
+        over_cells([&](std::ptrdiff_t c, int slot, auto lanes) {
+          face_temperature(c, slot, minus, lanes);
+          face_temperature(c, slot, plus, lanes);
+        });
+      const int slots = (f1 - f0) * W;
+      double change[variable_count][block_slots];  // flux / h of face f0 + b, pencil l: b W + l
+      const auto solve = [&](int b, auto lanes) {
+        using S = decltype(lanes);
+        const auto side = [&](const FaceStates& x, int slot) {
+          const auto at = [&](int v) { return load_lanes<S>(&x[v][slot]); };
+          return FaceStateOf<S>{at(0), at(un_index), at(1 + (d + 1) % 3), at(1 + (d + 2) % 3), at(4),
+                                pressure ? at(5) : S{}, at(6)};
+        };
+        S F[5];
+        riemann_flux<R>(side(plus, b), side(minus, b + W), F);
+        store_lanes(&change[density][b], F[0] * inv_h);
+        store_lanes(&change[energy][b], F[4] * inv_h);
+        store_lanes(&change[normal][b], F[1] * inv_h);
+        store_lanes(&change[tangential1][b], F[2] * inv_h);
+        store_lanes(&change[tangential2][b], F[3] * inv_h);
+      };
+      int b = 0;
+      for (; b + 2 <= slots; b += 2) solve(b, Pair{});
+      for (; b < slots; ++b) solve(b, 0.0);
+      // The wall's mass, energy and tangential momentum fluxes are zero exactly.
+      if (walls)
+        for (int f : {0, P.length})
+          if (f >= f0 && f < f1)
+            for (int lane = 0; lane < W; ++lane)
+              for (int v : {int{density}, int{energy}, tangential1, tangential2}) change[v][(f - f0) * W + lane] = 0.0;
       // Face f adds to cell f (its high side) and subtracts from cell f - 1. Each cell
       // receives its low face first, then its high face (in this block or the next), as in
-      // a face-by-face loop; the two loops have no dependence from one face to the next.
+      // a face-by-face loop; the loops run along the pencils' row, contiguous in storage.
       const int add_end = std::min(f1, P.length), subtract_begin = std::max(f0, 1);
       for (int v = 0; v < variable_count; ++v) {
-        for (int lane = 0; lane < W; ++lane) {
-          double* dU = dUdt.q[v].data() + base + lane;
-          const double* ch = change[v] + lane;  // ch[(f - f0) W]: face f
-          for (int f = f0; f < add_end; ++f) dU[f * s] += ch[(f - f0) * W];
-          for (int f = subtract_begin; f < f1; ++f) dU[(f - 1) * s] -= ch[(f - f0) * W];
+        double* dU = dUdt.q[v].data() + base;
+        const double* ch = change[v];  // ch[(f - f0) W + lane]: face f of pencil lane
+        if (W == 1) {
+          for (int f = f0; f < add_end; ++f) dU[f * s] += ch[f - f0];
+          for (int f = subtract_begin; f < f1; ++f) dU[(f - 1) * s] -= ch[f - f0];
+          continue;
         }
+        for (int f = f0; f < add_end; ++f)
+          for (int lane = 0; lane < W; ++lane) dU[f * s + lane] += ch[(f - f0) * W + lane];
+        for (int f = subtract_begin; f < f1; ++f)
+          for (int lane = 0; lane < W; ++lane) dU[(f - 1) * s + lane] -= ch[(f - f0) * W + lane];
       }
     };
-    // Pencils across x (y and z faces) go two at a time: side by side in storage, one Pair
-    // holds both (bit for bit the scalar arithmetic of each); an odd row's last pencil goes
-    // alone (a decomposed box's blocks are often odd in x).
+    // Pencils across x (y and z faces) go a run of a row at a time (at most max_lanes, a longer
+    // row cut into balanced runs): side by side in storage, their cells are reconstructed and
+    // their fluxes added as contiguous rows, and two neighbours share a Pair (bit for bit the
+    // scalar arithmetic of each). Blocks along the pencils hold block_slots slots.
     // Dynamic scheduling: on a shared machine a thread that is held up does not hold up the
     // other (pencils touch disjoint cells, so the result does not depend on the order). A
-    // chunk is a whole row or plane of pencils, so that two threads never write into the
+    // chunk is a whole row or plane of pencils, so that two threads rarely write into the
     // same cache line.
-    const bool paired = s != 1;
-    const int per_row = paired ? (P.count_a + 1) / 2 : P.count_a;
-    const int groups = per_row * P.count_b;
-#pragma omp parallel for schedule(dynamic, per_row) if (g.threaded())
+    const bool across = s != 1;
+    const int runs_per_row = across ? (P.count_a + max_lanes - 1) / max_lanes : P.count_a;
+    const int groups = runs_per_row * P.count_b;
+#pragma omp parallel for schedule(dynamic, runs_per_row) if (g.threaded())
     for (int group = 0; group < groups; ++group) {
-      const int a = paired ? 2 * (group % per_row) : group % per_row, b = group / per_row;
-      const bool pair = paired && a + 1 < P.count_a;
+      const int run = group % runs_per_row, b = group / runs_per_row;
+      const int a = across ? run * P.count_a / runs_per_row : run;
+      const int W = across ? (run + 1) * P.count_a / runs_per_row - a : 1;
       const std::ptrdiff_t base = P.base(g, d, a, b);
-      for (int f0 = 0; f0 <= P.length; f0 += face_block) {
-        const int f1 = std::min(f0 + face_block, P.length + 1);
-        if (pair)
-          block(std::integral_constant<int, 2>{}, base, f0, f1);
-        else
-          block(std::integral_constant<int, 1>{}, base, f0, f1);
-      }
+      const int faces_per_block = block_slots / W - 1;
+      for (int f0 = 0; f0 <= P.length; f0 += faces_per_block)
+        block(W, base, f0, std::min(f0 + faces_per_block, P.length + 1));
     }
   }
 }

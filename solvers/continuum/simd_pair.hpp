@@ -17,8 +17,18 @@ inline Pair magnitude(Pair x) { return (Pair)((PairMask)x & ~sign_bit); }
 inline Pair with_sign_of(Pair x, Pair sign) {
   return (Pair)(((PairMask)x & ~sign_bit) | ((PairMask)sign & sign_bit));
 }
-inline Pair smaller(Pair a, Pair b) { return b < a ? b : a; }  // std::min(a, b) per lane
+/// std::min(a, b) and std::max(a, b) per lane, for a double or a Pair.
+template <class S> inline S smaller(S a, S b) { return b < a ? b : a; }
+template <class S> inline S larger(S a, S b) { return a < b ? b : a; }
 }  // namespace pair_detail
+
+/// Whether any lane of a comparison's result is set (a double's comparison: the bool itself).
+template <class Mask> inline bool any_lane(Mask mask) {
+  if constexpr (std::is_same_v<Mask, bool>)
+    return mask;
+  else
+    return (mask[0] | mask[1]) != 0;
+}
 
 /// Loads one value (double) or two adjacent ones (Pair); stores where a mask or flag is set.
 template <class S> inline S load_lanes(const double* x) {

@@ -125,30 +125,35 @@ const continuum::State& periodic_column(double h) {
   return states.emplace(h, column.state()).first->second;
 }
 
-/// Times one cycle from the periodic state of the column at the case's cell size; in 3D every
+/// Sets every column of `solver`'s box (or block) to the 1D `column` state of the same cell size.
+void every_column_from(const continuum::State& column, continuum::TimeIntegrator& solver) {
+  const continuum::Grid& g = solver.op().grid();
+  const continuum::Grid column_grid = continuum::make_grid(1, 1.0, g.height(), g.h);
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i)
+        for (int v = 0; v < continuum::variable_count; ++v)
+          solver.state().q[v][g.index(i, j, k)] = column.q[v][column_grid.index(0, 0, k)];
+}
+
+/// Times one cycle (or its first `fraction`) from the periodic state of the column at the case's cell size; in 3D every
 /// column of the box starts as that column (a horizontally uniform state, which the 3D
 /// solver keeps to round-off: test Uniform3D.MatchesOneDimensionalRunToRoundOff). Under
 /// `mpirun -np P` the box is decomposed over the P ranks and each fills its own block.
-void run_periodic_cycle(benchmark::State& state, const continuum::ContinuumCase& c) {
+void run_periodic_cycle(benchmark::State& state, const continuum::ContinuumCase& c, double fraction = 1.0) {
   const continuum::State& column = periodic_column(c.grid.h);
-  const continuum::Grid column_grid = continuum::make_grid(1, 1.0, c.grid.height(), c.grid.h);
   const double period = c.parameters.shaker.period();
   const auto halo = c.grid.dimension == 3 && launched_by_mpi()
                         ? std::make_shared<const continuum::Halo>(c.grid, Ranks::world().size())
                         : nullptr;
   const auto from_periodic_state = [&] {
     continuum::TimeIntegrator solver = continuum::make_solver(c, halo);
-    const continuum::Grid& g = solver.op().grid();
-    for (int k = 0; k < g.nz; ++k)
-      for (int j = 0; j < g.ny; ++j)
-        for (int i = 0; i < g.nx; ++i)
-          for (int v = 0; v < continuum::variable_count; ++v)
-            solver.state().q[v][g.index(i, j, k)] = column.q[v][column_grid.index(0, 0, k)];
+    every_column_from(column, solver);
     solver.set_time(transient_cycles * period);
     if (halo) MPI_Barrier(MPI_COMM_WORLD);
     return solver;
   };
-  time_cycles(state, c, from_periodic_state, (transient_cycles + 1) * period, 1.0);
+  time_cycles(state, c, from_periodic_state, (transient_cycles + fraction) * period, fraction);
   state.counters["ranks"] = halo ? halo->size() : 1;
 }
 
@@ -192,6 +197,34 @@ void BM_Continuum3D_PeriodicCycle_PaperStages(benchmark::State& state) {
 }
 BENCHMARK(BM_Continuum3D_PeriodicCycle_PaperStages)
     ->Arg(2)->Arg(10)->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(3)->UseRealTime();
+
+// The first tenth of that cycle: a run short enough to alternate old and new binaries in one session when a kernel changes.
+void BM_Continuum3D_PeriodicCycleSlice_PaperStages(benchmark::State& state) {
+  run_periodic_cycle(state, base_case(3, 0.5, "paper", "explicit", static_cast<int>(state.range(0))), 0.1);
+}
+BENCHMARK(BM_Continuum3D_PeriodicCycleSlice_PaperStages)
+    ->Arg(10)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// One evaluation of the right-hand side (every term: inviscid and viscous fluxes, closure,
+// sources) of that box at the periodic state's phase 0 in one process, repeated: its short
+// iterations average over a noisy machine, so a kernel's old and new versions can be compared
+// in minutes. The counter is cell updates per second of a single stage.
+void BM_Continuum3D_OperatorRhs(benchmark::State& state) {
+  const continuum::ContinuumCase c = base_case(3, 0.5, "paper", "explicit", 10);
+  continuum::TimeIntegrator solver = continuum::make_solver(c);
+  every_column_from(periodic_column(c.grid.h), solver);
+  const continuum::Grid& g = solver.op().grid();
+  continuum::State dUdt;
+  dUdt.resize(g.size());
+  const double t = transient_cycles * c.parameters.shaker.period();
+  for (auto _ : state) {
+    solver.op().rhs(t, solver.state(), dUdt);
+    benchmark::DoNotOptimize(dUdt.q[0].data());
+  }
+  state.counters["cell_updates_per_second"] = benchmark::Counter(
+      static_cast<double>(g.interior_cells()) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Continuum3D_OperatorRhs)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 
 // The 1D base case's fastest setting that agrees with the reference (paper transport,
 // extrapolated implicit diffusion, SSP-RK(4,2)) on the 3D box: the step is the advective
