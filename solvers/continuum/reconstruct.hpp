@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
 
 #include "continuum/operator.hpp"
 #include "continuum/simd_pair.hpp"
@@ -33,52 +34,37 @@ template <Limiter L> inline double limited_slope(double backward, double forward
   }
 }
 
-/// The same limiters for two cells at once (simd_pair.hpp): per lane the values above.
-template <Limiter L> inline Pair limited_slope(Pair backward, Pair forward) {
+/// The same limiters for adjacent cells at once (simd_pair.hpp): per lane the values above.
+template <Limiter L, class V>
+  requires(!std::is_same_v<V, double>)
+inline V limited_slope(V backward, V forward) {
   using namespace pair_detail;
-  const Pair zero = {0.0, 0.0};
+  const V zero = V{};
   if constexpr (L == Limiter::minmod) {
-    const Pair smallest = magnitude(backward) < magnitude(forward) ? backward : forward;
+    const V smallest = magnitude(backward) < magnitude(forward) ? backward : forward;
     return backward * forward <= 0.0 ? zero : smallest;
   } else if constexpr (L == Limiter::mc) {
-    const Pair central = 0.5 * (backward + forward);
-    const Pair bound = 2.0 * smaller(magnitude(backward), magnitude(forward));
-    const Pair slope = with_sign_of(smaller(magnitude(central), bound), central);
+    const V central = 0.5 * (backward + forward);
+    const V bound = 2.0 * smaller(magnitude(backward), magnitude(forward));
+    const V slope = with_sign_of(smaller(magnitude(central), bound), central);
     return backward * forward <= 0.0 ? zero : slope;
   } else if constexpr (L == Limiter::none) {
     return 0.5 * (backward + forward);
   } else {
-    const Pair product = backward * forward;
+    const V product = backward * forward;
     return product <= 0.0 ? zero : 2.0 * product / (backward + forward);
   }
 }
 
-/// Values at the low (minus) and high (plus) faces of the middle cell.
-template <Limiter L>
-inline void reconstruct(double left, double middle, double right, double& minus, double& plus) {
-  const double half_slope = 0.5 * limited_slope<L>(middle - left, right - middle);
-  minus = middle - half_slope;
-  plus = middle + half_slope;
-}
-
-/// reconstruct() for the adjacent cells x[0] and x[1] at once, their neighbours s away
-/// (s = 1: a contiguous run; s = a stride: two pencils side by side); the faces of x[0] go to
-/// minus[0], plus[0], those of x[1] to minus[1], plus[1].
-template <Limiter L>
-inline void reconstruct_pair(const double* x, std::ptrdiff_t s, double* minus, double* plus) {
-  const Pair left = load_lanes<Pair>(x - s), middle = load_lanes<Pair>(x);
-  const Pair half_slope = 0.5 * limited_slope<L>(middle - left, load_lanes<Pair>(x + s) - middle);
+/// Values at the low (minus) and high (plus) faces of the cells x[0 .. n - 1] (S a double,
+/// n = 1, or a vector of n), their neighbours s away (s = 1: a contiguous run; s = a stride:
+/// pencils side by side); the faces of x[l] go to minus[l], plus[l].
+template <Limiter L, class S>
+inline void reconstruct_lanes(const double* x, std::ptrdiff_t s, double* minus, double* plus) {
+  const S left = load_lanes<S>(x - s), middle = load_lanes<S>(x);
+  const S half_slope = 0.5 * limited_slope<L>(middle - left, load_lanes<S>(x + s) - middle);
   store_lanes(minus, middle - half_slope);
   store_lanes(plus, middle + half_slope);
-}
-
-/// reconstruct() for cells 0 .. count - 1 of a contiguous run x (x[-1] and x[count] exist),
-/// two cells at a time.
-template <Limiter L>
-inline void reconstruct_run(const double* x, int count, double* minus, double* plus) {
-  int q = 0;
-  for (; q + 2 <= count; q += 2) reconstruct_pair<L>(x + q, 1, minus + q, plus + q);
-  for (; q < count; ++q) reconstruct<L>(x[q - 1], x[q], x[q + 1], minus[q], plus[q]);
 }
 
 }  // namespace shaker::continuum

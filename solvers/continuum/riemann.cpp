@@ -7,8 +7,6 @@
 // (the wall pressure) survives; mass, energy and tangential momentum fluxes are exactly zero,
 // so mass is conserved to round-off.
 #include <algorithm>
-#include <type_traits>
-#include <utility>
 
 #include "continuum/reconstruct.hpp"
 #include "continuum/riemann.hpp"
@@ -57,8 +55,8 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
   // of pencil `lane`, slot = q W + lane, for W pencils side by side in x at once (their cells
   // are adjacent in storage).
   using FaceStates = double[7][block_slots];
-  // S = double: cell c; S = Pair: cells c and c + 1, either of a contiguous pencil (s = 1,
-  // slots q and q + 1) or of two pencils side by side (lanes l and l + 1 of cell q), every
+  // S = double: cell c; S a vector: cells c, c + 1, ..., either of a contiguous pencil (s = 1,
+  // slots q, q + 1, ...) or of pencils side by side (lanes l, l + 1, ... of cell q), every
   // lane doing the scalar arithmetic, the early returns of the scalar code as a mask.
   const auto characteristic = [&](std::ptrdiff_t c, std::ptrdiff_t s, int un, int q,
                                   FaceStates& minus, FaceStates& plus, auto lanes) {
@@ -166,30 +164,18 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
       // problems.
       const int cells = f1 - f0 + 1;
       const std::ptrdiff_t c0 = base + (f0 - 1) * s;  // the block's cell q of pencil l is c0 + q s + l
-      // Calls step(c, slot, Pair{}) for two adjacent cells and step(c, slot, 0.0) for one, over
-      // every cell of the block, the lanes of a cell in pairs (W > 1) or the run in pairs (W = 1).
+      // Calls step(c, slot, lanes) for every cell of the block, `lanes` a double or a vector of
+      // adjacent cells (simd_pair.hpp, for_lanes): a cell's pencils (W > 1) or the run (W = 1).
       const auto over_cells = [&](auto step) {
-        if (W == 1 && s == 1) {
-          int q = 0;
-          for (; q + 2 <= cells; q += 2) step(c0 + q, q, Pair{});
-          for (; q < cells; ++q) step(c0 + q, q, 0.0);
-          return;
-        }
-        for (int q = 0; q < cells; ++q) {
-          const std::ptrdiff_t c = c0 + q * s;
-          int lane = 0;
-          for (; lane + 2 <= W; lane += 2) step(c + lane, q * W + lane, Pair{});
-          for (; lane < W; ++lane) step(c + lane, q * W + lane, 0.0);
-        }
+        if (W == 1 && s == 1) return for_lanes(cells, [&](int q, auto lanes) { step(c0 + q, q, lanes); });
+        for (int q = 0; q < cells; ++q)
+          for_lanes(W, [&](int lane, auto lanes) { step(c0 + q * s + lane, q * W + lane, lanes); });
       };
       FaceStates minus, plus;
       for (int v = 0; v < 7; ++v) {
         const double* x = fields[v];
         over_cells([&](std::ptrdiff_t c, int slot, auto lanes) {
-          if constexpr (std::is_same_v<decltype(lanes), Pair>)
-            reconstruct_pair<L>(x + c, s, minus[v] + slot, plus[v] + slot);
-          else
-            reconstruct<L>(x[c - s], x[c], x[c + s], minus[v][slot], plus[v][slot]);
+          reconstruct_lanes<L, decltype(lanes)>(x + c, s, minus[v] + slot, plus[v] + slot);
         });
       }
       if (pressure)
@@ -198,7 +184,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
         });
       // Face f0 + b of pencil `lane` has its left state in plus[.][b W + lane] and its right
       // one in minus[.][(b + 1) W + lane]: consecutive slots are consecutive faces (W = 1) or
-      // the same face of neighbouring pencils, two at a time in a Pair either way.
+      // the same face of neighbouring pencils, a vector of them at a time either way.
       if (walls)
         for (int f = f0; f < f1; ++f)
           if (f <= 1 || f >= P.length - 1)
@@ -225,9 +211,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
         store_lanes(&change[tangential1][b], F[2] * inv_h);
         store_lanes(&change[tangential2][b], F[3] * inv_h);
       };
-      int b = 0;
-      for (; b + 2 <= slots; b += 2) solve(b, Pair{});
-      for (; b < slots; ++b) solve(b, 0.0);
+      for_lanes(slots, solve);
       // The wall's mass, energy and tangential momentum fluxes are zero exactly.
       if (walls)
         for (int f : {0, P.length})
@@ -254,7 +238,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     };
     // Pencils across x (y and z faces) go a run of a row at a time (at most max_lanes, a longer
     // row cut into balanced runs): side by side in storage, their cells are reconstructed and
-    // their fluxes added as contiguous rows, and two neighbours share a Pair (bit for bit the
+    // their fluxes added as contiguous rows, and neighbours share a vector (bit for bit the
     // scalar arithmetic of each). Blocks along the pencils hold block_slots slots.
     // Dynamic scheduling: on a shared machine a thread that is held up does not hold up the
     // other (pencils touch disjoint cells, so the result does not depend on the order). A

@@ -10,7 +10,7 @@
 
 namespace shaker::continuum {
 
-/// One side of a face, for one face (S = double) or two (S = Pair, simd_pair.hpp).
+/// One side of a face, for one face (S = double) or several (S a vector, simd_pair.hpp).
 template <class S> struct FaceStateOf {
   S n, un, ut1, ut2, T, p, c;
   S total_energy() const { return n * (1.5 * T + 0.5 * (un * un + ut1 * ut1 + ut2 * ut2)); }
@@ -26,10 +26,10 @@ template <class S> inline void physical_flux(const FaceStateOf<S>& s, S E, S* F)
   F[4] = (E + s.p) * s.un;
 }
 
-// Written without branches on the state, so that S = Pair solves two faces at once: every
-// case's flux is formed and each lane selects its own (supersonic left or right, HLL, HLLC),
-// which is per lane the arithmetic of a solver that returns early, bit for bit (the test
-// RiemannFlux.PairLanesMatchTheBranchingSolver holds it to one written that way). HLL's flux,
+// Written without branches on the state, so that a vector S solves several faces at once:
+// every case's flux is formed and each lane selects its own (supersonic left or right, HLL,
+// HLLC), which is per lane the arithmetic of a solver that returns early, bit for bit (the test
+// RiemannFlux.VectorLanesMatchTheBranchingSolver holds it to one written that way). HLL's flux,
 // which HLLC needs only where its star state does not exist, is formed only if some lane does.
 // Always inlined into the per-face loop of the flux kernel (docs/performance.md).
 template <RiemannSolver Solver, class S>

@@ -182,34 +182,23 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
   const int length = g.row_length();
   const auto run = [&](int row) {
     const std::ptrdiff_t first = g.row_start(row), end = first + length;
-    const std::ptrdiff_t paired_end = first + (end - first) / 2 * 2;
-    for (std::ptrdiff_t c = first; c < paired_end; c += 2) {  // two cells at a time: the loop below, per lane
-      const Pair n = load_lanes<Pair>(N + c), mx = load_lanes<Pair>(Mx + c),
-                 my = load_lanes<Pair>(My + c), mz = load_lanes<Pair>(Mz + c);
-      const Pair inv = 1.0 / n;
-      const Pair ux = mx * inv, uy = my * inv, uz = mz * inv;
-      const Pair kinetic = 0.5 * (mx * ux + my * uy + mz * uz);
-      const Pair thermal = (load_lanes<Pair>(E + c) - kinetic) * inv / 1.5;
-      const Pair zero = {0.0, 0.0};
-      const Pair T = 0.0 < thermal ? thermal : zero;  // std::max(0.0, thermal)
+    // Adjacent cells at once (simd_pair.hpp), per lane what to_primitive computes.
+    for_lanes(length, [&](int i, auto lanes) {
+      using S = decltype(lanes);
+      const std::ptrdiff_t c = first + i;
+      const S n = load_lanes<S>(N + c), mx = load_lanes<S>(Mx + c), my = load_lanes<S>(My + c),
+              mz = load_lanes<S>(Mz + c);
+      const S inv = 1.0 / n;
+      const S ux = mx * inv, uy = my * inv, uz = mz * inv;
+      const S kinetic = 0.5 * (mx * ux + my * uy + mz * uz);
+      // E - kinetic loses digits in fast, cold, dilute cells: a round-off negative is zero.
+      const S thermal = (load_lanes<S>(E + c) - kinetic) * inv / 1.5;
       store_lanes(wn + c, n);
       store_lanes(wx + c, ux);
       store_lanes(wy + c, uy);
       store_lanes(wz + c, uz);
-      store_lanes(wT + c, T);
-    }
-    for (std::ptrdiff_t c = paired_end; c < end; ++c) {
-      const double n = N[c];
-      const double inv = 1.0 / n;
-      const double ux = Mx[c] * inv, uy = My[c] * inv, uz = Mz[c] * inv;
-      const double kinetic = 0.5 * (Mx[c] * ux + My[c] * uy + Mz[c] * uz);
-      wn[c] = n;
-      wx[c] = ux;
-      wy[c] = uy;
-      wz[c] = uz;
-      // E - kinetic loses digits in fast, cold, dilute cells: a round-off negative is zero.
-      wT[c] = std::max(0.0, (E[c] - kinetic) * inv / 1.5);
-    }
+      store_lanes(wT + c, 0.0 < thermal ? thermal : S{});  // std::max(0.0, thermal) per lane
+    });
     for (std::ptrdiff_t c = first; c < end; c += lane_count) {
       const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(lane_count, end - c));
       Cells n, T;

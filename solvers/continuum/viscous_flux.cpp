@@ -21,9 +21,9 @@ inline double harmonic_mean(double a, double b) {
   const double sum = a + b;
   return sum > 0.0 ? 2.0 * a * b / sum : 0.0;
 }
-inline Pair harmonic_mean(Pair a, Pair b) {  // per lane the above
-  const Pair sum = a + b, zero = {0.0, 0.0};
-  return sum > 0.0 ? 2.0 * a * b / sum : zero;
+template <class V> inline V harmonic_mean(V a, V b) {  // per lane the above
+  const V sum = a + b;
+  return sum > 0.0 ? 2.0 * a * b / sum : V{};
 }
 
 /// tau_zz at a wall, WallStress::second_order: cell 0 is the wall cell, cell 1 the next one
@@ -66,8 +66,8 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
   for (int f0 = 0; f0 <= length; f0 += block) {
     const int f1 = std::min(f0 + block, length + 1);
     double change[4][block];  // per unit time: momentum x, y, z, energy of face f0 + b
-    // Faces f0 + b (S = double) or f0 + b and f0 + b + 1 (S = Pair, the same arithmetic per
-    // lane).
+    // Face f0 + b (S = double) or faces f0 + b, f0 + b + 1, ... (S a vector, the same
+    // arithmetic per lane).
     const auto faces = [&](int b, auto lanes) {
       using S = decltype(lanes);
       const auto at = [](const double* x) { return load_lanes<S>(x); };
@@ -93,9 +93,7 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
       store_lanes(&change[2][b], -tz * inv_h);
       store_lanes(&change[3][b], (-work - kappa_f * (at(T + cR) - at(T + cL)) * inv_h) * inv_h);
     };
-    int paired = 0;
-    for (; paired + 2 <= f1 - f0; paired += 2) faces(paired, Pair{});
-    for (; paired < f1 - f0; ++paired) faces(paired, 0.0);
+    for_lanes(f1 - f0, faces);
     if (walls && wall_stress == WallStress::second_order) {
       // The same arithmetic as the 3D kernel's wall faces, whose tangential divergence is 0
       // in a horizontally uniform state.
@@ -140,9 +138,9 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
   const int n_a = d == 0 ? g.ny : g.nx, n_b = d == 2 ? g.ny : g.nz;
   const int length = d == 0 ? g.nx : d == 1 ? g.ny : g.nz;
   const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
-  // The face whose high-side cell is cR (S = double), or the faces of cells cR and cR + 1
-  // (S = Pair: x-neighbours, either two pencils side by side or two faces of an x pencil),
-  // every lane doing the scalar arithmetic. `add` / `subtract`: the face adds to its high
+  // The face whose high-side cell is cR (S = double), or the faces of cells cR, cR + 1, ...
+  // (S a vector: x-neighbours, either pencils side by side or faces of an x pencil), every
+  // lane doing the scalar arithmetic. `add` / `subtract`: the face adds to its high
   // cell / subtracts from its low cell (not both at the ends of a pencil).
   const auto face = [&](std::ptrdiff_t cR, bool add, bool subtract, bool wall, auto lanes) {
     using S = decltype(lanes);
@@ -199,27 +197,27 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
       if (subtract) store_lanes(dU + cL, at(dU + cL) - change);
     }
   };
-  // y and z faces: two pencils side by side (an odd row's last pencil alone); x faces: two
-  // faces at a time between the pencil's end faces. Either way each cell receives its low
-  // face before its high face, as in the face-by-face loop, so the sums are the same bit for
-  // bit.
-  const bool paired = d != 0;
-  const int per_row = paired ? (n_a + 1) / 2 : n_a;
+  // y and z faces: a vector's width of pencils side by side (a row's last ones narrower); x
+  // faces: a vector's width of faces at a time between the pencil's end faces. Either way each
+  // cell receives its low face before its high face, as in the face-by-face loop, so the sums
+  // are the same bit for bit.
+  constexpr int width = lanes_of<Wide>;
+  const bool across = d != 0;
+  const int per_row = across ? (n_a + width - 1) / width : n_a;
 #pragma omp parallel for schedule(dynamic, per_row) if (g.threaded())
   for (int group = 0; group < per_row * n_b; ++group) {
-    const int a = paired ? 2 * (group % per_row) : group % per_row, b = group / per_row;
+    const int a = across ? width * (group % per_row) : group % per_row, b = group / per_row;
     const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
-    const auto wall_face = [&](int f) { return walls && (f == 0 || f == length); };
-    if (paired && a + 1 < n_a) {
-      for (int f = 0; f <= length; ++f) face(base + f * s, f < length, f > 0, wall_face(f), Pair{});
+    if (across) {
+      const int pencils = std::min(width, n_a - a);
+      const auto wall_face = [&](int f) { return walls && (f == 0 || f == length); };
+      for (int f = 0; f <= length; ++f)
+        for_lanes(pencils, [&](int l, auto lanes) { face(base + f * s + l, f < length, f > 0, wall_face(f), lanes); });
       continue;
     }
-    int f = 0;
-    if (d == 0) {
-      face(base, true, false, false, 0.0);
-      for (f = 1; f + 1 < length; f += 2) face(base + f, true, true, false, Pair{});
-    }
-    for (; f <= length; ++f) face(base + f * s, f < length, f > 0, wall_face(f), 0.0);
+    face(base, true, false, false, 0.0);
+    for_lanes(length - 1, [&](int i, auto lanes) { face(base + 1 + i, true, true, false, lanes); });
+    face(base + length, false, true, false, 0.0);
   }
 }
 }  // namespace

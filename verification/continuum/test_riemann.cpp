@@ -145,8 +145,8 @@ INSTANTIATE_TEST_SUITE_P(
                                                  : "_ssprk" + std::to_string(std::get<3>(param_info.param)) + "2");
     });
 
-// The flux kernel solves two faces at once (riemann_flux over Pair lanes, every case formed and
-// selected). The reference is the textbook solver with early returns, one face at a time: each
+// The flux kernel solves several faces at once (riemann_flux over vector lanes, every case
+// formed and selected). The reference is the textbook solver with early returns, one face at a time: each
 // lane must match it bit for bit, over states that reach every case (supersonic either way,
 // HLL's and HLLC's star regions on either side of the contact, pressureless sides moving apart).
 template <RiemannSolver Solver>
@@ -193,32 +193,36 @@ FaceState random_state(std::mt19937_64& random, bool pressureless) {
   return {n, 6.0 * unit(random) - 3.0, 2.0 * unit(random) - 1.0, 2.0 * unit(random) - 1.0, T, n * T * chi, c};
 }
 
-template <RiemannSolver Solver> void expect_lanes_match_branching_solver() {
+template <RiemannSolver Solver, class V> void expect_lanes_match_branching_solver() {
+  constexpr int width = lanes_of<V>;
   std::mt19937_64 random(20261204);
   int cases[4] = {0, 0, 0, 0};  // supersonic left, supersonic right, subsonic, vacuum
-  for (int trial = 0; trial < 20000; ++trial) {
+  for (int trial = 0; trial < 40000 / width; ++trial) {
     const bool pressureless = trial % 5 == 0;
-    FaceState L[2], R[2];
-    for (int lane = 0; lane < 2; ++lane) {
+    FaceState L[width], R[width];
+    for (int lane = 0; lane < width; ++lane) {
       L[lane] = random_state(random, pressureless);
       R[lane] = random_state(random, pressureless);
     }
     const auto lanes = [&](const FaceState* s) {
-      const auto pair = [](double a, double b) { return Pair{a, b}; };
-      return FaceStateOf<Pair>{pair(s[0].n, s[1].n),     pair(s[0].un, s[1].un), pair(s[0].ut1, s[1].ut1),
-                               pair(s[0].ut2, s[1].ut2), pair(s[0].T, s[1].T),   pair(s[0].p, s[1].p),
-                               pair(s[0].c, s[1].c)};
+      FaceStateOf<V> v;
+      for (int lane = 0; lane < width; ++lane) {
+        v.n[lane] = s[lane].n, v.un[lane] = s[lane].un, v.ut1[lane] = s[lane].ut1, v.ut2[lane] = s[lane].ut2;
+        v.T[lane] = s[lane].T, v.p[lane] = s[lane].p, v.c[lane] = s[lane].c;
+      }
+      return v;
     };
-    Pair F[5];
+    V F[5];
     riemann_flux<Solver>(lanes(L), lanes(R), F);
-    for (int lane = 0; lane < 2; ++lane) {
+    for (int lane = 0; lane < width; ++lane) {
       double expected[5], scalar[5];
       branching_flux<Solver>(L[lane], R[lane], expected);
       riemann_flux<Solver>(L[lane], R[lane], scalar);
       for (int v = 0; v < 5; ++v) {
         const double got = F[v][lane];
         ASSERT_EQ(std::memcmp(&got, &expected[v], sizeof got), 0)
-            << "trial " << trial << " lane " << lane << " component " << v << ": " << got << " vs " << expected[v];
+            << width << " lanes, trial " << trial << " lane " << lane << " component " << v << ": " << got
+            << " vs " << expected[v];
         ASSERT_EQ(std::memcmp(&scalar[v], &expected[v], sizeof got), 0) << "trial " << trial << " component " << v;
       }
       const FaceState &l = L[lane], &r = R[lane];
@@ -228,12 +232,16 @@ template <RiemannSolver Solver> void expect_lanes_match_branching_solver() {
     }
   }
   // Every case was reached often enough for the comparison to mean something.
-  for (int k = 0; k < 4; ++k) EXPECT_GE(cases[k], 500) << "case " << k;
+  for (int k = 0; k < 4; ++k) EXPECT_GE(cases[k], 500) << width << " lanes, case " << k;
 }
 
-TEST(RiemannFlux, PairLanesMatchTheBranchingSolver) {
-  expect_lanes_match_branching_solver<RiemannSolver::hllc>();
-  expect_lanes_match_branching_solver<RiemannSolver::hll>();
+// Pair and the build's widest vector (Wide: four lanes with AVX2, else the Pair again).
+TEST(RiemannFlux, VectorLanesMatchTheBranchingSolver) {
+  expect_lanes_match_branching_solver<RiemannSolver::hllc, Pair>();
+  expect_lanes_match_branching_solver<RiemannSolver::hll, Pair>();
+  expect_lanes_match_branching_solver<RiemannSolver::hllc, Wide>();
+  expect_lanes_match_branching_solver<RiemannSolver::hll, Wide>();
+  RecordProperty("widest_lanes", lanes_of<Wide>);
 }
 
 }  // namespace
