@@ -5,7 +5,9 @@
 // at a wall): copied too, not re-evaluated (exactly the same values, since every closure
 // value is even in u_z).
 // On a decomposed box (halo.hpp) the x and y ghosts come from the neighbouring ranks instead
-// of the periodic copy; the z ghosts are filled locally afterwards either way.
+// of the periodic copy; the z ghosts are filled locally afterwards either way. The conserved
+// state's ghosts are never read (every flux takes its neighbours from the primitives and the
+// closure), so only these are filled.
 #include "continuum/halo.hpp"
 #include "continuum/operator.hpp"
 
@@ -70,29 +72,19 @@ void fill(const Grid& g, const Halo* halo, const std::vector<double*>& fields, C
 }
 }  // namespace
 
-void Operator::fill_ghosts(State& U) const {
-  std::vector<double*> fields;
-  if (halo_)
-    for (auto& v : U.q) fields.push_back(v.data());
-  fill(grid_, halo_.get(), fields, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
-    for (int v = 0; v < variable_count; ++v) U.q[v][to] = U.q[v][from];
-    if (reverse_z) U.q[momentum_z][to] = -U.q[momentum_z][from];
-  });
-}
-
+// The fluxes read the primitives and the closure beside each cell; the collisional loss
+// only in the cell itself (sources.cpp), so its ghosts are not filled.
 void Operator::copy_closure_to_ghosts() {
   std::vector<double*> fields;
   if (halo_) {
     for (auto& v : w_) fields.push_back(v.data());
-    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda,
-                    &closure_.kappa, &closure_.loss})
+    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa})
       fields.push_back(v->data());
   }
   fill(grid_, halo_.get(), fields, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
     for (auto& v : w_) v[to] = v[from];
     if (reverse_z) w_[3][to] = -w_[3][from];
-    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda,
-                    &closure_.kappa, &closure_.loss})
+    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa})
       (*v)[to] = (*v)[from];
   });
 }

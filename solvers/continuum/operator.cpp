@@ -23,8 +23,7 @@ Operator::Operator(const Grid& grid, const PhysicsSettings& settings, std::share
   pow_value_.assign(cells, 0.0);
 }
 
-void Operator::rhs(double t, State& U, State& dUdt, Part part) {
-  fill_ghosts(U);
+void Operator::rhs(double t, const State& U, State& dUdt, Part part) {
   const Terms& terms = settings_.terms;
   const bool diffusive = part != Part::hyperbolic_and_sources &&
                          (terms.shear_viscosity || terms.bulk_viscosity || terms.conduction);

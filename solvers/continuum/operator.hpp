@@ -78,23 +78,21 @@ class Operator {
   /// step limits and energy sums are taken over the whole box.
   Operator(const Grid& grid, const PhysicsSettings& settings, std::shared_ptr<const Halo> halo = nullptr);
 
-  /// dUdt = L(U, t). Fills U's ghost cells first (so U is not const). Throws DomainError
-  /// (constitutive function outside its domain) on a broken state.
-  void rhs(double t, State& U, State& dUdt, Part part = Part::all);
+  /// dUdt = L(U, t). Only U's interior cells are read: the fluxes take their neighbours from
+  /// the primitives and closure, whose ghosts the evaluation fills (walls, periodic or the
+  /// halo's exchange). Throws DomainError (constitutive function outside its domain) on a
+  /// broken state.
+  void rhs(double t, const State& U, State& dUdt, Part part = Part::all);
 
   /// Largest stable explicit steps at the last evaluated state (call after rhs):
   /// advective cfl * h / max(sum_d |u_d| + c), and FE diffusive h^2 / (2 dim D_max).
   double advective_step(double cfl) const;
   double diffusive_step() const;
 
-  /// Fills ghosts and evaluates primitives and the closure at U (with the transport
+  /// Evaluates primitives and the closure at U, ghosts included (with the transport
   /// coefficients unless need_transport is false), without fluxes.
-  void prepare(State& U, bool need_transport = true) {
-    fill_ghosts(U);
-    evaluate_closure(U, need_transport);
-  }
+  void prepare(const State& U, bool need_transport = true) { evaluate_closure(U, need_transport); }
 
-  void fill_ghosts(State& U) const;  ///< walls (mirror) or periodic, x, y periodic
   /// Gravity plus frame force per unit mass at time t (z component).
   double body_force(double t) const;
 

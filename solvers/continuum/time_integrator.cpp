@@ -252,7 +252,7 @@ bool TimeIntegrator::rkl2(double dt, std::string& failure) {
   State& Yjm1 = Yjm1_;
   State& Yj = Yj_;
   Yjm2.q = Y0.q;
-  Yjm1.q = Y0.q;  // ghosts included: rhs fills them, axpy writes interiors only
+  Yjm1.q = Y0.q;  // interiors are what count: no state's ghosts are read
   Yj.q = Y0.q;
   axpy(Yjm1, 1.0, Y0, 0.0, Y0, b(1) * w1 * dt, M0);
   if (!admissible(Yjm1, t_, failure)) return false;
