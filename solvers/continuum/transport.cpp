@@ -26,35 +26,20 @@ namespace shaker::continuum {
 
 namespace {
 
-/// W cells' values of one scalar; the arithmetic the model templates use, lane by lane.
+/// W cells' values of one scalar, a vector (simd_pair.hpp): the arithmetic the model
+/// templates use, one instruction for all lanes, each lane the double's arithmetic.
 template <int W> struct Lanes {
-  double v[W];
+  using Vector = typename DoubleLanes<W>::type;
+  Vector v;
   Lanes() = default;
-  Lanes(double x) {  // NOLINT: implicit, like the double operands of the model's formulas
-    for (double& e : v) e = x;
-  }
+  Lanes(double x) : v(Vector{} + x) {}  // NOLINT: implicit, like the double operands of the model's formulas
+  explicit Lanes(Vector x) : v(x) {}
   /// The model's domain checks look at value_of(x); every lane is checked before evaluation.
   double value() const { return v[0]; }
-  friend Lanes operator+(const Lanes& a, const Lanes& b) {
-    Lanes r;
-    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] + b.v[l];
-    return r;
-  }
-  friend Lanes operator-(const Lanes& a, const Lanes& b) {
-    Lanes r;
-    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] - b.v[l];
-    return r;
-  }
-  friend Lanes operator*(const Lanes& a, const Lanes& b) {
-    Lanes r;
-    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] * b.v[l];
-    return r;
-  }
-  friend Lanes operator/(const Lanes& a, const Lanes& b) {
-    Lanes r;
-    for (int l = 0; l < W; ++l) r.v[l] = a.v[l] / b.v[l];
-    return r;
-  }
+  friend Lanes operator+(const Lanes& a, const Lanes& b) { return Lanes(a.v + b.v); }
+  friend Lanes operator-(const Lanes& a, const Lanes& b) { return Lanes(a.v - b.v); }
+  friend Lanes operator*(const Lanes& a, const Lanes& b) { return Lanes(a.v * b.v); }
+  friend Lanes operator/(const Lanes& a, const Lanes& b) { return Lanes(a.v / b.v); }
   Lanes& operator+=(const Lanes& b) { return *this = *this + b; }
   friend Lanes sqrt(const Lanes& a) {
     Lanes r;
@@ -205,8 +190,8 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
       bool valid = e_valid;
       PowMemo memo;
       if (lanes == lane_count) {  // whole-group copies (no scalar stores read back as pairs)
-        std::copy_n(wn + c, lane_count, n.v);
-        std::copy_n(wT + c, lane_count, T.v);
+        n.v = load_lanes<Cells::Vector>(wn + c);
+        T.v = load_lanes<Cells::Vector>(wT + c);
         std::copy_n(pow_argument_.data() + c, lane_count, memo.argument);
         std::copy_n(pow_value_.data() + c, lane_count, memo.value);
       } else {
