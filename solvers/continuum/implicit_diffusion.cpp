@@ -10,16 +10,12 @@
 #include <vector>
 
 #include "common/errors.hpp"
+#include "continuum/face_coefficients.hpp"
 #include "continuum/halo.hpp"
-#include "continuum/wall_stress.hpp"
 
 namespace shaker::continuum {
 
 namespace {
-inline double harmonic_mean(double a, double b) {
-  const double sum = a + b;
-  return sum > 0.0 ? 2.0 * a * b / sum : 0.0;
-}
 
 /// Diffusion coefficient of `component` (0..2: u_x, u_y, u_z; 3: T) across a face normal
 /// to `direction`.

@@ -10,21 +10,13 @@
 // zero (no heat through the walls, zero normal gradient of the tangential velocity).
 #include <algorithm>
 
+#include "continuum/face_coefficients.hpp"
 #include "continuum/operator.hpp"
 #include "continuum/simd_pair.hpp"
-#include "continuum/wall_stress.hpp"
 
 namespace shaker::continuum {
 
 namespace {
-inline double harmonic_mean(double a, double b) {
-  const double sum = a + b;
-  return sum > 0.0 ? 2.0 * a * b / sum : 0.0;
-}
-template <class V> inline V harmonic_mean(V a, V b) {  // per lane the above
-  const V sum = a + b;
-  return sum > 0.0 ? 2.0 * a * b / sum : V{};
-}
 
 /// tau_zz at a wall, WallStress::second_order: cell 0 is the wall cell, cell 1 the next one
 /// away from the wall, `toward` +1 at the bottom wall and -1 at the top (z runs away from the
