@@ -75,17 +75,17 @@ void fill(const Grid& g, const Halo* halo, const std::vector<double*>& fields, C
 // The fluxes read the primitives and the closure beside each cell; the collisional loss
 // only in the cell itself (sources.cpp), so its ghosts are not filled.
 void Operator::copy_closure_to_ghosts() {
+  std::vector<double>* const read_beside[] = {&closure_.p,  &closure_.c,      &closure_.chi,
+                                              &closure_.mu, &closure_.lambda, &closure_.kappa};
   std::vector<double*> fields;
   if (halo_) {
     for (auto& v : w_) fields.push_back(v.data());
-    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa})
-      fields.push_back(v->data());
+    for (auto* v : read_beside) fields.push_back(v->data());
   }
   fill(grid_, halo_.get(), fields, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
     for (auto& v : w_) v[to] = v[from];
     if (reverse_z) w_[3][to] = -w_[3][from];
-    for (auto* v : {&closure_.p, &closure_.c, &closure_.chi, &closure_.mu, &closure_.lambda, &closure_.kappa})
-      (*v)[to] = (*v)[from];
+    for (auto* v : read_beside) (*v)[to] = (*v)[from];
   });
 }
 
