@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <tuple>
 
 #include "common/errors.hpp"
 
@@ -53,13 +54,12 @@ class Stopwatch {
 }  // namespace
 
 Halo::Halo(const Grid& box, int ranks) : box_(box), local_(box) {
-  dims_[0] = dims_[1] = 0;  // both free for MPI_Dims_create
-  MPI_Dims_create(ranks, 2, dims_);
+  std::tie(dims_[0], dims_[1]) = layout(ranks);
   const int fewest_x = box.nx / dims_[0], fewest_y = box.ny / dims_[1];
   if (fewest_x < min_cells_per_rank || fewest_y < min_cells_per_rank)
     throw InputError(fmt::format(
         "the 3D box of {} x {} cells (continuum.box_width / continuum.cell_size) cannot be split "
-        "over {} ranks: MPI_Dims_create gives {} x {} ranks, {} x {} cells or fewer each; allowed: "
+        "over {} ranks: split as {} x {} ranks (x by y), {} x {} cells or fewer each; allowed: "
         "at least {} cells per rank in x and in y, so at most {} ranks in x and {} in y (fewer "
         "ranks, or a wider box)",
         box.nx, box.ny, ranks, dims_[0], dims_[1], fewest_x, fewest_y, min_cells_per_rank,
@@ -74,6 +74,12 @@ Halo::Halo(const Grid& box, int ranks) : box_(box), local_(box) {
   block_ = block_of(rank_);
   local_.nx = block_.nx;
   local_.ny = block_.ny;
+}
+
+std::pair<int, int> Halo::layout(int ranks) {
+  int dims[2] = {0, 0};  // both free for MPI_Dims_create, which orders them px >= py
+  MPI_Dims_create(ranks, 2, dims);
+  return {dims[1], dims[0]};
 }
 
 Halo::~Halo() {

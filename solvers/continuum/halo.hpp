@@ -1,6 +1,6 @@
 #pragma once
 // The 3D box decomposed horizontally over the ranks of an MPI launch (docs/parallel.md): a
-// Cartesian communicator periodic in x and y (MPI_Dims_create chooses px x py), each rank the
+// Cartesian communicator periodic in x and y (px x py ranks, Halo::layout), each rank the
 // owner of a block of whole columns with the grid's two ghost layers. This class is the one
 // place that talks to MPI for the continuum: the halo exchange of ghost cells, the global
 // reductions (time step, energy budget, the implicit diffusion's dot products and plane sums),
@@ -33,6 +33,11 @@ class Halo {
   /// naming the sizes and the allowed range, when a rank would own fewer than
   /// min_cells_per_rank cells in x or in y; every rank decides alike.
   Halo(const Grid& box, int ranks);
+  /// Ranks along x and y for `ranks` in all: MPI_Dims_create's as square a split as `ranks`
+  /// allows, with the larger count along y (px <= py), so that the x rows, the contiguous
+  /// direction in storage, are cut least: longer runs for the x sweeps, and the ghost layers
+  /// sent between ranks are whole rows.
+  static std::pair<int, int> layout(int ranks);
   ~Halo();
   Halo(const Halo&) = delete;
   Halo& operator=(const Halo&) = delete;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "continuum/halo.hpp"
 
@@ -16,28 +17,49 @@ TimeIntegrator::TimeIntegrator(const Grid& grid, const PhysicsSettings& physics,
   for (State* s : {&U_, &U0_, &U1_, &U2_, &K_, &K0_, &start_}) s->resize(grid.size());
 }
 
-void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y,
-                          double c, const State& k) const {
-  const Grid& g = op_.grid();
+namespace {
+/// Calls run(first, length, v) for every variable v of every contiguous run of interior cells
+/// (a whole 1D column, or one x row in 3D), threaded on large grids.
+template <class Run> void for_interior_runs(const Grid& g, Run run) {
   const int length = g.row_length();
-  // One contiguous run of interior cells (a whole 1D column, or one x row in 3D).
-  const auto run = [&](int row) {
-    const std::ptrdiff_t first = g.row_start(row);
-    for (int v = 0; v < variable_count; ++v) {
-      const double* X = x.q[v].data() + first;
-      const double* Y = y.q[v].data() + first;
-      const double* Kv = k.q[v].data() + first;
-      double* O = out.q[v].data() + first;
-      for (int i = 0; i < length; ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
-    }
+  const auto row_of_every_variable = [&](int row) {
+    for (int v = 0; v < variable_count; ++v) run(g.row_start(row), length, v);
   };
   const int rows = g.interior_rows();
   if (g.threaded()) {
 #pragma omp parallel for schedule(dynamic, 2 * g.ny)
-    for (int row = 0; row < rows; ++row) run(row);
+    for (int row = 0; row < rows; ++row) row_of_every_variable(row);
   } else {
-    for (int row = 0; row < rows; ++row) run(row);
+    for (int row = 0; row < rows; ++row) row_of_every_variable(row);
   }
+}
+}  // namespace
+
+void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y,
+                          double c, const State& k) const {
+  for_interior_runs(op_.grid(), [&](std::ptrdiff_t first, int length, int v) {
+    const double* X = x.q[v].data() + first;
+    const double* Y = y.q[v].data() + first;
+    const double* Kv = k.q[v].data() + first;
+    double* O = out.q[v].data() + first;
+    for (int i = 0; i < length; ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
+  });
+}
+
+void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y, double c,
+                          const State& k, double d, const State& z, double e, const State& m) const {
+  for_interior_runs(op_.grid(), [&](std::ptrdiff_t first, int length, int v) {
+    const double* X = x.q[v].data() + first;
+    const double* Y = y.q[v].data() + first;
+    const double* Kv = k.q[v].data() + first;
+    const double* Z = z.q[v].data() + first;
+    const double* M = m.q[v].data() + first;
+    double* O = out.q[v].data() + first;
+    for (int i = 0; i < length; ++i) {
+      const double first_three = a * X[i] + b * Y[i] + c * Kv[i];
+      O[i] = first_three + d * Z[i] + e * M[i];
+    }
+  });
 }
 
 double interior_energy_sum(const Grid& g, const State& s) {
@@ -232,12 +254,14 @@ bool TimeIntegrator::rkl2(double dt, std::string& failure) {
   // The stage recursion needs Y0, Y_{j-1}, Y_{j-2}, Y_j, M0 = L(Y0) and L(Y_{j-1}). The
   // SSP stages U1_, U2_, K_ are free during the split diffusion step; three more scratch
   // states are allocated once, on the first RKL2 step, not per step.
-  for (State* scratch : {&Yjm2_, &Yjm1_, &Yj_})
-    if (scratch->size() != U_.size()) scratch->resize(U_.size());
-  State& Y0 = U1_;
+  for (State* stage : {&Yjm2_, &Yjm1_, &Yj_})
+    if (stage->size() != U_.size()) stage->resize(U_.size());
+  // Y0 is U_ itself, read until the last stage; the stages rotate through three scratch
+  // states (Y_{j-2} is Y0 itself at j = 2), and the last is swapped into U_. No copies: only
+  // interiors are written and read (no state's ghosts are read).
+  const State& Y0 = U_;
   State& M0 = K_;
   State& L = U2_;
-  Y0.q = U_.q;
   op_.rhs(t_, Y0, M0, Part::diffusive);
   const double dt_fe = op_.diffusive_step();
   if (!std::isfinite(dt_fe)) return true;
@@ -248,27 +272,24 @@ bool TimeIntegrator::rkl2(double dt, std::string& failure) {
   counters_.diffusion_stages += s;
   auto b = [](int j) { return j <= 2 ? 1.0 / 3.0 : (j * j + j - 2.0) / (2.0 * j * (j + 1.0)); };
   const double w1 = 4.0 / (s * s + s - 2.0);
-  State& Yjm2 = Yjm2_;
-  State& Yjm1 = Yjm1_;
-  State& Yj = Yj_;
-  Yjm2.q = Y0.q;
-  Yjm1.q = Y0.q;  // interiors are what count: no state's ghosts are read
-  Yj.q = Y0.q;
-  axpy(Yjm1, 1.0, Y0, 0.0, Y0, b(1) * w1 * dt, M0);
-  if (!admissible(Yjm1, t_, failure)) return false;
+  State* scratch[3] = {&Yjm2_, &Yjm1_, &Yj_};
+  const State* Yjm2 = &Y0;
+  State* Yjm1 = scratch[0];
+  axpy(*Yjm1, 1.0, Y0, 0.0, Y0, b(1) * w1 * dt, M0);
+  if (!admissible(*Yjm1, t_, failure)) return false;
   for (int j = 2; j <= s; ++j) {
     const double mu = (2.0 * j - 1.0) / j * b(j) / b(j - 1);
     const double nu = -(j - 1.0) / j * b(j) / b(j - 2);
     const double mu_tilde = mu * w1;
     const double gamma_tilde = -(1.0 - b(j - 1)) * mu_tilde;
-    op_.rhs(t_, Yjm1, L, Part::diffusive);
-    axpy(Yj, mu, Yjm1, nu, Yjm2, mu_tilde * dt, L);
-    axpy(Yj, 1.0, Yj, 1.0 - mu - nu, Y0, gamma_tilde * dt, M0);
-    if (!admissible(Yj, t_, failure)) return false;
-    std::swap(Yjm2, Yjm1);
-    std::swap(Yjm1, Yj);
+    op_.rhs(t_, *Yjm1, L, Part::diffusive);
+    State* Yj = scratch[(j - 1) % 3];
+    axpy(*Yj, mu, *Yjm1, nu, *Yjm2, mu_tilde * dt, L, 1.0 - mu - nu, Y0, gamma_tilde * dt, M0);
+    if (!admissible(*Yj, t_, failure)) return false;
+    Yjm2 = Yjm1;
+    Yjm1 = Yj;
   }
-  U_.q = Yjm1.q;
+  std::swap(U_.q, Yjm1->q);
   return true;
 }
 
@@ -294,9 +315,9 @@ bool TimeIntegrator::try_step(double dt, std::string& failure) {
       pending_.floor_energy += total_energy() - before;
       return ok;
     };
-    U_.q = U0_.q;
+    // U_ equals U0_ here (step() sets both, on every attempt).
     if (!diffuse(0.5 * dt)) return false;
-    U0_.q = U_.q;
+    std::swap(U0_.q, U_.q);  // the SSP step reads U0_ and overwrites U_'s interior
     op_.rhs(t_, U0_, K0_, Part::hyperbolic_and_sources);
     power0_ = op_.source_power();
     if (!ssp_runge_kutta(dt, Part::hyperbolic_and_sources, failure)) return false;

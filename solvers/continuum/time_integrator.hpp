@@ -109,6 +109,10 @@ class TimeIntegrator {
                        std::int64_t* failing_cell = nullptr);
   void axpy(State& out, double a, const State& x, double b, const State& y, double c,
             const State& k) const;  ///< out = a x + b y + c k on interior cells
+  /// out = (a x + b y + c k) + d z + e m on interior cells: bit for bit the first axpy, then
+  /// axpy(out, 1, out, d, z, e, m), in one pass.
+  void axpy(State& out, double a, const State& x, double b, const State& y, double c, const State& k,
+            double d, const State& z, double e, const State& m) const;
 
   Operator op_;
   ImplicitDiffusion implicit_;

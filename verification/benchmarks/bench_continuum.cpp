@@ -205,6 +205,12 @@ void BM_Continuum3D_PeriodicCycleSlice_PaperStages(benchmark::State& state) {
 BENCHMARK(BM_Continuum3D_PeriodicCycleSlice_PaperStages)
     ->Arg(10)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
+void BM_Continuum3D_PeriodicCycleSlice_PaperRkl2Stages(benchmark::State& state) {
+  run_periodic_cycle(state, base_case(3, 0.5, "paper", "rkl2", static_cast<int>(state.range(0))), 0.1);
+}
+BENCHMARK(BM_Continuum3D_PeriodicCycleSlice_PaperRkl2Stages)
+    ->Arg(10)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
 // One evaluation of the right-hand side (every term: inviscid and viscous fluxes, closure,
 // sources) of that box at the periodic state's phase 0 in one process, repeated: its short
 // iterations average over a noisy machine, so a kernel's old and new versions can be compared
@@ -275,7 +281,7 @@ BENCHMARK(BM_Continuum3D_MemoryPerCell)->Iterations(1);
 
 // Weak scaling of the decomposed 3D box: every rank owns a block of W x W columns (W the
 // argument) of the base case's height at cell 0.5 (160 planes). Under `mpirun -np P` the box
-// is (px W) x (py W) cells, px x py = MPI_Dims_create(P, 2); without a launcher W x W on one
+// is (px W) x (py W) cells, px x py = Halo::layout(P); without a launcher W x W on one
 // process (the serial path). Twenty steps of the paper transport with explicit diffusion from
 // the flat layer, timed between barriers; cell updates per second of the whole box and per
 // rank (per core with OMP_NUM_THREADS=1), and the fraction of rank 0's time spent in messages
@@ -284,14 +290,10 @@ void BM_Continuum3D_DecomposedBlock(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0));
   const bool launched = launched_by_mpi();
   const int ranks = Ranks::world().size();
-  int dims[2] = {1, 1};
-  if (launched) {
-    dims[0] = dims[1] = 0;
-    MPI_Dims_create(ranks, 2, dims);
-  }
+  const auto [px, py] = launched ? continuum::Halo::layout(ranks) : std::pair{1, 1};
   continuum::ContinuumCase c = base_case(3, 0.5, "paper", "explicit");
-  c.grid.nx = dims[0] * width;
-  c.grid.ny = dims[1] * width;
+  c.grid.nx = px * width;
+  c.grid.ny = py * width;
   const auto halo = launched ? std::make_shared<const continuum::Halo>(c.grid, ranks) : nullptr;
   const auto barrier = [&] {
     if (launched) MPI_Barrier(MPI_COMM_WORLD);

@@ -301,7 +301,7 @@ INSTANTIATE_TEST_SUITE_P(
                       FastIntegrator{"full", "implicit", 4}, FastIntegrator{"full", "implicit_extrapolated", 10},
                       FastIntegrator{"paper", "explicit", 4}, FastIntegrator{"paper", "explicit", 6},
                       FastIntegrator{"paper", "explicit", 10},
-                      FastIntegrator{"paper", "implicit_extrapolated", 2}),
+                      FastIntegrator{"paper", "implicit_extrapolated", 2}, FastIntegrator{"paper", "rkl2", 10}),
     [](const ::testing::TestParamInfo<FastIntegrator>& p) {
       return p.param.transport + "_" + p.param.diffusion + "_s" + std::to_string(p.param.stages);
     });
@@ -481,7 +481,7 @@ INSTANTIATE_TEST_SUITE_P(
                       TimeStepCase{1, "paper", "implicit_extrapolated", 2},
                       TimeStepCase{1, "paper", "implicit", 2},
                       TimeStepCase{1, "full", "implicit_extrapolated", 2},
-                      TimeStepCase{1, "full", "implicit", 2},
+                      TimeStepCase{1, "full", "implicit", 2}, TimeStepCase{1, "paper", "rkl2", 10},
                       TimeStepCase{3, "paper", "explicit", 2}, TimeStepCase{3, "paper", "explicit", 10},
                       TimeStepCase{3, "paper", "implicit_extrapolated", 4},
                       TimeStepCase{3, "paper", "implicit_extrapolated", 2},

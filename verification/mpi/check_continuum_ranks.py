@@ -410,7 +410,7 @@ def check_refused(shaker, work, launcher):
             ("1D column on 2 ranks", 2, ["continuum.dimension=1", "continuum.field_phases=[]"],
              ["continuum.dimension = 1", "one rank"]),
             ("8 x 8 box on 3 ranks", 3, ["continuum.box_width=4.0"],
-             ["8 x 8 cells", "3 x 1 ranks", "at least 3 cells per rank", "at most 2 ranks in x"]),
+             ["8 x 8 cells", "1 x 3 ranks", "at least 3 cells per rank", "at most 2 ranks in x and 2 in y"]),
             ("box too large for this machine on 2 ranks", 2,
              [f"continuum.box_width={width_filling(1.5)}", "continuum.field_phases=[]"],
              ["over 2 ranks, 2 of them on this machine", "MemAvailable",
