@@ -35,7 +35,7 @@ constexpr int max_lanes = 32;
 
 template <Limiter L, RiemannSolver R>
 void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
-                     const Operator::Closure& closure, bool pressureful, State& dUdt) {
+                     const Operator::Closure& closure, bool pressureful, State& dUdt, int k0, int k1) {
   const double inv_h = 1.0 / g.h;
   const bool pressure = pressureful;
   const double* fields[7] = {w[0].data(),  w[1].data(),
@@ -83,7 +83,9 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     store_lanes_where(keep, &minus[un][q], u0 - 0.5 * du);
     store_lanes_where(keep, &minus[4][q], p_minus);
   };
-  for (int d = g.first_direction(); d < 3; ++d) {
+  // The faces of direction d that belong to planes k0 .. k1 - 1: along x and y every face of
+  // those planes, along z the faces k0 .. k1 - 1 (the top face nz too with the last plane).
+  const auto sweep = [&](int d) {
     const std::ptrdiff_t s = g.stride(d);
     const int un_index = 1 + d;
     const Pencils P = pencils_of(g, d);
@@ -246,41 +248,44 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     // same cache line.
     const bool across = s != 1;
     const int runs_per_row = across ? (P.count_a + max_lanes - 1) / max_lanes : P.count_a;
-    const int groups = runs_per_row * P.count_b;
+    const bool along_z = d == 2;  // pencils b are the planes for x and y, the rows of y for z
+    const int b_first = along_z ? 0 : k0, groups = runs_per_row * (along_z ? P.count_b : k1 - k0);
+    const int f_begin = along_z ? k0 : 0, f_end = along_z && k1 < g.nz ? k1 : P.length + 1;
 #pragma omp parallel for schedule(dynamic, runs_per_row) if (g.threaded())
     for (int group = 0; group < groups; ++group) {
-      const int run = group % runs_per_row, b = group / runs_per_row;
+      const int run = group % runs_per_row, b = b_first + group / runs_per_row;
       const int a = across ? run * P.count_a / runs_per_row : run;
       const int W = across ? (run + 1) * P.count_a / runs_per_row - a : 1;
       const std::ptrdiff_t base = P.base(g, d, a, b);
       const int faces_per_block = block_slots / W - 1;
-      for (int f0 = 0; f0 <= P.length; f0 += faces_per_block)
-        block(W, base, f0, std::min(f0 + faces_per_block, P.length + 1));
+      for (int f0 = f_begin; f0 < f_end; f0 += faces_per_block)
+        block(W, base, f0, std::min(f0 + faces_per_block, f_end));
     }
-  }
+  };
+  for (int d = g.first_direction(); d < 3; ++d) sweep(d);
 }
 
 template <Limiter L>
 void dispatch_riemann(RiemannSolver r, const Grid& g,
                       const std::array<std::vector<double>, variable_count>& w,
-                      const Operator::Closure& closure, bool pressureful, State& dUdt) {
+                      const Operator::Closure& closure, bool pressureful, State& dUdt, int k0, int k1) {
   if (r == RiemannSolver::hllc)
-    inviscid_fluxes<L, RiemannSolver::hllc>(g, w, closure, pressureful, dUdt);
+    inviscid_fluxes<L, RiemannSolver::hllc>(g, w, closure, pressureful, dUdt, k0, k1);
   else
-    inviscid_fluxes<L, RiemannSolver::hll>(g, w, closure, pressureful, dUdt);
+    inviscid_fluxes<L, RiemannSolver::hll>(g, w, closure, pressureful, dUdt, k0, k1);
 }
 }  // namespace
 
-void Operator::add_inviscid_fluxes(State& dUdt) {
+void Operator::add_inviscid_fluxes(State& dUdt, int k0, int k1) {
   switch (settings_.limiter) {
     case Limiter::minmod:
-      return dispatch_riemann<Limiter::minmod>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt);
+      return dispatch_riemann<Limiter::minmod>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt, k0, k1);
     case Limiter::mc:
-      return dispatch_riemann<Limiter::mc>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt);
+      return dispatch_riemann<Limiter::mc>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt, k0, k1);
     case Limiter::van_leer:
-      return dispatch_riemann<Limiter::van_leer>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt);
+      return dispatch_riemann<Limiter::van_leer>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt, k0, k1);
     case Limiter::none:
-      return dispatch_riemann<Limiter::none>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt);
+      return dispatch_riemann<Limiter::none>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt, k0, k1);
   }
 }
 

@@ -115,9 +115,12 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
 namespace {
 /// The faces normal to direction d (a template parameter: the gradient's index logic is
 /// resolved at compile time).
+/// Faces of the planes k0 .. k1 - 1 as in riemann.cpp: along x and y every face of those
+/// planes, along z the faces k0 .. k1 - 1 (the top face nz too with the last plane).
 template <int d>
 void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
-                            const Operator::Closure& closure, WallStress wall_stress, State& dUdt) {
+                            const Operator::Closure& closure, WallStress wall_stress, State& dUdt,
+                            int k0, int k1) {
   const double inv_h = 1.0 / g.h;
   const bool three_d = g.dimension == 3;
   const double* u[3] = {w[1].data(), w[2].data(), w[3].data()};
@@ -196,14 +199,16 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
   constexpr int width = lanes_of<Wide>;
   const bool across = d != 0;
   const int per_row = across ? (n_a + width - 1) / width : n_a;
+  const int b_first = d == 2 ? 0 : k0, groups = per_row * (d == 2 ? n_b : k1 - k0);
+  const int f_begin = d == 2 ? k0 : 0, f_end = d == 2 && k1 < g.nz ? k1 : length + 1;
 #pragma omp parallel for schedule(dynamic, per_row) if (g.threaded())
-  for (int group = 0; group < per_row * n_b; ++group) {
-    const int a = across ? width * (group % per_row) : group % per_row, b = group / per_row;
+  for (int group = 0; group < groups; ++group) {
+    const int a = across ? width * (group % per_row) : group % per_row, b = b_first + group / per_row;
     const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
     if (across) {
       const int pencils = std::min(width, n_a - a);
       const auto wall_face = [&](int f) { return walls && (f == 0 || f == length); };
-      for (int f = 0; f <= length; ++f)
+      for (int f = f_begin; f < f_end; ++f)
         for_lanes(pencils, [&](int l, auto lanes) { face(base + f * s + l, f < length, f > 0, wall_face(f), lanes); });
       continue;
     }
@@ -214,16 +219,16 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
 }
 }  // namespace
 
-void Operator::add_diffusive_fluxes(State& dUdt) {
+void Operator::add_diffusive_fluxes(State& dUdt, int k0, int k1) {
   const Grid& g = grid_;
   const WallStress wall_stress = settings_.wall_stress;
-  if (g.dimension != 3 && g.nx == 1 && g.ny == 1)
+  if (g.dimension != 3 && g.nx == 1 && g.ny == 1)  // rhs passes a column whole
     return column_diffusive_fluxes(g, w_, closure_, wall_stress, dUdt);
   if (g.first_direction() == 0) {
-    diffusive_fluxes_along<0>(g, w_, closure_, wall_stress, dUdt);
-    diffusive_fluxes_along<1>(g, w_, closure_, wall_stress, dUdt);
+    diffusive_fluxes_along<0>(g, w_, closure_, wall_stress, dUdt, k0, k1);
+    diffusive_fluxes_along<1>(g, w_, closure_, wall_stress, dUdt, k0, k1);
   }
-  diffusive_fluxes_along<2>(g, w_, closure_, wall_stress, dUdt);
+  diffusive_fluxes_along<2>(g, w_, closure_, wall_stress, dUdt, k0, k1);
 }
 
 }  // namespace shaker::continuum
