@@ -74,14 +74,17 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     const S dp = 0.5 * (w1 + w3), du = 0.5 * (w3 - w1) / impedance, dn = w2 + dp * inv_c2;
     const S n_plus = n0 + 0.5 * dn, p_plus = p0 + 0.5 * dp;
     const S n_minus = n0 - 0.5 * dn, p_minus = p0 - 0.5 * dp;
-    // (no sound speed, or a face value that is not positive: keep the component-wise values)
+    // (no sound speed, or a face value that is not positive: the component-wise values, what
+    // reconstruct_lanes gives from the same differences)
     const auto keep = (c0 > 0.0) & (n_plus > 0.0) & (p_plus > 0.0) & (n_minus > 0.0) & (p_minus > 0.0);
-    store_lanes_where(keep, &plus[0][q], n_plus);
-    store_lanes_where(keep, &plus[un][q], u0 + 0.5 * du);
-    store_lanes_where(keep, &plus[4][q], p_plus);
-    store_lanes_where(keep, &minus[0][q], n_minus);
-    store_lanes_where(keep, &minus[un][q], u0 - 0.5 * du);
-    store_lanes_where(keep, &minus[4][q], p_minus);
+    const S half_n = 0.5 * limited_slope<L>(dn_b, dn_f), half_u = 0.5 * limited_slope<L>(du_b, du_f),
+            half_p = 0.5 * limited_slope<L>(dp_b, dp_f);
+    store_lanes(&plus[0][q], keep ? n_plus : n0 + half_n);
+    store_lanes(&plus[un][q], keep ? u0 + 0.5 * du : u0 + half_u);
+    store_lanes(&plus[4][q], keep ? p_plus : p0 + half_p);
+    store_lanes(&minus[0][q], keep ? n_minus : n0 - half_n);
+    store_lanes(&minus[un][q], keep ? u0 - 0.5 * du : u0 - half_u);
+    store_lanes(&minus[4][q], keep ? p_minus : p0 - half_p);
   };
   // The faces of direction d that belong to planes k0 .. k1 - 1: along x and y every face of
   // those planes, along z the faces k0 .. k1 - 1 (the top face nz too with the last plane).
@@ -143,19 +146,24 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     // face temperature far outside the neighbouring cells' range; such a face state falls back
     // to its cell's average (first order there). The band is a factor of 2 around the range,
     // so smooth flow (where p / (n chi) differs from T by O(h)) never triggers it.
-    const auto face_temperature = [&](std::ptrdiff_t c, int slot, auto& x, auto lanes) {
+    // Both face states of the cells at c (slot `slot`), which share the cells' range.
+    const auto face_temperatures = [&](std::ptrdiff_t c, int slot, FaceStates& low_faces,
+                                       FaceStates& high_faces, auto lanes) {
       using S = decltype(lanes);
       using pair_detail::larger;
       using pair_detail::smaller;
       const double* T = w[4].data();
       const auto at = [](const double* y) { return load_lanes<S>(y); };
-      const S p = at(&x[4][slot]), T_face = p / (at(&x[0][slot]) * at(&x[5][slot]));
       const S Tb = at(T + c - s), Tc = at(T + c), Tf = at(T + c + s);
       const S low = 0.5 * smaller(smaller(Tb, Tc), Tf), high = 2.0 * larger(larger(Tb, Tc), Tf);
-      const auto inside = (T_face >= low) & (T_face <= high);
-      for (int v : {0, 1, 2, 3, 6}) store_lanes(&x[v][slot], inside ? at(&x[v][slot]) : at(fields[v] + c));
-      store_lanes(&x[4][slot], inside ? T_face : Tc);
-      store_lanes(&x[5][slot], inside ? p : at(closure.p.data() + c));
+      for (FaceStates* x : {&low_faces, &high_faces}) {
+        const S p = at(&(*x)[4][slot]), T_face = p / (at(&(*x)[0][slot]) * at(&(*x)[5][slot]));
+        const auto inside = (T_face >= low) & (T_face <= high);
+        store_lanes(&(*x)[4][slot], inside ? T_face : Tc);
+        store_lanes(&(*x)[5][slot], inside ? p : at(closure.p.data() + c));
+        if (any_lane(!inside))  // rare: the other fields fall back to the cell's too
+          for (int v : {0, 1, 2, 3, 6}) store_lanes_where(!inside, &(*x)[v][slot], at(fields[v] + c));
+      }
     };
     // Block of faces f0 .. f1 - 1 of W pencils whose first cells are base, base + 1, ...
     // (W = 1 along x: a pencil is a row, contiguous).
@@ -175,6 +183,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
       };
       FaceStates minus, plus;
       for (int v = 0; v < 7; ++v) {
+        if (pressure && (v == 0 || v == un_index || v == 4)) continue;  // characteristic() does these
         const double* x = fields[v];
         over_cells([&](std::ptrdiff_t c, int slot, auto lanes) {
           reconstruct_lanes<L, decltype(lanes)>(x + c, s, minus[v] + slot, plus[v] + slot);
@@ -193,8 +202,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
             for (int lane = 0; lane < W; ++lane) wall_face(base + lane, f, (f - f0) * W + lane, W, minus, plus);
       if (pressure)
         over_cells([&](std::ptrdiff_t c, int slot, auto lanes) {
-          face_temperature(c, slot, minus, lanes);
-          face_temperature(c, slot, plus, lanes);
+          face_temperatures(c, slot, minus, plus, lanes);
         });
       const int slots = (f1 - f0) * W;
       double change[variable_count][block_slots];  // flux / h of face f0 + b, pencil l: b W + l
