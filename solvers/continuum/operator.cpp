@@ -28,26 +28,25 @@ void Operator::rhs(double t, const State& U, State& dUdt, Part part) {
   const bool diffusive = part != Part::hyperbolic_and_sources &&
                          (terms.shear_viscosity || terms.bulk_viscosity || terms.conduction);
   evaluate_closure(U, diffusive);
-  // A large grid is zeroed plane by plane on every thread (serial, the fill of the 3D box
-  // would be the largest serial part of the evaluation).
-  if (grid_.threaded()) {
-    const std::ptrdiff_t plane = grid_.stride_z();
-    const int planes = static_cast<int>(static_cast<std::ptrdiff_t>(grid_.size()) / plane);
-#pragma omp parallel for schedule(static)
-    for (int k = 0; k < planes; ++k)
-      for (auto& v : dUdt.q) std::fill(v.begin() + k * plane, v.begin() + (k + 1) * plane, 0.0);
-  } else {
-    for (auto& v : dUdt.q) std::fill(v.begin(), v.end(), 0.0);
-  }
   // A 3D box goes a slab of planes at a time, its fields and right-hand side staying in cache
-  // from one sweep to the next (six passes over the box from memory otherwise); the viscous
-  // fluxes follow one slab behind the inviscid ones. Every cell still receives its terms in the
-  // order of whole-box sweeps (inviscid x, y, z low, z high, then viscous alike; a slab's top
-  // z face is swept with the next slab), so the sums are the same bit for bit.
+  // from one sweep to the next (six passes over the box from memory otherwise): the slab's
+  // right-hand side is zeroed, its inviscid fluxes added, then the viscous fluxes of the slab
+  // before it. Every cell still receives its terms in the order of whole-box sweeps (inviscid
+  // x, y, z low, z high, then viscous alike; a slab's top z face is swept with the next slab),
+  // so the sums are the same bit for bit. Only the interior planes are zeroed: nothing writes
+  // or reads the z ghosts of a right-hand side.
   const bool inviscid = part != Part::diffusive && terms.advection;
   const int nz = grid_.nz, slab = grid_.dimension == 3 ? slab_planes : nz;
+  const std::ptrdiff_t plane = grid_.stride_z(), first = plane * Grid::ghosts;  // plane 0, x and y ghosts too
   for (int k0 = 0; k0 < nz + slab; k0 += slab) {
-    if (inviscid && k0 < nz) add_inviscid_fluxes(dUdt, k0, std::min(k0 + slab, nz));
+    if (k0 < nz) {
+      const int k1 = std::min(k0 + slab, nz);
+      // Threaded plane by plane (the fill would be the largest serial part of the evaluation).
+#pragma omp parallel for schedule(static) if (grid_.threaded())
+      for (int k = k0; k < k1; ++k)
+        for (auto& v : dUdt.q) std::fill_n(v.begin() + first + k * plane, plane, 0.0);
+      if (inviscid) add_inviscid_fluxes(dUdt, k0, k1);
+    }
     if (diffusive && k0 > 0 && k0 - slab < nz) add_diffusive_fluxes(dUdt, k0 - slab, std::min(k0, nz));
   }
   if (part != Part::diffusive) add_sources(t, U, dUdt);

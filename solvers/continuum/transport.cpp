@@ -215,6 +215,18 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
       const CellClosure<Cells> r = need_transport ? evaluate_cells<true>(settings_, n, T, h)
                                                   : evaluate_cells<false>(settings_, n, T, h);
       pow_memo = nullptr;
+      if (lanes == lane_count) {  // whole vectors: per lane the arithmetic of `store`
+        std::copy_n(memo.argument, lane_count, pow_argument_.data() + c);
+        std::copy_n(memo.value, lane_count, pow_value_.data() + c);
+        store_lanes(cl.p.data() + c, r.p.v);
+        store_lanes(cl.c.data() + c, r.c.v);
+        store_lanes(cl.chi.data() + c, T.v > 0.0 ? r.p.v / (n.v * T.v) : Cells::Vector{} + 1.0);
+        store_lanes(cl.mu.data() + c, r.mu.v);
+        store_lanes(cl.lambda.data() + c, r.lambda.v);
+        store_lanes(cl.kappa.data() + c, r.kappa.v);
+        store_lanes(cl.loss.data() + c, r.loss.v);
+        continue;
+      }
       for (int l = 0; l < lanes; ++l) {
         pow_argument_[c + l] = memo.argument[l];
         pow_value_[c + l] = memo.value[l];
