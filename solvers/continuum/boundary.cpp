@@ -23,16 +23,11 @@ template <class Body> void loop(const Grid& g, int begin, int end, Body body) {
   }
 }
 
-/// Calls copy(to, from, reverse_z) for every x and y ghost of the interior planes (x, then y
-/// including the x ghosts, plane by plane), so that every source cell is already filled.
-template <class Copy> void for_each_periodic_xy_ghost(const Grid& g, Copy copy) {
+/// Calls copy(to, from, reverse_z) for every y ghost of the interior planes, x ghosts
+/// included (filled before, by the closure's rows), so that every source cell is filled.
+template <class Copy> void for_each_periodic_y_ghost(const Grid& g, Copy copy) {
   const int G = Grid::ghosts;
   loop(g, 0, g.nz, [&](int k) {
-    for (int j = 0; j < g.ny; ++j)
-      for (int m = 1; m <= G; ++m) {
-        copy(g.index(-m, j, k), g.index(g.nx - m, j, k), false);
-        copy(g.index(g.nx - 1 + m, j, k), g.index(m - 1, j, k), false);
-      }
     for (int i = -G; i < g.nx + G; ++i)
       for (int m = 1; m <= G; ++m) {
         copy(g.index(i, -m, k), g.index(i, g.ny - m, k), false);
@@ -61,31 +56,48 @@ template <class Copy> void for_each_z_ghost(const Grid& g, Copy copy) {
   });
 }
 
-/// Every ghost of `fields`: x and y from the halo (or the periodic copy), then z.
+/// Every ghost of `fields`: x (unless the rows filled them) and y from the halo, or y by
+/// the periodic copy, then z.
 template <class Copy>
-void fill(const Grid& g, const Halo* halo, const std::vector<double*>& fields, Copy copy) {
+void fill(const Grid& g, const Halo* halo, const std::vector<double*>& fields, bool x_filled, Copy copy) {
   if (halo)
-    halo->exchange(fields);
+    halo->exchange(fields, x_filled);
   else if (g.dimension == 3)
-    for_each_periodic_xy_ghost(g, copy);
+    for_each_periodic_y_ghost(g, copy);
   for_each_z_ghost(g, copy);
 }
 }  // namespace
 
 // The fluxes read the primitives and the closure beside each cell; the collisional loss
 // only in the cell itself (sources.cpp), so its ghosts are not filled.
-void Operator::copy_closure_to_ghosts() {
-  std::vector<double>* const read_beside[] = {&closure_.p,  &closure_.c,      &closure_.chi,
-                                              &closure_.mu, &closure_.lambda, &closure_.kappa};
-  std::vector<double*> fields;
-  if (halo_) {
-    for (auto& v : w_) fields.push_back(v.data());
-    for (auto* v : read_beside) fields.push_back(v->data());
+std::array<std::vector<double>*, variable_count + 6> Operator::ghosted_fields() {
+  return {&w_[0],       &w_[1],       &w_[2],         &w_[3],      &w_[4],          &closure_.p,
+          &closure_.c,  &closure_.chi, &closure_.mu,  &closure_.lambda, &closure_.kappa};
+}
+
+bool Operator::x_ghosts_by_rows() const {
+  return grid_.dimension == 3 && (!halo_ || halo_->ranks_along(0) == 1);
+}
+
+void Operator::copy_row_to_x_ghosts(std::ptrdiff_t first) {
+  const int nx = grid_.nx;
+  for (std::vector<double>* field : ghosted_fields()) {
+    double* row = field->data() + first;
+    for (int m = 1; m <= Grid::ghosts; ++m) {
+      row[-m] = row[nx - m];
+      row[nx - 1 + m] = row[m - 1];
+    }
   }
-  fill(grid_, halo_.get(), fields, [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
-    for (auto& v : w_) v[to] = v[from];
+}
+
+void Operator::copy_closure_to_ghosts() {
+  const auto ghosted = ghosted_fields();
+  std::vector<double*> fields;
+  if (halo_)
+    for (auto* v : ghosted) fields.push_back(v->data());
+  fill(grid_, halo_.get(), fields, x_ghosts_by_rows(), [&](std::ptrdiff_t to, std::ptrdiff_t from, bool reverse_z) {
+    for (auto* v : ghosted) (*v)[to] = (*v)[from];
     if (reverse_z) w_[3][to] = -w_[3][from];
-    for (auto* v : read_beside) (*v)[to] = (*v)[from];
   });
 }
 

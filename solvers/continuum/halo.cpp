@@ -96,8 +96,8 @@ Block Halo::block_of(int rank) const {
   return Block{i0, j0, nx, ny};
 }
 
-void Halo::exchange(const std::vector<double*>& fields) const {
-  exchange_direction(0, fields);
+void Halo::exchange(const std::vector<double*>& fields, bool x_filled) const {
+  if (!x_filled || dims_[0] != 1) exchange_direction(0, fields);
   exchange_direction(1, fields);
 }
 

@@ -56,7 +56,8 @@ class Halo {
   /// field: x first, then y including the x ghosts, so that corner ghosts hold the diagonal
   /// neighbour's cells, as the serial periodic copy does. A direction with one rank copies
   /// locally; otherwise non-blocking messages to and from both neighbours.
-  void exchange(const std::vector<double*>& fields) const;
+  /// `x_filled`: the caller has filled the x ghosts itself (one rank along x only).
+  void exchange(const std::vector<double*>& fields, bool x_filled = false) const;
 
   double sum(double local) const;
   double max(double local) const;

@@ -131,6 +131,14 @@ class Operator {
   void evaluate_closure(const State& U, bool need_transport);
   void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp
   void copy_closure_to_ghosts();                                             // boundary.cpp
+  /// The fields whose ghosts are filled: the primitives, then the closure values the fluxes
+  /// read beside a cell (boundary.cpp).
+  std::array<std::vector<double>*, variable_count + 6> ghosted_fields();
+  /// Whether x is periodic within this process (no halo, or one rank along x), so that the
+  /// closure's row loop fills each row's x ghosts while the row is in cache.
+  bool x_ghosts_by_rows() const;
+  /// Copies row `first`'s periodic x ghosts of the ghosted fields (its interior cells filled).
+  void copy_row_to_x_ghosts(std::ptrdiff_t first);                          // boundary.cpp
   /// The faces of planes k0 .. k1 - 1 (along z: faces k0 .. k1 - 1, and nz with the last).
   void add_inviscid_fluxes(State& dUdt, int k0, int k1);                     // riemann.cpp
   void add_diffusive_fluxes(State& dUdt, int k0, int k1);                    // viscous_flux.cpp

@@ -161,7 +161,9 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
     cl.kappa[c] = r.kappa;
     cl.loss[c] = r.loss;
   };
-  // One contiguous run of interior cells (ghosts copy theirs afterwards): the primitives
+  const bool x_by_rows = x_ghosts_by_rows();
+  // One contiguous run of interior cells (its x ghosts, where x is periodic in this process,
+  // copied while the row is in cache; the other ghosts afterwards): the primitives
   // (what to_primitive computes, as one vectorisable loop), then the closure lane group by
   // lane group.
   const int length = g.row_length();
@@ -234,6 +236,7 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
       for (int l = 0; l < lanes; ++l)
         store(c + l, CellClosure<double>{r.p.v[l], r.c.v[l], r.mu.v[l], r.lambda.v[l], r.kappa.v[l], r.loss.v[l]});
     }
+    if (x_by_rows) copy_row_to_x_ghosts(first);
   };
   const int rows = g.interior_rows();
   if (g.threaded()) {
