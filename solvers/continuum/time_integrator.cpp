@@ -18,22 +18,66 @@ TimeIntegrator::TimeIntegrator(const Grid& grid, const PhysicsSettings& physics,
 }
 
 namespace {
-/// Calls run(first, length, v) for every variable v of every contiguous run of interior cells
-/// (a whole 1D column, or one x row in 3D), threaded on large grids.
-template <class Run> void for_interior_runs(const Grid& g, Run run) {
-  const int length = g.row_length();
-  const auto row_of_every_variable = [&](int row) {
-    for (int v = 0; v < variable_count; ++v) run(g.row_start(row), length, v);
-  };
+/// Whether body(row) is true for some contiguous run of interior cells (a whole 1D column, or
+/// one x row in 3D); body is called for every row, threaded on large grids.
+template <class Body> bool any_interior_row(const Grid& g, Body body) {
   const int rows = g.interior_rows();
+  bool any = false;
   if (g.threaded()) {
-#pragma omp parallel for schedule(dynamic, 2 * g.ny)
-    for (int row = 0; row < rows; ++row) row_of_every_variable(row);
+#pragma omp parallel for schedule(dynamic, 2 * g.ny) reduction(|| : any)
+    for (int row = 0; row < rows; ++row) any = body(row) || any;
   } else {
-    for (int row = 0; row < rows; ++row) row_of_every_variable(row);
+    for (int row = 0; row < rows; ++row) any = body(row) || any;
   }
+  return any;
+}
+
+/// Calls run(first, length, v) for every variable v of every contiguous run of interior cells.
+template <class Run> void for_interior_runs(const Grid& g, Run run) {
+  any_interior_row(g, [&](int row) {
+    for (int v = 0; v < variable_count; ++v) run(g.row_start(row), g.row_length(), v);
+    return false;
+  });
+}
+
+/// Whether some cell of the row is outside the model's domain or below the temperature floor:
+/// one branch-free scan (which vectorises); admissible_here looks closer only then.
+bool row_suspect(const Grid& g, const State& s, int row, double floor) {
+  const double* N = s.q[density].data();
+  const double* Mx = s.q[momentum_x].data();
+  const double* My = s.q[momentum_y].data();
+  const double* Mz = s.q[momentum_z].data();
+  const double* E = s.q[energy].data();
+  const std::ptrdiff_t first = g.row_start(row);
+  bool any = false;
+  for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) {
+    const double n = N[c];
+    const double kinetic = 0.5 * (Mx[c] * Mx[c] + My[c] * My[c] + Mz[c] * Mz[c]) / n;
+    // NaN and infinities fail the comparisons: a non-finite n, E or momentum makes the cell
+    // suspect through n or through E - kinetic.
+    const bool fine = n > 0.0 && volume_fraction(n) < nu_max && E[c] - kinetic >= 1.5 * n * floor &&
+                      E[c] - kinetic < std::numeric_limits<double>::infinity();
+    any = any || !fine;
+  }
+  return any;
 }
 }  // namespace
+
+bool TimeIntegrator::axpy_and_scan(State& out, double a, const State& x, double b, const State& y,
+                                   double c, const State& k) const {
+  const Grid& g = op_.grid();
+  return any_interior_row(g, [&](int row) {
+    const std::ptrdiff_t first = g.row_start(row);
+    for (int v = 0; v < variable_count; ++v) {
+      const double* X = x.q[v].data() + first;
+      const double* Y = y.q[v].data() + first;
+      const double* Kv = k.q[v].data() + first;
+      double* O = out.q[v].data() + first;
+      for (int i = 0; i < g.row_length(); ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
+    }
+    return row_suspect(g, out, row, settings_.temperature_floor);
+  });
+}
 
 void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y,
                           double c, const State& k) const {
@@ -76,12 +120,12 @@ double TimeIntegrator::total_energy() const {
   return interior_energy_sum(op_.grid(), U_) * op_.grid().h / op_.plate_columns();
 }
 
-bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double* added) {
+bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double* added, const bool* scanned) {
   const Halo* halo = op_.halo();
-  if (!halo) return admissible_here(s, t, failure, added);
+  if (!halo) return admissible_here(s, t, failure, added, scanned);
   const std::int64_t floors_before = counters_.temperature_floor_uses;
   std::int64_t failing_cell = 0;
-  const bool here = admissible_here(s, t, failure, added, &failing_cell);
+  const bool here = admissible_here(s, t, failure, added, scanned, &failing_cell);
   // Every rank must take the same branch (retry or go on), and name the cell a plain run
   // names: the first failing one in the box's storage order.
   std::string first_failure = here ? std::string() : failure;
@@ -92,7 +136,7 @@ bool TimeIntegrator::admissible(State& s, double t, std::string& failure, double
 }
 
 bool TimeIntegrator::admissible_here(State& s, double t, std::string& failure, double* added,
-                                     std::int64_t* failing_cell) {
+                                     const bool* scanned, std::int64_t* failing_cell) {
   const Grid& g = op_.grid();
   const double floor = settings_.temperature_floor;
   std::int64_t floors = 0;
@@ -102,29 +146,9 @@ bool TimeIntegrator::admissible_here(State& s, double t, std::string& failure, d
   double* My = s.q[momentum_y].data();
   double* Mz = s.q[momentum_z].data();
   double* E = s.q[energy].data();
-  // Almost always every cell is admissible and above the floor: one branch-free scan (which
-  // vectorises) establishes that, and only otherwise the cell-by-cell pass below runs.
-  const auto row_suspect = [&](int row) {
-    const std::ptrdiff_t first = g.row_start(row);
-    bool any = false;
-    for (std::ptrdiff_t c = first; c < first + g.row_length(); ++c) {
-      const double n = N[c];
-      const double kinetic = 0.5 * (Mx[c] * Mx[c] + My[c] * My[c] + Mz[c] * Mz[c]) / n;
-      // NaN and infinities fail the comparisons: a non-finite n, E or momentum makes the cell
-      // suspect through n or through E - kinetic.
-      const bool fine = n > 0.0 && volume_fraction(n) < nu_max && E[c] - kinetic >= 1.5 * n * floor &&
-                        E[c] - kinetic < std::numeric_limits<double>::infinity();
-      any = any || !fine;
-    }
-    return any;
-  };
-  bool suspect = false;
-  if (g.threaded()) {
-#pragma omp parallel for schedule(static) reduction(|| : suspect)
-    for (int row = 0; row < g.interior_rows(); ++row) suspect = row_suspect(row) || suspect;
-  } else {
-    for (int row = 0; row < g.interior_rows(); ++row) suspect = row_suspect(row) || suspect;
-  }
+  // Almost always every cell is admissible and above the floor: one scan establishes that
+  // (unless the caller's axpy_and_scan did), and only otherwise the cell-by-cell pass below runs.
+  const bool suspect = scanned ? *scanned : any_interior_row(g, [&](int row) { return row_suspect(g, s, row, floor); });
   if (!suspect) {
     if (added) *added = 0.0;
     return true;
@@ -214,8 +238,8 @@ bool TimeIntegrator::ssp_rk_second_order(double dt, Part part, std::string& fail
   for (int stage = 1; stage < s; ++stage) {
     State& Y = stage % 2 == 1 ? U1_ : U2_;
     double floor = 0.0;
-    axpy(Y, 1.0, *previous, 0.0, *previous, h, *slope);
-    if (!admissible(Y, t_ + stage * h, failure, &floor)) return false;
+    const bool suspect = axpy_and_scan(Y, 1.0, *previous, 0.0, *previous, h, *slope);
+    if (!admissible(Y, t_ + stage * h, failure, &floor, &suspect)) return false;
     floors += carried * floor;
     op_.rhs(t_ + stage * h, Y, K_, part);
     book(dt, 1.0 / s, op_.source_power());
@@ -223,8 +247,8 @@ bool TimeIntegrator::ssp_rk_second_order(double dt, Part part, std::string& fail
     slope = &K_;
   }
   double floor_end = 0.0;
-  axpy(U_, 1.0 / s, U0_, carried, *previous, carried * h, K_);
-  if (!admissible(U_, t_ + dt, failure, &floor_end)) return false;
+  const bool suspect = axpy_and_scan(U_, 1.0 / s, U0_, carried, *previous, carried * h, K_);
+  if (!admissible(U_, t_ + dt, failure, &floor_end, &suspect)) return false;
   pending_.floor_energy += floors + floor_end;
   return true;
 }

@@ -101,14 +101,19 @@ class TimeIntegrator {
   bool implicit_extrapolated(double dt, std::string& failure);
   /// Adds weight * dt times the source power of one stage to the pending budget.
   void book(double dt, double weight, const Operator::SourcePower& p);
-  /// `added` (if given) receives the energy per unit plate area the temperature floor added.
-  bool admissible(State& s, double t, std::string& failure, double* added = nullptr);
+  /// `added` (if given) receives the energy per unit plate area the temperature floor added;
+  /// `scanned` (if given) is axpy_and_scan's result for s, which spares the scan.
+  bool admissible(State& s, double t, std::string& failure, double* added = nullptr,
+                  const bool* scanned = nullptr);
   /// admissible on this rank's cells; `failing_cell` (if given) receives a failing cell's place
   /// in the box's storage order.
-  bool admissible_here(State& s, double t, std::string& failure, double* added,
+  bool admissible_here(State& s, double t, std::string& failure, double* added, const bool* scanned,
                        std::int64_t* failing_cell = nullptr);
   void axpy(State& out, double a, const State& x, double b, const State& y, double c,
             const State& k) const;  ///< out = a x + b y + c k on interior cells
+  /// axpy, and whether some cell of `out` needs admissible's closer look, in one pass.
+  bool axpy_and_scan(State& out, double a, const State& x, double b, const State& y, double c,
+                     const State& k) const;
   /// out = (a x + b y + c k) + d z + e m on interior cells: bit for bit the first axpy, then
   /// axpy(out, 1, out, d, z, e, m), in one pass.
   void axpy(State& out, double a, const State& x, double b, const State& y, double c, const State& k,
