@@ -36,7 +36,9 @@ void Operator::rhs(double t, const State& U, State& dUdt, Part part) {
   // so the sums are the same bit for bit. Only the interior planes are zeroed: nothing writes
   // or reads the z ghosts of a right-hand side.
   const bool inviscid = part != Part::diffusive && terms.advection;
-  const int nz = grid_.nz, slab = grid_.dimension == 3 ? slab_planes : nz;
+  // (A threaded box goes whole: a parallel region per sweep and slab would cost more than
+  // the cache saves.)
+  const int nz = grid_.nz, slab = grid_.dimension == 3 && !grid_.threaded() ? slab_planes : nz;
   const std::ptrdiff_t plane = grid_.stride_z(), first = plane * Grid::ghosts;  // plane 0, x and y ghosts too
   for (int k0 = 0; k0 < nz + slab; k0 += slab) {
     if (k0 < nz) {
