@@ -11,7 +11,22 @@
 #include "common/errors.hpp"
 #include "continuum/halo.hpp"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace shaker::continuum {
+
+namespace {
+/// The threads an OpenMP region of this process runs on (1 without OpenMP).
+int threads() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+}  // namespace
 
 Operator::Operator(const Grid& grid, const PhysicsSettings& settings, std::shared_ptr<const Halo> halo)
     : grid_(grid), settings_(settings), halo_(std::move(halo)) {
@@ -36,9 +51,10 @@ void Operator::rhs(double t, const State& U, State& dUdt, Part part) {
   // so the sums are the same bit for bit. Only the interior planes are zeroed: nothing writes
   // or reads the z ghosts of a right-hand side.
   const bool inviscid = part != Part::diffusive && terms.advection;
-  // (A threaded box goes whole: a parallel region per sweep and slab would cost more than
-  // the cache saves.)
-  const int nz = grid_.nz, slab = grid_.dimension == 3 && !grid_.threaded() ? slab_planes : nz;
+  // (A box shared by several threads goes whole: a parallel region per sweep and slab would
+  // cost more than the cache saves.)
+  const bool shared = grid_.threaded() && threads() > 1;
+  const int nz = grid_.nz, slab = grid_.dimension == 3 && !shared ? slab_planes : nz;
   const std::ptrdiff_t plane = grid_.stride_z(), first = plane * Grid::ghosts;  // plane 0, x and y ghosts too
   for (int k0 = 0; k0 < nz + slab; k0 += slab) {
     if (k0 < nz) {
