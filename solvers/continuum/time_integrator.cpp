@@ -61,20 +61,23 @@ bool row_suspect(const Grid& g, const State& s, int row, double floor) {
   }
   return any;
 }
+
+/// out = a x + b y + c k for variable v on the run of `length` cells from `first`.
+void combine_run(State& out, double a, const State& x, double b, const State& y, double c, const State& k,
+                 std::ptrdiff_t first, int length, int v) {
+  const double* X = x.q[v].data() + first;
+  const double* Y = y.q[v].data() + first;
+  const double* Kv = k.q[v].data() + first;
+  double* O = out.q[v].data() + first;
+  for (int i = 0; i < length; ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
+}
 }  // namespace
 
 bool TimeIntegrator::axpy_and_scan(State& out, double a, const State& x, double b, const State& y,
                                    double c, const State& k) const {
   const Grid& g = op_.grid();
   return any_interior_row(g, [&](int row) {
-    const std::ptrdiff_t first = g.row_start(row);
-    for (int v = 0; v < variable_count; ++v) {
-      const double* X = x.q[v].data() + first;
-      const double* Y = y.q[v].data() + first;
-      const double* Kv = k.q[v].data() + first;
-      double* O = out.q[v].data() + first;
-      for (int i = 0; i < g.row_length(); ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
-    }
+    for (int v = 0; v < variable_count; ++v) combine_run(out, a, x, b, y, c, k, g.row_start(row), g.row_length(), v);
     return row_suspect(g, out, row, settings_.temperature_floor);
   });
 }
@@ -82,11 +85,7 @@ bool TimeIntegrator::axpy_and_scan(State& out, double a, const State& x, double 
 void TimeIntegrator::axpy(State& out, double a, const State& x, double b, const State& y,
                           double c, const State& k) const {
   for_interior_runs(op_.grid(), [&](std::ptrdiff_t first, int length, int v) {
-    const double* X = x.q[v].data() + first;
-    const double* Y = y.q[v].data() + first;
-    const double* Kv = k.q[v].data() + first;
-    double* O = out.q[v].data() + first;
-    for (int i = 0; i < length; ++i) O[i] = a * X[i] + b * Y[i] + c * Kv[i];
+    combine_run(out, a, x, b, y, c, k, first, length, v);
   });
 }
 
