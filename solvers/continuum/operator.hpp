@@ -71,6 +71,18 @@ enum class Part { all, hyperbolic_and_sources, diffusive };
 
 class Halo;  // halo.hpp
 
+/// The part of a flux sweep along direction d that belongs to planes k0 .. k1 - 1. A sweep's
+/// pencils run along d, indexed (a, b) across it, b being the plane for x and y and the row
+/// for z; faces 0 .. length along each pencil. Along x and y: the pencils of those planes, every
+/// face; along z: every pencil, faces k0 .. k1 - 1 (the top face nz too with the last plane).
+struct SlabSweep {
+  int b_first, b_count, f_begin, f_end;
+};
+inline SlabSweep slab_sweep(const Grid& g, int d, int k0, int k1) {
+  if (d == 2) return {0, g.ny, k0, k1 < g.nz ? k1 : g.nz + 1};
+  return {k0, k1 - k0, 0, (d == 0 ? g.nx : g.ny) + 1};
+}
+
 class Operator {
  public:
   /// Planes of a slab: a 3D box's fluxes are added a slab at a time (rhs). Eight planes of

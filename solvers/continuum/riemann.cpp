@@ -15,17 +15,18 @@ namespace shaker::continuum {
 
 namespace {
 
-/// The cells of one direction as pencils: base index of each pencil and the step along it.
+/// The cells of one direction as pencils (a, b), `length` cells each, count_a across a row
+/// (the b of a slab: slab_sweep); base index of each pencil.
 struct Pencils {
-  int count_a, count_b, length;  ///< pencils = count_a x count_b, `length` cells each
+  int count_a, length;
   std::ptrdiff_t base(const Grid& g, int d, int a, int b) const {
     return d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
   }
 };
 Pencils pencils_of(const Grid& g, int d) {
-  if (d == 0) return {g.ny, g.nz, g.nx};
-  if (d == 1) return {g.nx, g.nz, g.ny};
-  return {g.nx, g.ny, g.nz};
+  if (d == 0) return {g.ny, g.nx};
+  if (d == 1) return {g.nx, g.ny};
+  return {g.nx, g.nz};
 }
 
 /// Slots (cells x pencils) of a block: its face states (2 x 7 x slots doubles) stay in L1/L2.
@@ -86,8 +87,7 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     store_lanes(&minus[un][q], keep ? u0 - 0.5 * du : u0 - half_u);
     store_lanes(&minus[4][q], keep ? p_minus : p0 - half_p);
   };
-  // The faces of direction d that belong to planes k0 .. k1 - 1: along x and y every face of
-  // those planes, along z the faces k0 .. k1 - 1 (the top face nz too with the last plane).
+  // The faces of direction d that belong to planes k0 .. k1 - 1 (slab_sweep).
   const auto sweep = [&](int d) {
     const std::ptrdiff_t s = g.stride(d);
     const int un_index = 1 + d;
@@ -256,18 +256,17 @@ void inviscid_fluxes(const Grid& g, const std::array<std::vector<double>, variab
     // same cache line.
     const bool across = s != 1;
     const int runs_per_row = across ? (P.count_a + max_lanes - 1) / max_lanes : P.count_a;
-    const bool along_z = d == 2;  // pencils b are the planes for x and y, the rows of y for z
-    const int b_first = along_z ? 0 : k0, groups = runs_per_row * (along_z ? P.count_b : k1 - k0);
-    const int f_begin = along_z ? k0 : 0, f_end = along_z && k1 < g.nz ? k1 : P.length + 1;
+    const SlabSweep part = slab_sweep(g, d, k0, k1);
+    const int groups = runs_per_row * part.b_count;
 #pragma omp parallel for schedule(dynamic, runs_per_row) if (g.threaded())
     for (int group = 0; group < groups; ++group) {
-      const int run = group % runs_per_row, b = b_first + group / runs_per_row;
+      const int run = group % runs_per_row, b = part.b_first + group / runs_per_row;
       const int a = across ? run * P.count_a / runs_per_row : run;
       const int W = across ? (run + 1) * P.count_a / runs_per_row - a : 1;
       const std::ptrdiff_t base = P.base(g, d, a, b);
       const int faces_per_block = block_slots / W - 1;
-      for (int f0 = f_begin; f0 < f_end; f0 += faces_per_block)
-        block(W, base, f0, std::min(f0 + faces_per_block, f_end));
+      for (int f0 = part.f_begin; f0 < part.f_end; f0 += faces_per_block)
+        block(W, base, f0, std::min(f0 + faces_per_block, part.f_end));
     }
   };
   for (int d = g.first_direction(); d < 3; ++d) sweep(d);

@@ -115,8 +115,7 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
 namespace {
 /// The faces normal to direction d (a template parameter: the gradient's index logic is
 /// resolved at compile time).
-/// Faces of the planes k0 .. k1 - 1 as in riemann.cpp: along x and y every face of those
-/// planes, along z the faces k0 .. k1 - 1 (the top face nz too with the last plane).
+/// Faces of the planes k0 .. k1 - 1 (slab_sweep).
 template <int d>
 void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
                             const Operator::Closure& closure, WallStress wall_stress, State& dUdt,
@@ -130,7 +129,7 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
   const double* kappa = closure.kappa.data();
   const std::ptrdiff_t strides[3] = {g.stride(0), g.stride(1), g.stride(2)};
   const std::ptrdiff_t s = strides[d];
-  const int n_a = d == 0 ? g.ny : g.nx, n_b = d == 2 ? g.ny : g.nz;
+  const int n_a = d == 0 ? g.ny : g.nx;
   const int length = d == 0 ? g.nx : d == 1 ? g.ny : g.nz;
   const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
   // The face whose high-side cell is cR (S = double), or the faces of cells cR, cR + 1, ...
@@ -199,16 +198,16 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
   constexpr int width = lanes_of<Wide>;
   const bool across = d != 0;
   const int per_row = across ? (n_a + width - 1) / width : n_a;
-  const int b_first = d == 2 ? 0 : k0, groups = per_row * (d == 2 ? n_b : k1 - k0);
-  const int f_begin = d == 2 ? k0 : 0, f_end = d == 2 && k1 < g.nz ? k1 : length + 1;
+  const SlabSweep part = slab_sweep(g, d, k0, k1);
+  const int groups = per_row * part.b_count;
 #pragma omp parallel for schedule(dynamic, per_row) if (g.threaded())
   for (int group = 0; group < groups; ++group) {
-    const int a = across ? width * (group % per_row) : group % per_row, b = b_first + group / per_row;
+    const int a = across ? width * (group % per_row) : group % per_row, b = part.b_first + group / per_row;
     const std::ptrdiff_t base = d == 0 ? g.index(0, a, b) : d == 1 ? g.index(a, 0, b) : g.index(a, b, 0);
     if (across) {
       const int pencils = std::min(width, n_a - a);
       const auto wall_face = [&](int f) { return walls && (f == 0 || f == length); };
-      for (int f = f_begin; f < f_end; ++f)
+      for (int f = part.f_begin; f < part.f_end; ++f)
         for_lanes(pencils, [&](int l, auto lanes) { face(base + f * s + l, f < length, f > 0, wall_face(f), lanes); });
       continue;
     }
