@@ -53,7 +53,7 @@ class Stopwatch {
 
 }  // namespace
 
-Halo::Halo(const Grid& box, int ranks) : box_(box), local_(box) {
+Halo::Halo(const Grid& box, int ranks, HaloTransport transport) : box_(box), local_(box) {
   std::tie(dims_[0], dims_[1]) = layout(ranks);
   const int fewest_x = box.nx / dims_[0], fewest_y = box.ny / dims_[1];
   if (fewest_x < min_cells_per_rank || fewest_y < min_cells_per_rank)
@@ -74,6 +74,59 @@ Halo::Halo(const Grid& box, int ranks) : box_(box), local_(box) {
   block_ = block_of(rank_);
   local_.nx = block_.nx;
   local_.ny = block_.ny;
+  if (transport == HaloTransport::automatic && size_ > 1) share_memory_with_neighbours();
+}
+
+namespace {
+/// Doubles in one ghost layer set (Grid::ghosts deep) of a block along direction d.
+std::size_t layer_size(const Grid& box, const Block& b, int d) {
+  return static_cast<std::size_t>(Grid::ghosts) * box.nz * (d == 0 ? b.ny : b.nx + 2 * Grid::ghosts);
+}
+/// The most fields one exchange sends through the window (the operator's ghosted fields).
+constexpr std::size_t shared_fields = variable_count + 6;
+}  // namespace
+
+void Halo::share_memory_with_neighbours() {
+  MPI_Comm_split_type(cartesian_, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &machine_);
+  MPI_Group everyone, machine;
+  MPI_Comm_group(cartesian_, &everyone);
+  MPI_Comm_group(machine_, &machine);
+  int neighbours[2][2], on_machine[2][2];
+  for (int d = 0; d < 2; ++d) {
+    neighbours[d][0] = low_[d];
+    neighbours[d][1] = high_[d];
+  }
+  MPI_Group_translate_ranks(everyone, 4, &neighbours[0][0], machine, &on_machine[0][0]);
+  MPI_Group_free(&everyone);
+  MPI_Group_free(&machine);
+  int local = 1;
+  for (int d = 0; d < 2; ++d)
+    for (int side = 0; side < 2; ++side) local = local && (dims_[d] == 1 || on_machine[d][side] != MPI_UNDEFINED);
+  int everywhere = 0;
+  MPI_Allreduce(&local, &everywhere, 1, MPI_INT, MPI_LAND, cartesian_);
+  if (!everywhere) {
+    MPI_Comm_free(&machine_);
+    return;
+  }
+  std::size_t total = 0;
+  for (int d = 0; d < 2; ++d) {
+    if (dims_[d] == 1) continue;
+    for (int r = 0; r < size_; ++r) capacity_[d] = std::max(capacity_[d], shared_fields * layer_size(box_, block_of(r), d));
+    offset_[d] = total;
+    total += 4 * capacity_[d];
+  }
+  MPI_Win_allocate_shared(static_cast<MPI_Aint>(total * sizeof(double)), sizeof(double), MPI_INFO_NULL, machine_,
+                          &mine_, &window_);
+  MPI_Win_lock_all(MPI_MODE_NOCHECK, window_);
+  for (int d = 0; d < 2; ++d)
+    for (int side = 0; side < 2; ++side) {
+      if (dims_[d] == 1) continue;
+      MPI_Aint size = 0;
+      int unit = 0;
+      double* base = nullptr;
+      MPI_Win_shared_query(window_, on_machine[d][side], &size, &unit, &base);
+      peers_[d][side] = base;
+    }
 }
 
 std::pair<int, int> Halo::layout(int ranks) {
@@ -85,7 +138,13 @@ std::pair<int, int> Halo::layout(int ranks) {
 Halo::~Halo() {
   int finalized = 0;
   MPI_Finalized(&finalized);
-  if (cartesian_ != MPI_COMM_NULL && !finalized) MPI_Comm_free(&cartesian_);
+  if (finalized) return;
+  if (window_ != MPI_WIN_NULL) {
+    MPI_Win_unlock_all(window_);
+    MPI_Win_free(&window_);
+  }
+  if (machine_ != MPI_COMM_NULL) MPI_Comm_free(&machine_);
+  if (cartesian_ != MPI_COMM_NULL) MPI_Comm_free(&cartesian_);
 }
 
 Block Halo::block_of(int rank) const {
@@ -113,6 +172,7 @@ void Halo::exchange_direction(int d, const std::vector<double*>& fields) const {
     }
     return;
   }
+  if (window_ != MPI_WIN_NULL && fields.size() <= shared_fields) return exchange_shared(d, fields);
   const std::size_t layer = static_cast<std::size_t>(G) * g.nz * (d == 0 ? g.ny : g.nx + 2 * G);
   const std::size_t count = layer * fields.size();
   for (auto* buffer : {&send_low_, &send_high_, &receive_low_, &receive_high_}) buffer->resize(count);
@@ -141,6 +201,39 @@ void Halo::exchange_direction(int d, const std::vector<double*>& fields) const {
   }
   unpack(-G, receive_low_);
   unpack(n, receive_high_);
+}
+
+void Halo::exchange_shared(int d, const std::vector<double*>& fields) const {
+  const Grid& g = local_;
+  const int G = Grid::ghosts;
+  const int n = d == 0 ? g.nx : g.ny;
+  // Generation `parity` of side s (0: the layers for the low neighbour, 1: for the high one).
+  const std::size_t parity = generation_[d]++ % 2;
+  const auto part = [&](auto* base, int s) { return base + offset_[d] + (2 * parity + s) * capacity_[d]; };
+  const auto pack = [&](int first, double* to) {
+    for (const double* field : fields) for_layer(g, d, first, [&](std::ptrdiff_t c) { *to++ = field[c]; });
+  };
+  const auto unpack = [&](int first, const double* from) {
+    for (double* field : fields) for_layer(g, d, first, [&](std::ptrdiff_t c) { field[c] = *from++; });
+  };
+  pack(0, part(mine_, 0));
+  pack(n - G, part(mine_, 1));
+  {
+    // Each rank tells both neighbours that its layers are in place, and waits for theirs.
+    // A generation is rewritten two exchanges later, after the neighbours have said, by
+    // their notification of the exchange in between, that they have read it.
+    const Stopwatch timed(communication_seconds_);
+    MPI_Win_sync(window_);
+    MPI_Request requests[4];
+    MPI_Irecv(nullptr, 0, MPI_BYTE, low_[d], tag_upwards, cartesian_, &requests[0]);
+    MPI_Irecv(nullptr, 0, MPI_BYTE, high_[d], tag_downwards, cartesian_, &requests[1]);
+    MPI_Isend(nullptr, 0, MPI_BYTE, low_[d], tag_downwards, cartesian_, &requests[2]);
+    MPI_Isend(nullptr, 0, MPI_BYTE, high_[d], tag_upwards, cartesian_, &requests[3]);
+    MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
+    MPI_Win_sync(window_);
+  }
+  unpack(-G, part(peers_[d][0], 1));  // the low neighbour's layers for its high neighbour
+  unpack(n, part(peers_[d][1], 0));
 }
 
 double Halo::sum(double local) const {

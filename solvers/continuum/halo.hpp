@@ -23,6 +23,12 @@ struct Block {
   int i0 = 0, j0 = 0, nx = 0, ny = 0;
 };
 
+/// How ghost layers travel between ranks. `automatic`: through a window of shared memory
+/// (MPI_Win_allocate_shared) when every rank's neighbours are on its own machine, which
+/// spares the messages' copies in the kernel; otherwise, and with `messages`, non-blocking
+/// messages.
+enum class HaloTransport { automatic, messages };
+
 class Halo {
  public:
   /// Fewest cells a rank may own in x or in y: the reconstruction reads two ghost layers, all
@@ -32,7 +38,7 @@ class Halo {
   /// The decomposition of `box` over every rank of the launch (collective). Throws InputError,
   /// naming the sizes and the allowed range, when a rank would own fewer than
   /// min_cells_per_rank cells in x or in y; every rank decides alike.
-  Halo(const Grid& box, int ranks);
+  Halo(const Grid& box, int ranks, HaloTransport transport = HaloTransport::automatic);
   /// Ranks along x and y for `ranks` in all: MPI_Dims_create's as square a split as `ranks`
   /// allows, with the larger count along y (px <= py), so that the x rows, the contiguous
   /// direction in storage, are cut least: longer runs for the x sweeps, and the ghost layers
@@ -49,6 +55,10 @@ class Halo {
   int size() const { return size_; }
   bool root() const { return rank_ == 0; }
   int ranks_along(int direction) const { return dims_[direction]; }
+  /// Whether ghost layers go through shared memory (HaloTransport).
+  bool shares_memory() const { return window_ != MPI_WIN_NULL; }
+  /// Bytes of this rank's part of the shared window (0 with messages).
+  double shared_bytes() const { return static_cast<double>(4 * (capacity_[0] + capacity_[1]) * sizeof(double)); }
   /// Columns of the whole box: amounts per unit plate area divide by them.
   double plate_columns() const { return static_cast<double>(box_.nx) * box_.ny; }
 
@@ -87,6 +97,12 @@ class Halo {
 
  private:
   void exchange_direction(int direction, const std::vector<double*>& fields) const;
+  /// The same through the shared-memory window: each rank packs its edge layers into its own
+  /// part of the window, and its neighbours unpack them from there after a notification.
+  void exchange_shared(int direction, const std::vector<double*>& fields) const;
+  /// Allocates the window on the ranks of this machine when every neighbour of every rank is
+  /// on its machine (collective); otherwise messages.
+  void share_memory_with_neighbours();
   Block block_of(int rank) const;
 
   /// Every rank's share of the box for gather and scatter, counted in columns of all
@@ -113,6 +129,16 @@ class Halo {
   int coords_[2] = {0, 0};
   int low_[2] = {0, 0}, high_[2] = {0, 0};  ///< neighbour ranks in x and y
   mutable std::vector<double> send_low_, send_high_, receive_low_, receive_high_;
+  /// The shared window (none: messages). A rank's part holds, per direction d, two
+  /// generations x two sides (the layers for the low and the high neighbour) of
+  /// capacity_[d] doubles from offset_[d]; peers_[d][side] is where the low (0) or high (1)
+  /// neighbour's part starts. Successive exchanges along d alternate generations.
+  MPI_Comm machine_ = MPI_COMM_NULL;
+  MPI_Win window_ = MPI_WIN_NULL;
+  std::size_t capacity_[2] = {0, 0}, offset_[2] = {0, 0};
+  double* mine_ = nullptr;
+  const double* peers_[2][2] = {{nullptr, nullptr}, {nullptr, nullptr}};
+  mutable std::uint64_t generation_[2] = {0, 0};
   mutable double communication_seconds_ = 0.0;
 };
 

@@ -272,8 +272,9 @@ std::shared_ptr<const Halo> decomposition(const Grid& grid) {
 
 /// The run's memory on this machine, checked before anything is allocated (InputError on every
 /// rank alike). Each process holds the solver's working set of its cells (its block under a
-/// launcher); the writer also the field snapshots and, decomposed, the gathered box. The ranks
-/// sharing a machine share its MemAvailable, so their needs add up.
+/// launcher) and its part of the halo's shared window; the writer also the field snapshots
+/// and, decomposed, the gathered box. The ranks sharing a machine share its MemAvailable, so
+/// their needs add up.
 void check_memory_of_run(const ContinuumCase& c, const Halo* halo) {
   const Grid& g = c.grid;
   const double box_cells = static_cast<double>(g.nx) * g.ny * g.nz;
@@ -281,7 +282,8 @@ void check_memory_of_run(const ContinuumCase& c, const Halo* halo) {
   constexpr double stored_bytes_per_cell = variable_count * sizeof(double);
   const double copies = (halo ? 1.0 : 0.0) + static_cast<double>(c.field_phases.size());
   const bool writer = !halo || halo->root();
-  const double mine = own_cells * solver_bytes_per_cell + (writer ? copies * box_cells * stored_bytes_per_cell : 0.0);
+  const double mine = own_cells * solver_bytes_per_cell + (halo ? halo->shared_bytes() : 0.0) +
+                      (writer ? copies * box_cells * stored_bytes_per_cell : 0.0);
   const auto [machine, ranks_here] = halo ? halo->sum_on_machine(mine) : std::pair<double, int>{mine, 1};
   const std::string grid = fmt::format(
       "a {}D grid of {:.3g} cells (continuum.cell_size = {}, continuum.ceiling = {}{})", g.dimension,

@@ -39,16 +39,21 @@ continuum::ContinuumCase base_case(int dimension, double h, const char* transpor
 template <class MakeSolver>
 void time_cycles(benchmark::State& state, const continuum::ContinuumCase& c, MakeSolver make,
                  double t_end, double cycles) {
-  double seconds = 0, steps = 0, cpu_seconds = 0, rejected = 0;
+  double seconds = 0, steps = 0, cpu_seconds = 0, rejected = 0, communication = 0;
+  bool decomposed = false;
   for (auto _ : state) {
     state.PauseTiming();
     continuum::TimeIntegrator solver = make();
     state.ResumeTiming();
+    const continuum::Halo* halo = solver.op().halo();
+    decomposed = halo != nullptr;
+    const double communicated = halo ? halo->communication_seconds() : 0.0;
     const auto start = std::chrono::steady_clock::now();
     const std::clock_t cpu_start = std::clock();
     solver.advance_to(t_end);
     cpu_seconds += static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    communication += halo ? halo->communication_seconds() - communicated : 0.0;
     steps += static_cast<double>(solver.counters().steps);
     rejected += static_cast<double>(solver.counters().rejected_steps);
   }
@@ -61,6 +66,8 @@ void time_cycles(benchmark::State& state, const continuum::ContinuumCase& c, Mak
   state.counters["cells"] = cells;
   // The machine is shared: process CPU seconds per cycle compare across runs under load.
   state.counters["cpu_seconds_per_cycle"] = cpu_seconds * per_cycle;
+  // Rank 0's time in messages and reductions, waiting for the other ranks included.
+  if (decomposed) state.counters["communication_fraction"] = communication / seconds;
 }
 
 /// The first `fraction` of a cycle from the case's initial state (the flat layer at rest).
