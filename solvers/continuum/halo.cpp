@@ -115,8 +115,21 @@ void Halo::share_memory_with_neighbours() {
     offset_[d] = total;
     total += 4 * capacity_[d];
   }
-  MPI_Win_allocate_shared(static_cast<MPI_Aint>(total * sizeof(double)), sizeof(double), MPI_INFO_NULL, machine_,
-                          &mine_, &window_);
+  // An MPI without shared windows, or a machine whose shared memory (/dev/shm) is too small
+  // for them, leaves every rank with messages instead of ending the run.
+  MPI_Comm_set_errhandler(machine_, MPI_ERRORS_RETURN);
+  const bool allocated = MPI_Win_allocate_shared(static_cast<MPI_Aint>(total * sizeof(double)), sizeof(double),
+                                                 MPI_INFO_NULL, machine_, &mine_, &window_) == MPI_SUCCESS;
+  int everyone_allocated = 0, mine = allocated ? 1 : 0;
+  MPI_Allreduce(&mine, &everyone_allocated, 1, MPI_INT, MPI_LAND, cartesian_);
+  if (!everyone_allocated) {
+    if (allocated) MPI_Win_free(&window_);
+    window_ = MPI_WIN_NULL;
+    mine_ = nullptr;
+    capacity_[0] = capacity_[1] = 0;
+    MPI_Comm_free(&machine_);
+    return;
+  }
   MPI_Win_lock_all(MPI_MODE_NOCHECK, window_);
   for (int d = 0; d < 2; ++d)
     for (int side = 0; side < 2; ++side) {
