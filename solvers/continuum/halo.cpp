@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <limits>
 #include <tuple>
 
@@ -151,7 +152,10 @@ std::pair<int, int> Halo::layout(int ranks) {
 Halo::~Halo() {
   int finalized = 0;
   MPI_Finalized(&finalized);
-  if (finalized) return;
+  // Freeing a window or a communicator is collective: a rank unwinding from a failure of its
+  // own (the root's output, say) would wait there for ranks that never come, instead of
+  // reaching main's MPI_Abort. Left allocated, they end with the process.
+  if (finalized || std::uncaught_exceptions() > 0) return;
   if (window_ != MPI_WIN_NULL) {
     MPI_Win_unlock_all(window_);
     MPI_Win_free(&window_);

@@ -42,6 +42,11 @@
       the root writes the checkpoint and says so once, no run file is written, and the run
       continued from the checkpoint on 4 ranks ends in the straight run's final checkpoint, bit
       for bit but the budget.
+  check_continuum_ranks.py SHAKER root_failure [--mpirun CMD]
+      A failure of the root alone during a run on 2 ranks (its checkpoint's folder removed
+      after the first checkpoint, so that the next one cannot be written): the root says why
+      and every rank ends, exit 1 within a minute (no rank left waiting for the others, nor
+      the root for them), no run file written.
   check_continuum_ranks.py SHAKER refused [--mpirun CMD]
       A 1D column on 2 ranks, an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x), and a
       box too large for the machine's memory on 2 ranks (their blocks' needs added up, as both
@@ -60,9 +65,11 @@ import argparse
 import os
 import re
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
+import time
 
 import h5py
 import hdf5_contents
@@ -394,6 +401,45 @@ def check_signal(shaker, work, launcher):
     return failures
 
 
+def check_root_failure(shaker, work, launcher):
+    folder = os.path.join(work, "checkpoints")
+    os.mkdir(folder)
+    checkpoint = os.path.join(folder, "box.ckpt.h5")
+    words = mpirun_prefix(launcher, 2) + [
+        shaker, "continuum", "case.toml", "--set", "run.output=root_failure.h5",
+        "--set", "run.sampled_cycles=40", "--set", f"run.checkpoint={checkpoint}",
+        "--set", "run.checkpoint_every=1", "--quiet"]
+    process = subprocess.Popen(words, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, env=dict(os.environ, OMP_NUM_THREADS="1"),
+                               start_new_session=True)
+    failures = []
+    waited = time.monotonic()
+    while not os.path.exists(checkpoint) and process.poll() is None:
+        if time.monotonic() - waited > 120:
+            failures.append("no checkpoint after 120 s")
+            break
+        time.sleep(0.05)
+    shutil.rmtree(folder)
+    removed = time.monotonic()
+    try:
+        _, stderr = process.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        _, stderr = process.communicate()
+        return failures + [f"still running 60 s after the root's failure (a rank left waiting): "
+                           f"{stderr[-600:]}"]
+    if process.returncode != 1:
+        failures.append(f"exit {process.returncode}, expected 1: {stderr[-600:]}")
+    for needle in ("shaker: failed", "cannot write", "box.ckpt.h5"):
+        if needle not in stderr:
+            failures.append(f"the message lacks '{needle}': {stderr[-600:]}")
+    if os.path.exists(os.path.join(work, "root_failure.h5")):
+        failures.append("a run file was written")
+    print(f"root's checkpoint folder removed after the first checkpoint: exit "
+          f"{process.returncode} {time.monotonic() - removed:.1f} s later")
+    return failures
+
+
 def width_filling(share):
     """A box width (cell 0.5, ceiling 10: 20 cells high) whose solver working set, 600 bytes
     a cell, is `share` of this machine's MemAvailable: at 1.5 each of 2 ranks' halves fits,
@@ -434,7 +480,7 @@ def main():
     parser.add_argument("shaker")
     parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit",
                                           "implicit_wall_stress", "restart", "column", "failure",
-                                          "signal", "refused"])
+                                          "signal", "root_failure", "refused"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -461,6 +507,8 @@ def main():
         failures = check_failure(args.shaker, work, args.mpirun)
     elif args.check == "signal":
         failures = check_signal(args.shaker, work, args.mpirun)
+    elif args.check == "root_failure":
+        failures = check_root_failure(args.shaker, work, args.mpirun)
     else:
         failures = check_refused(args.shaker, work, args.mpirun)
     for failure in failures:
