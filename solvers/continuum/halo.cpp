@@ -37,6 +37,20 @@ template <class Visit> void for_layer(const Grid& g, int direction, int first, V
   }
 }
 
+/// Copies the layer starting at `first` along `direction` of every field, field after field,
+/// to `to` (pack) or from `from` (unpack): the order both ranks of a message share.
+void pack_layers(const Grid& g, int direction, int first, const std::vector<double*>& fields, double* to) {
+  for (const double* field : fields) for_layer(g, direction, first, [&](std::ptrdiff_t c) { *to++ = field[c]; });
+}
+void unpack_layers(const Grid& g, int direction, int first, const std::vector<double*>& fields, const double* from) {
+  for (double* field : fields) for_layer(g, direction, first, [&](std::ptrdiff_t c) { field[c] = *from++; });
+}
+
+/// Doubles in one ghost layer set (Grid::ghosts deep) of a block along direction d.
+std::size_t layer_size(const Grid& box, const Block& b, int d) {
+  return static_cast<std::size_t>(Grid::ghosts) * box.nz * (d == 0 ? b.ny : b.nx + 2 * Grid::ghosts);
+}
+
 constexpr int tag_downwards = 0, tag_upwards = 1;
 
 /// Adds the wall seconds of its lifetime to `total`.
@@ -79,10 +93,6 @@ Halo::Halo(const Grid& box, int ranks, HaloTransport transport) : box_(box), loc
 }
 
 namespace {
-/// Doubles in one ghost layer set (Grid::ghosts deep) of a block along direction d.
-std::size_t layer_size(const Grid& box, const Block& b, int d) {
-  return static_cast<std::size_t>(Grid::ghosts) * box.nz * (d == 0 ? b.ny : b.nx + 2 * Grid::ghosts);
-}
 /// The most fields one exchange sends through the window (the operator's ghosted fields).
 constexpr std::size_t shared_fields = variable_count + 6;
 }  // namespace
@@ -112,7 +122,8 @@ void Halo::share_memory_with_neighbours() {
   std::size_t total = 0;
   for (int d = 0; d < 2; ++d) {
     if (dims_[d] == 1) continue;
-    for (int r = 0; r < size_; ++r) capacity_[d] = std::max(capacity_[d], shared_fields * layer_size(box_, block_of(r), d));
+    for (int r = 0; r < size_; ++r)
+      capacity_[d] = std::max(capacity_[d], shared_fields * layer_size(box_, block_of(r), d));
     offset_[d] = total;
     total += 4 * capacity_[d];
   }
@@ -190,34 +201,23 @@ void Halo::exchange_direction(int d, const std::vector<double*>& fields) const {
     return;
   }
   if (window_ != MPI_WIN_NULL && fields.size() <= shared_fields) return exchange_shared(d, fields);
-  const std::size_t layer = static_cast<std::size_t>(G) * g.nz * (d == 0 ? g.ny : g.nx + 2 * G);
-  const std::size_t count = layer * fields.size();
+  const std::size_t count = layer_size(box_, block_, d) * fields.size();
   for (auto* buffer : {&send_low_, &send_high_, &receive_low_, &receive_high_}) buffer->resize(count);
-  const auto pack = [&](int first, std::vector<double>& buffer) {
-    std::size_t at = 0;
-    for (const double* field : fields)
-      for_layer(g, d, first, [&](std::ptrdiff_t c) { buffer[at++] = field[c]; });
-  };
-  const auto unpack = [&](int first, const std::vector<double>& buffer) {
-    std::size_t at = 0;
-    for (double* field : fields)
-      for_layer(g, d, first, [&](std::ptrdiff_t c) { field[c] = buffer[at++]; });
-  };
   const int size = static_cast<int>(count);
   MPI_Request requests[4];
   // Receives posted before the sends, so that the messages need no buffering on arrival.
   MPI_Irecv(receive_low_.data(), size, MPI_DOUBLE, low_[d], tag_upwards, cartesian_, &requests[0]);
   MPI_Irecv(receive_high_.data(), size, MPI_DOUBLE, high_[d], tag_downwards, cartesian_, &requests[1]);
-  pack(0, send_low_);
-  pack(n - G, send_high_);
+  pack_layers(g, d, 0, fields, send_low_.data());
+  pack_layers(g, d, n - G, fields, send_high_.data());
   {
     const Stopwatch timed(communication_seconds_);
     MPI_Isend(send_low_.data(), size, MPI_DOUBLE, low_[d], tag_downwards, cartesian_, &requests[2]);
     MPI_Isend(send_high_.data(), size, MPI_DOUBLE, high_[d], tag_upwards, cartesian_, &requests[3]);
     MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
   }
-  unpack(-G, receive_low_);
-  unpack(n, receive_high_);
+  unpack_layers(g, d, -G, fields, receive_low_.data());
+  unpack_layers(g, d, n, fields, receive_high_.data());
 }
 
 void Halo::exchange_shared(int d, const std::vector<double*>& fields) const {
@@ -227,14 +227,8 @@ void Halo::exchange_shared(int d, const std::vector<double*>& fields) const {
   // Generation `parity` of side s (0: the layers for the low neighbour, 1: for the high one).
   const std::size_t parity = generation_[d]++ % 2;
   const auto part = [&](auto* base, int s) { return base + offset_[d] + (2 * parity + s) * capacity_[d]; };
-  const auto pack = [&](int first, double* to) {
-    for (const double* field : fields) for_layer(g, d, first, [&](std::ptrdiff_t c) { *to++ = field[c]; });
-  };
-  const auto unpack = [&](int first, const double* from) {
-    for (double* field : fields) for_layer(g, d, first, [&](std::ptrdiff_t c) { field[c] = *from++; });
-  };
-  pack(0, part(mine_, 0));
-  pack(n - G, part(mine_, 1));
+  pack_layers(g, d, 0, fields, part(mine_, 0));
+  pack_layers(g, d, n - G, fields, part(mine_, 1));
   {
     // Each rank tells both neighbours that its layers are in place, and waits for theirs.
     // A generation is rewritten two exchanges later, after the neighbours have said, by
@@ -249,8 +243,9 @@ void Halo::exchange_shared(int d, const std::vector<double*>& fields) const {
     MPI_Waitall(4, requests, MPI_STATUSES_IGNORE);
     MPI_Win_sync(window_);
   }
-  unpack(-G, part(peers_[d][0], 1));  // the low neighbour's layers for its high neighbour
-  unpack(n, part(peers_[d][1], 0));
+  // The low neighbour's layers for its high neighbour, and the high one's for its low one.
+  unpack_layers(g, d, -G, fields, part(peers_[d][0], 1));
+  unpack_layers(g, d, n, fields, part(peers_[d][1], 0));
 }
 
 double Halo::sum(double local) const {
