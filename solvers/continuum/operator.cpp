@@ -67,7 +67,22 @@ void Operator::rhs(double t, const State& U, State& dUdt, Part part) {
     }
     if (diffusive && k0 > 0 && k0 - slab < nz) add_diffusive_fluxes(dUdt, k0 - slab, std::min(k0, nz));
   }
-  if (part != Part::diffusive) add_sources(t, U, dUdt);
+  if (part != Part::diffusive) {
+    add_artificial_fluxes(dUdt);
+    add_sources(t, U, dUdt);
+  }
+}
+
+ArtificialForm effective_artificial_form(const PhysicsSettings& s) {
+  if (!s.terms.artificial_dissipation) return ArtificialForm::none;
+  if (s.artificial.form != ArtificialForm::automatic) return s.artificial.form;
+  return s.transport == model::Transport::paper ? ArtificialForm::transport_coefficients : ArtificialForm::none;
+}
+
+double Operator::artificial_step() const {
+  const int dims = grid_.dimension == 3 ? 3 : 1;
+  const double D = halo_ ? halo_->max(artificial_diffusivity_) : artificial_diffusivity_;
+  return D > 0.0 ? grid_.h * grid_.h / (2.0 * dims * D) : std::numeric_limits<double>::infinity();
 }
 
 double Operator::plate_columns() const {
@@ -164,6 +179,22 @@ RiemannSolver riemann_from_string(const std::string& name) {
   if (name == "hllc") return RiemannSolver::hllc;
   if (name == "hll") return RiemannSolver::hll;
   throw InputError(fmt::format("continuum.riemann = \"{}\": allowed values are hllc, hll", name));
+}
+
+ArtificialForm artificial_form_from_string(const std::string& name) {
+  if (name == "auto") return ArtificialForm::automatic;
+  if (name == "none") return ArtificialForm::none;
+  if (name == "transport_coefficients") return ArtificialForm::transport_coefficients;
+  if (name == "second_difference") return ArtificialForm::second_difference;
+  if (name == "von_neumann_richtmyer") return ArtificialForm::von_neumann_richtmyer;
+  throw InputError(fmt::format("continuum.artificial_dissipation = \"{}\": allowed values are auto, none, "
+                               "transport_coefficients, second_difference, von_neumann_richtmyer", name));
+}
+
+WallEnergy wall_energy_from_string(const std::string& key, const std::string& name) {
+  if (name == "adiabatic") return WallEnergy::adiabatic;
+  if (name == "inelastic") return WallEnergy::inelastic;
+  throw InputError(fmt::format("{} = \"{}\": allowed values are adiabatic, inelastic", key, name));
 }
 
 }  // namespace shaker::continuum

@@ -28,19 +28,34 @@ struct Terms {
   bool advection = true, pressure = true;
   bool shear_viscosity = true, bulk_viscosity = true, conduction = true;
   bool collisional_loss = true, gravity = true, frame_force = true;
-  bool artificial_dissipation = true;  ///< only with paper transport
+  bool artificial_dissipation = true;  ///< the form of PhysicsSettings::artificial, if any
 };
 
-/// Artificial dissipation of the `paper` variant, confined to low density:
-///   mu_art = viscosity * n h c s(nu),  kappa_art = conductivity * n h c s(nu),
-///   s(nu) = 1 / (1 + (nu / volume_fraction)^4),
-/// c the local sound speed, h the cell size. It vanishes like h with refinement and is
-/// negligible where nu >> volume_fraction (the layer and the shock).
+/// Which artificial dissipation the operator adds in the dilute regions (docs/models.md,
+/// "Artificial dissipation"). Every form is weighted by the density switch
+/// s(nu) = 1 / (1 + (nu / volume_fraction)^4), scales with the cell size h, and vanishes with
+/// refinement.
+///  - transport_coefficients: mu += viscosity * n h c s, kappa += conductivity * n h c s;
+///  - second_difference: every conserved variable diffuses with D = viscosity * h (|u_n| + c) s
+///    across each face (a scalar, Lax-Friedrichs-like second difference);
+///  - von_neumann_richtmyer: a face in compression (u_n jumps down across it by du > 0) carries
+///    the extra pressure q = viscosity * n du^2 s in its normal momentum and q u_n in its energy
+///    flux.
+/// `automatic` is transport_coefficients with paper transport and none with full transport.
+enum class ArtificialForm { automatic, none, transport_coefficients, second_difference, von_neumann_richtmyer };
+
 struct ArtificialDissipation {
+  ArtificialForm form = ArtificialForm::automatic;
   double viscosity = 0.5;
   double conductivity = 0.5;
   double volume_fraction = 0.01;
 };
+
+/// The energy a wall takes from the gas beside it. `adiabatic`: none (zero heat flux, as in the
+/// paper). `inelastic`: the loss of a Maxwellian gas bouncing off a flat wall with the
+/// particles' restitution e, Q = (1 - e^2) n_w T sqrt(T / (2 pi)) per unit area, n_w = p / T
+/// the contact density (sources.cpp).
+enum class WallEnergy { adiabatic, inelastic };
 
 /// The walls' normal viscous stress. `mirror`: the mirror ghost's, the wall cell's coefficients
 /// and the slope 2 u_0 / h, first order where n' or u_z'' is not zero at the wall (every layer
@@ -58,9 +73,13 @@ struct PhysicsSettings {
   Limiter limiter = Limiter::mc;
   RiemannSolver riemann = RiemannSolver::hllc;
   WallStress wall_stress = WallStress::mirror;
+  WallEnergy plate_energy = WallEnergy::adiabatic, ceiling_energy = WallEnergy::adiabatic;
   Terms terms;
   ShakerKinematics shaker{3.0, 0.095};
 };
+
+/// The artificial dissipation in effect (`automatic` resolved), none if its term is off.
+ArtificialForm effective_artificial_form(const PhysicsSettings& s);
 
 /// Optional source added per cell: (t, x, y, z, out[variable_count]) adds to out.
 /// In 1D x = y = 0. Used by the manufactured-solution harness.
@@ -105,6 +124,9 @@ class Operator {
   /// advective cfl * h / max(sum_d |u_d| + c), and FE diffusive h^2 / (2 dim D_max).
   double advective_step(double cfl) const;
   double diffusive_step() const;
+  /// Largest stable forward-Euler step of the explicit artificial dissipation (second_difference,
+  /// von_neumann_richtmyer) at the last rhs, h^2 / (2 dim D_max); infinite without it.
+  double artificial_step() const;
 
   /// Evaluates primitives and the closure at U, ghosts included (with the transport
   /// coefficients unless need_transport is false), without fluxes.
@@ -154,6 +176,10 @@ class Operator {
   /// The faces of planes k0 .. k1 - 1 (along z: faces k0 .. k1 - 1, and nz with the last).
   void add_inviscid_fluxes(State& dUdt, int k0, int k1);                     // riemann.cpp
   void add_diffusive_fluxes(State& dUdt, int k0, int k1);                    // viscous_flux.cpp
+  /// The face-based artificial dissipation forms (artificial_dissipation.cpp).
+  void add_artificial_fluxes(State& dUdt);
+  /// The inelastic walls' energy loss, added to dUdt and to the loss sum (sources.cpp).
+  double add_wall_energy_losses(State& dUdt) const;
   void add_sources(double t, const State& U, State& dUdt);                   // sources.cpp
 
   Grid grid_;
@@ -165,9 +191,12 @@ class Operator {
   /// Per cell: the last argument of the closure's pow and its value (transport.cpp).
   std::vector<double> pow_argument_, pow_value_;
   SourcePower source_power_;
+  double artificial_diffusivity_ = 0.0;  ///< largest D of the last add_artificial_fluxes
 };
 
 Limiter limiter_from_string(const std::string& name);          ///< throws InputError
 RiemannSolver riemann_from_string(const std::string& name);    ///< throws InputError
+ArtificialForm artificial_form_from_string(const std::string& name);  ///< throws InputError
+WallEnergy wall_energy_from_string(const std::string& key, const std::string& name);  ///< throws InputError
 
 }  // namespace shaker::continuum

@@ -12,7 +12,7 @@ std::vector<ParameterSpec> continuum_parameters() {
       real("continuum.ceiling", 80.0, positive(1e5), "height of the ceiling above the plate").in("sigma"),
       real("continuum.initial_volume_fraction", 0.5, Range{0.0, 0.65, true, true},
            "volume fraction of the initial flat layer (below nu_max = 0.65)").in("1"),
-      text("continuum.transport", "paper", {"paper", "full"},
+      text("continuum.transport", "full", {"paper", "full"},
            "paper: 1/G terms dropped plus low-density artificial dissipation; full: all terms").in("-"),
       text("continuum.limiter", "mc", {"minmod", "mc", "van_leer", "none"},
            "slope limiter; none = unlimited central slopes (smooth-solution verification only)").in("-"),
@@ -44,12 +44,27 @@ std::vector<ParameterSpec> continuum_parameters() {
            "m_1 from the step's start)").in("-"),
       real("continuum.temperature_floor", 1e-12, positive(1.0),
            "lowest temperature; every raise to it is counted and reported").in("g sigma"),
+      text("continuum.artificial_dissipation", "auto",
+           {"auto", "none", "transport_coefficients", "second_difference", "von_neumann_richtmyer"},
+           "artificial dissipation in the dilute regions, each weighted by s(nu) = 1 / (1 + (nu / "
+           "nu_art)^4): transport_coefficients adds to mu and kappa; second_difference diffuses "
+           "every conserved variable with D = coefficient * h (|u_n| + c) s; von_neumann_richtmyer "
+           "adds q = coefficient * n du^2 s to the pressure of a face in compression; auto = "
+           "transport_coefficients with paper transport, none with full (docs/models.md)").in("-"),
       real("continuum.artificial_viscosity", 0.5, at_least(0.0, 100.0),
-           "paper transport: mu_art = coefficient * n h c / (1 + (nu / nu_art)^4)").in("1"),
+           "coefficient of the artificial dissipation: mu_art = coefficient * n h c s(nu) "
+           "(transport_coefficients), the second difference's or the von Neumann-Richtmyer "
+           "pressure's coefficient").in("1"),
       real("continuum.artificial_conductivity", 0.5, at_least(0.0, 100.0),
-           "paper transport: kappa_art = coefficient * n h c / (1 + (nu / nu_art)^4)").in("1"),
+           "transport_coefficients: kappa_art = coefficient * n h c s(nu)").in("1"),
       real("continuum.artificial_volume_fraction", 0.01, positive(0.65),
-           "paper transport: nu_art, the volume fraction below which artificial dissipation acts").in("1"),
+           "nu_art, the volume fraction below which artificial dissipation acts").in("1"),
+      text("continuum.plate_energy", "adiabatic", {"adiabatic", "inelastic"},
+           "energy the plate takes from the gas: adiabatic = none (dT/dz = 0, as the paper); "
+           "inelastic = (1 - e^2) n_w T sqrt(T / (2 pi)) per unit area, n_w = p / T, the loss of "
+           "a gas bouncing off a wall with the particles' restitution").in("-"),
+      text("continuum.ceiling_energy", "adiabatic", {"adiabatic", "inelastic"},
+           "the same for the ceiling").in("-"),
       real_list("continuum.field_phases", {}, Range{0.0, 1.0, false, true},
                 "3D only: phases f t of the last sampled cycle whose full fields are written "
                 "(RUN.fields.h5 + RUN.fields.xdmf), each a stored phase k / run.phases_per_cycle, "

@@ -68,9 +68,12 @@ ContinuumCase continuum_case(const config::Config& config) {
   p.limiter = limiter_from_string(config.text("continuum.limiter"));
   p.riemann = riemann_from_string(config.text("continuum.riemann"));
   p.shaker = c.parameters.shaker;
-  p.artificial = ArtificialDissipation{config.real("continuum.artificial_viscosity"),
+  p.artificial = ArtificialDissipation{artificial_form_from_string(config.text("continuum.artificial_dissipation")),
+                                       config.real("continuum.artificial_viscosity"),
                                        config.real("continuum.artificial_conductivity"),
                                        config.real("continuum.artificial_volume_fraction")};
+  p.plate_energy = wall_energy_from_string("continuum.plate_energy", config.text("continuum.plate_energy"));
+  p.ceiling_energy = wall_energy_from_string("continuum.ceiling_energy", config.text("continuum.ceiling_energy"));
   IntegratorSettings& i = c.integration;
   i.order = static_cast<int>(config.integer("continuum.integrator_order"));
   i.stages = static_cast<int>(config.integer("continuum.integrator_stages"));

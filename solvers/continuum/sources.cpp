@@ -1,6 +1,8 @@
 // Volume sources: gravity and the frame force of the oscillating container (body force per
 // unit mass -g (1 + Gamma cos(omega t)) in z), the collisional energy loss gamma of the
-// model, and the optional external (manufactured) source.
+// model, the inelastic walls' energy loss, and the optional external (manufactured) source.
+#include <cmath>
+
 #include "continuum/halo.hpp"
 #include "continuum/operator.hpp"
 
@@ -43,6 +45,7 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
     for (int k = 0; k < g.nz; ++k)
       for (int j = 0; j < g.ny; ++j) run(g.index(0, j, k), g.nx, body, lost);
   }
+  lost += add_wall_energy_losses(dUdt);
   // The external source is a user callback: it stays serial.
   if (external) {
     const int i0 = halo_ ? halo_->block().i0 : 0, j0 = halo_ ? halo_->block().j0 : 0;
@@ -61,6 +64,31 @@ void Operator::add_sources(double t, const State& U, State& dUdt) {
   // those of the whole box (a rank's share is summed over the ranks with its budget).
   const double per_area = g.h / plate_columns();
   source_power_ = SourcePower{body * per_area, lost * per_area};
+}
+
+// A Maxwellian gas beside a flat wall hits it n_w sqrt(T / (2 pi)) times per unit area and
+// time; each bounce keeps e^2 of the normal kinetic energy, and <v_z^2> over the hits is 2 T,
+// so the wall takes Q = (1 - e^2) n_w T sqrt(T / (2 pi)). The density at contact n_w = p / T
+// (the contact theorem of hard spheres at a hard wall) carries the dense gas's enhancement.
+double Operator::add_wall_energy_losses(State& dUdt) const {
+  const Grid& g = grid_;
+  if (g.z_boundary != ZBoundary::walls) return 0.0;
+  const double one_minus_e2 = 1.0 - settings_.e * settings_.e;
+  double lost = 0.0;
+  for (int k : {0, g.nz - 1}) {
+    if ((k == 0 ? settings_.plate_energy : settings_.ceiling_energy) != WallEnergy::inelastic) continue;
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const std::ptrdiff_t c = g.index(i, j, k);
+        const double T = w_[4][c], n = w_[0][c];
+        const double contact = settings_.terms.pressure && T > 0.0 ? closure_.p[c] / T : n;
+        const double loss = one_minus_e2 * contact * T * std::sqrt(T / (2.0 * pi)) / g.h;
+        dUdt.q[energy][c] -= loss;
+        lost += loss;
+      }
+    if (g.nz == 1) break;
+  }
+  return lost;
 }
 
 }  // namespace shaker::continuum

@@ -193,6 +193,7 @@ double TimeIntegrator::choose_step(double t_limit) {
     dt = op_.advective_step(settings_.cfl * ssp_coefficient());
     if (settings_.diffusion == DiffusionIntegrator::explicit_rk)
       dt = std::min(dt, settings_.diffusion_number * ssp_coefficient() * op_.diffusive_step());
+    dt = std::min(dt, settings_.diffusion_number * ssp_coefficient() * op_.artificial_step());
   }
   if (!(dt > 0.0) || !std::isfinite(dt)) dt = t_limit - t_;
   return std::min(dt, t_limit - t_);

@@ -116,7 +116,7 @@ CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double
   if (terms.shear_viscosity) r.mu = m.shear_viscosity;
   if (terms.bulk_viscosity) r.lambda = m.bulk_viscosity;
   if (terms.conduction) r.kappa = m.thermal_conductivity;
-  if (s.transport == model::Transport::paper && terms.artificial_dissipation) {
+  if (effective_artificial_form(s) == ArtificialForm::transport_coefficients) {
     const S x = volume_fraction(n) / s.artificial.volume_fraction;
     const S x2 = x * x;
     const S weight = n * h * r.c / (1.0 + x2 * x2);

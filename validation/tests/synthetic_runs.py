@@ -169,9 +169,15 @@ def write_run(path, config_text, solver, seed):
 
 def write_runs(shaker, workdir, cases, quick):
     """The synthetic run files of `cases` (comma-separated) under workdir/runs."""
-    shaker = os.path.abspath(shaker)
     studies = run_validation.load_studies(os.path.join(VALIDATION, "studies.toml"))
-    plan = run_validation.plan_runs(shaker, studies, cases.split(","), quick)
+    write_plan(shaker, workdir, run_validation.plan_runs(os.path.abspath(shaker), studies,
+                                                         cases.split(","), quick))
+
+
+def write_plan(shaker, workdir, plan):
+    """A synthetic run file for every run of a plan (run_validation.plan_runs' dicts), under
+    the name the runner reuses."""
+    shaker = os.path.abspath(shaker)
     os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
     for i, run in enumerate(plan):
         text, key = run_validation.run_key(shaker, run)

@@ -96,3 +96,40 @@ def test_unknown_key_is_refused(shaker, work_dir):
         f.write("[layer]\nparticle = 3937\n")
     rc = subprocess.run([shaker, "config", bad], capture_output=True).returncode
     assert rc == 2, f"shaker config accepted a file with an unknown key (exit {rc})"
+
+
+# The keys that make up the continuum model and its numerics near vacuum: one setting for the
+# program's default and every validation case (docs/models.md).
+CONTINUUM_SETTING = ("transport", "artificial_dissipation", "artificial_viscosity",
+                     "artificial_conductivity", "artificial_volume_fraction", "temperature_floor",
+                     "plate_energy", "ceiling_energy", "limiter", "riemann", "wall_stress",
+                     "background_volume_fraction", "initial_temperature",
+                     "initial_volume_fraction")
+
+
+def test_an_empty_case_file_is_the_base_case(shaker, work_dir):
+    empty = os.path.join(work_dir, "empty.toml")
+    open(empty, "w").close()
+    result = subprocess.run([shaker, "config", empty], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    defaults = tomllib.loads(result.stdout)
+    base = tomllib.loads(run_validation.effective_config(shaker, "base", []))
+    differences = sorted(f"{section}.{key}: default {defaults[section].get(key)!r}, base "
+                         f"{value!r}" for section, values in base.items()
+                         for key, value in values.items()
+                         if defaults[section].get(key) != value)
+    assert differences == []
+
+
+def test_every_case_uses_the_default_continuum_setting(shaker, work_dir):
+    empty = os.path.join(work_dir, "empty.toml")
+    open(empty, "w").close()
+    defaults = tomllib.loads(subprocess.run([shaker, "config", empty], capture_output=True,
+                                            text=True, check=True).stdout)["continuum"]
+    differences = []
+    for name in sorted(FILES):
+        continuum = tomllib.loads(run_validation.effective_config(shaker, name, []))["continuum"]
+        differences += [f"{name}: continuum.{key} = {continuum[key]!r}, default "
+                        f"{defaults[key]!r}" for key in CONTINUUM_SETTING
+                        if continuum[key] != defaults[key]]
+    assert differences == []

@@ -89,6 +89,7 @@ dimension = 3
 cell_size = 0.5
 box_width = 5.0
 ceiling = 10.0
+transport = "paper"
 diffusion_integrator = "explicit"
 field_phases = [0.25, 0.75]
 [run]

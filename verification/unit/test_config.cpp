@@ -47,7 +47,7 @@ TEST(Config, DefaultsReproduceThePaperBaseCase) {
   EXPECT_EQ(c.real("md.bin_height"), 1.0);
   EXPECT_EQ(c.real("continuum.box_width"), 11.0);
   EXPECT_EQ(c.real("continuum.ceiling"), 80.0);
-  EXPECT_EQ(c.text("continuum.transport"), "paper");
+  EXPECT_EQ(c.text("continuum.transport"), "full");  // the validation cases' model
   EXPECT_EQ(c.integer("run.sampled_cycles"), 10);  // the paper averages over 10 cycles
 
   const auto p = shaker::CaseParameters::from(c);

@@ -1,0 +1,228 @@
+#!/usr/bin/python3
+"""The continuum sensitivity study: every choice the paper leaves open, one at a time.
+
+    validation/sensitivity.py --shaker build/release/solvers/app/shaker [--workdir DIR]
+        [--variants validation,plate_inelastic] [--cases base] [--jobs 2]
+        [--results DIR/sensitivity.json] [--report reports/continuum-sensitivity.md]
+        [--reuse-only] [--rerun]
+
+Each variant of validation/sensitivity.toml appends its `--set` overrides to the continuum
+cases of the study; the MD runs of the study's md_cases are run once, as the validation study
+runs them (validation/studies.toml: ensembles for single shocks). Runs are keyed by their
+effective configuration exactly as run_validation.py keys them, so a workdir shared with the
+validation study reuses its runs, and an interrupted study resumes where it stopped. Every
+variant is then judged by the claims the continuum fails (evaluated as the validation study
+does, with MD's jackknife errors), the 1 % mass bottom above the plate at chosen phases, the
+single-shock speed at e = 0.99, and its cost per cycle. reports/make_sensitivity_report.py
+writes the report.
+
+Exit status 0 when the results and report are written; 1 if a run or the report failed; 2 for
+bad arguments.
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+if __package__:
+    from . import quantities
+    from . import run_validation as rv
+else:  # run as a script: its folder, validation/, is first on sys.path
+    import quantities
+    import run_validation as rv
+
+HERE = rv.HERE
+ROOT = rv.ROOT
+
+
+def load_variants(path, studies):
+    """The study's settings and variants; ValueError names what is wrong."""
+    spec = rv.load_toml(path)
+    study, variants = spec["study"], spec["variant"]
+    known = set(studies["by_name"])
+    names = set()
+    for v in variants:
+        if v["name"] in names:
+            raise ValueError(f"variant {v['name']} appears twice")
+        names.add(v["name"])
+        unknown = [c for c in v.get("cases", []) if c not in study["cases"]]
+        if unknown:
+            raise ValueError(f"variant {v['name']}: cases {unknown} are not study cases")
+    for c in study["cases"] + study["md_cases"]:
+        if c not in known:
+            raise ValueError(f"case {c} is not in validation/studies.toml")
+    return study, variants
+
+
+def plan(shaker, studies, study, variants, case_filter):
+    """The solver runs: the MD references once, every variant's continuum cases."""
+    md_cases = [c for c in study["md_cases"] if not case_filter or c in case_filter]
+    runs = [dict(r, variant=None) for r in rv.plan_runs(shaker, studies, md_cases, False)
+            if r["solver"] == "md"]
+    for v in variants:
+        for case in v.get("cases", study["cases"]):
+            if case_filter and case not in case_filter:
+                continue
+            runs.append(dict(case=case, solver="continuum", replicas=1,
+                             overrides=list(v["overrides"]), timeout=study["timeout"],
+                             fallback=[], expect_failure=False, variant=v["name"]))
+    return runs
+
+
+def cycles_of(config):
+    run = config.get("run", {})
+    return run.get("transient_cycles", 0) + run.get("sampled_cycles", 0)
+
+
+def mass_gap(view, phase):
+    """The 1 % mass bottom above the plate at a stored phase, with its jackknife error."""
+    try:
+        k = quantities._row_at(view.analysis, phase)
+    except quantities.NotMeasured:
+        return None, None
+    value = float(view.analysis["mass_gap"][k])
+    error = view.errors.get("mass_gap")
+    error = float(error[k]) if error is not None and math.isfinite(error[k]) else None
+    return value, error
+
+
+def judge_variant(variant, md_views, continuum_views, claims, study, comparer):
+    """The variant's claims, mass bottoms, single-shock speed and cost."""
+    views = dict(md_views)
+    views.update({(case, "continuum"): view for case, view in continuum_views.items()})
+    cases = set(continuum_views)
+    chosen = [c for c in claims if c["id"] in study["claims"]
+              and all(case in cases or (case, "md") in md_views for case in c["cases"])]
+    results = rv.evaluate_claims(chosen, views, comparer, partial_cases_ok=False)
+    verdicts = {}
+    for claim in results:
+        solver = "md_vs_continuum" if claim["solvers"] == "md_vs_continuum" else "continuum"
+        entry = claim["per_solver"].get(solver)
+        if entry is None:
+            continue
+        first = entry["checks"][0]
+        verdicts[claim["id"]] = dict(status=entry["status"], value=first.get("value"),
+                                     error=first.get("error"), band=claim["band"],
+                                     comparison=claim["comparison"],
+                                     reason=first.get("reason"))
+    base = continuum_views.get("base")
+    gaps = {}
+    if base is not None and base.status == "ok":
+        for phase in study["mass_gap_phases"]:
+            gaps[f"{phase:g}"] = mass_gap(base, phase)
+    speed = None
+    shock = continuum_views.get("single_shock_e0p99")
+    if shock is not None and shock.status == "ok":
+        speed = shock.shock_speed
+    seconds = {case: view.runs[0]["seconds"] for case, view in continuum_views.items() if view.runs}
+    per_cycle = {case: seconds[case] / max(cycles_of(view.config), 1)
+                 for case, view in continuum_views.items() if case in seconds}
+    failed = {case: view.status for case, view in continuum_views.items() if view.status != "ok"}
+    return dict(name=variant["name"], choice=variant["choice"], overrides=variant["overrides"],
+                note=variant.get("note", ""), claims=verdicts, mass_gap=gaps,
+                single_shock_speed=speed, seconds_per_cycle=per_cycle, failed=failed)
+
+
+def md_reference(md_views, study):
+    """MD's numbers the variants are judged against, with their errors."""
+    base = md_views.get(("base", "md"))
+    gaps = {}
+    if base is not None and base.status == "ok":
+        gaps = {f"{p:g}": mass_gap(base, p) for p in study["mass_gap_phases"]}
+    shock = md_views.get(("single_shock_e0p99", "md"))
+    speed = None
+    if shock is not None and shock.status == "ok":
+        speed = (shock.shock_speed, shock.per_run_errors.get("shock_speed"))
+    formation = exit_phase = None
+    if base is not None and base.status == "ok":
+        errors = base.per_run_errors
+        formation = (base.per_run.get("formation_phase"), errors.get("formation_phase"))
+        exit_phase = (base.per_run.get("exit_phase"), errors.get("exit_phase"))
+    return dict(mass_gap=gaps, single_shock_speed=speed, formation_phase=formation,
+                exit_phase=exit_phase)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--shaker", required=True, help="path of the shaker program")
+    parser.add_argument("--workdir", default=os.path.join(HERE, "work"),
+                        help="runs and derived files (shared with run_validation.py: reused)")
+    parser.add_argument("--spec", default=os.path.join(HERE, "sensitivity.toml"))
+    parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
+    parser.add_argument("--claims", default=os.path.join(ROOT, "reference-data", "claims.toml"))
+    parser.add_argument("--variants", help="comma-separated subset of the variants")
+    parser.add_argument("--cases", help="comma-separated subset of the study's cases")
+    parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
+    parser.add_argument("--results", help="results JSON (default WORKDIR/sensitivity.json)")
+    parser.add_argument("--report", default=os.path.join(ROOT, "reports",
+                                                         "continuum-sensitivity.md"))
+    parser.add_argument("--rerun", action="store_true", help="ignore finished runs")
+    parser.add_argument("--reuse-only", action="store_true",
+                        help="never start a solver; use finished runs in --workdir only")
+    args = parser.parse_args(argv)
+
+    shaker, workdir = os.path.abspath(args.shaker), os.path.abspath(args.workdir)
+    studies = rv.load_studies(args.studies)
+    try:
+        study, variants = load_variants(args.spec, studies)
+    except (ValueError, KeyError) as error:
+        parser.error(f"{args.spec}: {error}")
+    if args.variants:
+        wanted = [v.strip() for v in args.variants.split(",") if v.strip()]
+        unknown = [w for w in wanted if w not in {v["name"] for v in variants}]
+        if unknown:
+            parser.error(f"unknown variant(s) {', '.join(unknown)}")
+        variants = [v for v in variants if v["name"] in wanted]
+    case_filter = None
+    if args.cases:
+        case_filter = [c.strip() for c in args.cases.split(",") if c.strip()]
+        unknown = [c for c in case_filter if c not in study["cases"]]
+        if unknown:
+            parser.error(f"unknown case(s) {', '.join(unknown)}; study cases: "
+                         + ", ".join(study["cases"]))
+    claims = rv.load_toml(args.claims)["claim"]
+    os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
+
+    started = time.monotonic()
+    runs = rv.execute_all(shaker, workdir, plan(shaker, studies, study, variants, case_filter),
+                          args.jobs, args.rerun, args.reuse_only)
+    md_views = {(r["case"], "md"): rv.build_view(shaker, r["case"], "md", r["record"], workdir)
+                for r in runs if r["solver"] == "md"}
+    comparer = rv.Comparer(shaker, os.path.join(workdir, "derived"))
+    judged = []
+    for v in variants:
+        continuum = {r["case"]: rv.build_view(shaker, r["case"], "continuum", r["record"], workdir)
+                     for r in runs if r.get("variant") == v["name"]}
+        judged.append(judge_variant(v, md_views, continuum, claims, study, comparer))
+        verdicts = [f"{k} {c['status']} {rv._format_value(c['value'])}"
+                    for k, c in judged[-1]["claims"].items()]
+        rv.log(f"{v['name']}: " + ", ".join(verdicts))
+    summary = dict(commit=rv.git("rev-parse", "HEAD"),
+                   shaker_version=subprocess.run([shaker, "--version"], capture_output=True,
+                                                 text=True).stdout.strip(),
+                   wall_seconds=time.monotonic() - started,
+                   simulated_seconds=sum(r["record"]["seconds"] for r in runs
+                                         if not r["record"].get("reused")),
+                   study=study, md=md_reference(md_views, study), variants=judged,
+                   runs=[dict(case=r["case"], solver=r["solver"], variant=r.get("variant"),
+                              status=r["record"]["status"], seconds=r["record"]["seconds"],
+                              reused=r["record"].get("reused", False),
+                              stderr=r["record"].get("stderr", "")[-400:]) for r in runs])
+    results = os.path.abspath(args.results or os.path.join(workdir, "sensitivity.json"))
+    with open(results + ".partial", "w") as f:
+        json.dump(rv.plain(summary), f, indent=1)
+    os.replace(results + ".partial", results)
+    report = subprocess.run([sys.executable, os.path.join(ROOT, "reports",
+                                                          "make_sensitivity_report.py"),
+                             "--results", results, "--output", args.report])
+    failed = [r for r in runs if r["record"]["status"] not in ("ok",)]
+    for r in failed:
+        rv.log(f"run failed: {r['case']} {r['solver']} {r.get('variant')}: {r['record']['status']}")
+    return 1 if report.returncode != 0 or failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

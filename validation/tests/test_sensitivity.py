@@ -1,0 +1,108 @@
+"""ctest validation.sensitivity: the continuum sensitivity study's plan and its pipeline.
+
+- The variants of validation/sensitivity.toml cover every choice the study must vary, each is
+  accepted by `shaker config` on every case it runs, and each differs from the reference by
+  its own overrides only (one choice at a time).
+- On synthetic run files (synthetic_runs.py) of two variants, validation/sensitivity.py
+  --reuse-only judges each variant by the claims it names, with numbers equal to what
+  `shaker compare` gives for the same files, and writes the report with its figure.
+
+    python3 -m pytest validation/tests/test_sensitivity.py --shaker SHAKER
+"""
+import json
+import os
+import subprocess
+import sys
+
+from validation import run_validation as rv
+from validation import sensitivity
+from validation.tests import synthetic_runs
+
+SPEC = os.path.join(rv.HERE, "sensitivity.toml")
+# The choices the study must vary (the paper leaves them open, or the project made them).
+REQUIRED_CHOICES = (
+    "transport variant", "artificial dissipation: form and coefficient",
+    "artificial dissipation: density threshold", "temperature floor",
+    "thermal wall condition at the plate", "ceiling: condition", "ceiling: height", "cell size",
+    "time integrator", "1D column against the 3D 11 x 11 box", "initial state",
+    "transient cycles", "reconstruction and limiter")
+
+
+def load():
+    studies = rv.load_studies(os.path.join(rv.HERE, "studies.toml"))
+    return (studies,) + sensitivity.load_variants(SPEC, studies)
+
+
+def test_every_choice_is_varied():
+    _, _, variants = load()
+    choices = {v["choice"] for v in variants}
+    missing = [c for c in REQUIRED_CHOICES if c not in choices]
+    assert not missing, f"choices without a variant: {missing}"
+    forms = {o.split("=")[1] for v in variants for o in v["overrides"]
+             if o.startswith("continuum.artificial_dissipation=")}
+    assert {"transport_coefficients", "second_difference", "von_neumann_richtmyer"} <= forms
+    coefficients = sorted(float(o.split("=")[1]) for v in variants for o in v["overrides"]
+                          if o.startswith("continuum.artificial_viscosity="))
+    assert coefficients[-1] / coefficients[0] >= 10.0, "coefficients span at least a decade"
+    cells = {o for v in variants for o in v["overrides"] if o.startswith("continuum.cell_size=")}
+    assert len(cells | {"continuum.cell_size=0.1"}) >= 3, "three grids"
+
+
+def test_variants_are_valid_and_one_at_a_time(shaker):
+    studies, study, variants = load()
+    reference = next(v for v in variants if not v["overrides"])
+    assert reference["name"] == "validation"
+    for v in variants:
+        for case in v.get("cases", study["cases"]):
+            text = rv.effective_config(shaker, case, v["overrides"])  # ValueError if refused
+            assert text
+        keys = [o.split("=")[0] for o in v["overrides"]]
+        assert len(keys) == len(set(keys)), f"{v['name']}: a key set twice"
+
+
+def test_pipeline_on_synthetic_runs(shaker, work_dir):
+    studies, study, variants = load()
+    chosen = [v for v in variants if v["name"] in ("validation", "plate_inelastic")]
+    workdir = os.path.join(work_dir, "work")
+    runs = sensitivity.plan(shaker, studies, study, chosen, ["base", "depth_h4p5",
+                                                             "depth_h13p5"])
+    synthetic_runs.write_plan(shaker, workdir, runs)
+    report = os.path.join(work_dir, "continuum-sensitivity.md")
+    result = subprocess.run(
+        [sys.executable, os.path.join(rv.HERE, "sensitivity.py"), "--shaker", shaker,
+         "--workdir", workdir, "--variants", "validation,plate_inelastic",
+         "--cases", "base,depth_h4p5,depth_h13p5", "--reuse-only", "--report", report],
+        capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    results = json.load(open(os.path.join(workdir, "sensitivity.json")))
+    assert all(r["reused"] for r in results["runs"]), "every run reused"
+    judged = {v["name"]: v for v in results["variants"]}
+    assert set(judged) == {"validation", "plate_inelastic"}
+    # C10 of a variant is the largest centre-of-mass fractional RMS over the three depths,
+    # each as `shaker compare CONTINUUM MD` gives it for the same files.
+    by_case = {}
+    for r in runs:
+        text, key = rv.run_key(shaker, r)
+        by_case.setdefault((r["case"], r["solver"], r["variant"]),
+                           os.path.join(workdir, "runs", f"{r['solver']}-{key[:20]}.h5"))
+    for name in judged:
+        expected = 0.0
+        for case in ("base", "depth_h4p5", "depth_h13p5"):
+            out = os.path.join(work_dir, f"{name}-{case}.csv")
+            subprocess.run([shaker, "compare", by_case[(case, "continuum", name)],
+                            by_case[(case, "md", None)], "--csv", out], check=True,
+                           capture_output=True)
+            rows = {line.split(",")[0]: line.split(",")[1] for line in open(out)}
+            expected = max(expected, float(rows["center_of_mass_fractional_rms"]))
+        got = judged[name]["claims"]["C10"]["value"]
+        assert abs(got - expected) < 1e-12, f"{name}: C10 {got} against compare's {expected}"
+        assert judged[name]["claims"]["C10"]["error"] is not None, "C10 carries MD's error"
+        assert judged[name]["claims"]["C1"]["status"] in ("pass", "fail", "unresolved")
+        gap, _ = judged[name]["mass_gap"]["0"]
+        assert gap is not None and gap >= 0.0
+    text = open(report).read()
+    for heading in ("## MD, the reference", "## Decision", "## Every variant"):
+        assert heading in text
+    assert "plate_inelastic" in text and "`continuum.plate_energy=inelastic`" in text
+    png = os.path.join(work_dir, "continuum-sensitivity", "variants.png")
+    assert os.path.getsize(png) > 10000
