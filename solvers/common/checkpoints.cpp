@@ -25,8 +25,7 @@ CheckpointSettings CheckpointSettings::from(const config::Config& config) {
 
 std::filesystem::path CheckpointSettings::stop_file() const {
   if (!file.empty()) return file;
-  std::filesystem::path beside_output = run_output;
-  return beside_output.replace_extension(".checkpoint.h5");
+  return derived_name(run_output, ".checkpoint.h5");
 }
 
 std::vector<NamedPath> CheckpointSettings::outputs() const {
@@ -53,7 +52,7 @@ std::string restart_source(const std::filesystem::path& path) {
 }
 
 std::filesystem::path previous_checkpoint(std::filesystem::path file) {
-  return file.replace_extension(".previous.h5");
+  return derived_name(std::move(file), ".previous.h5");
 }
 
 void write_checkpoint_header(hid_t file, const std::string& kind, const SchedulePosition& position,
