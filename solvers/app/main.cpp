@@ -53,13 +53,13 @@ int main(int argc, char** argv) {
   analyze->add_flag("--quiet", analysis.quiet, "print nothing (with --json or --csv)");
   analyze->add_option("--relative-drop", analysis.criteria.relative_drop,
                       "shock rule: minimum (T_max - T_min) / T_max")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+      ->check(finite_between(0.0, 1.0))->capture_default_str();
   analyze->add_option("--standard-errors", analysis.criteria.standard_errors,
                       "shock rule: minimum drop in combined standard errors")
-      ->check(CLI::Range(0.0, 100.0))->capture_default_str();
+      ->check(finite_between(0.0, 100.0))->capture_default_str();
   analyze->add_option("--deceleration", analysis.criteria.deceleration,
                       "shock rule: minimum fraction of the incoming velocity lost")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+      ->check(finite_between(0.0, 1.0))->capture_default_str();
 
   std::string first, second, compare_csv;
   auto* compare = app.add_subcommand(

@@ -265,14 +265,19 @@ void apply_damage(const fs::path& dir, const toml::value& step) {
     for (const auto& full : names) {
       const auto dims = shaker::h5::shape(file, full);
       // cycle_samples/cycles counts cycles per [phase x sample], not bins: it keeps its shape.
-      if (dims.size() != 2 || (op == "bins" && full.ends_with("/cycles"))) continue;
+      // "phases" also cuts the per-phase vectors of a group (profiles/phase, profiles/time).
+      const bool matrix = dims.size() == 2, per_phase = dims.size() == 1 && names.size() > 1;
+      if (!(matrix || (op == "phases" && per_phase)) || (op == "bins" && full.ends_with("/cycles")))
+        continue;
       const auto data = shaker::h5::read_doubles(file, full);
+      const std::size_t width = matrix ? dims[1] : 1;
       const std::size_t rows = op == "phases" ? toml::find<std::size_t>(step, "rows") : dims[0];
-      const std::size_t cols = op == "bins" ? toml::find<std::size_t>(step, "bins") : dims[1];
+      const std::size_t cols = op == "bins" ? toml::find<std::size_t>(step, "bins") : width;
       std::vector<double> cut;
       for (std::size_t r = 0; r < rows; ++r)
-        for (std::size_t c = 0; c < cols; ++c) cut.push_back(data[r * dims[1] + c]);
-      replace_dataset(file, full, cut, {rows, cols});
+        for (std::size_t c = 0; c < cols; ++c) cut.push_back(data[r * width + c]);
+      replace_dataset(file, full, cut, matrix ? std::vector<std::size_t>{rows, cols}
+                                              : std::vector<std::size_t>{rows});
     }
   } else {
     ADD_FAILURE() << "unknown damage op " << op;
