@@ -71,7 +71,11 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
   // saved cell grid's lowest row.
   config::require_same_keys(config, saved.configuration,
                             {"material.restitution", "material.e", "shaker.frequency", "shaker.gamma"}, source);
-  validate_state(g, saved.data);
+  try {
+    validate_state(g, saved.data);
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("{} is not a valid checkpoint: {}", source, error.what()));
+  }
   position = saved.position;
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
