@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/analysis.hpp"
+#include "analysis/run_analysis.hpp"
 #include "common/cycle_samples.hpp"
 #include "common/profile.hpp"
 #include "common/shaker_kinematics.hpp"
@@ -192,6 +193,14 @@ inline RunRecord synthetic_run(const Truth& tr, double scale, std::uint64_t seed
     run.profiles.push_back(std::move(p));
   }
   return run;
+}
+
+/// The options `shaker analyze` applies to a periodic run of the synthetic shaker.
+inline an::AnalysisOptions options() {
+  an::AnalysisOptions o;
+  o.periodic = true;
+  o.frequency = kFrequency;
+  return o;
 }
 
 }  // namespace synthetic

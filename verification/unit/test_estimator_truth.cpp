@@ -48,13 +48,6 @@ RunRecord synthetic_run(const Truth& tr, double scale, std::uint64_t seed) {
 
 // ---- The estimators, as `shaker analyze` applies them -----------------------------------
 
-an::AnalysisOptions options() {
-  an::AnalysisOptions o;
-  o.periodic = true;
-  o.frequency = kFrequency;
-  return o;
-}
-
 struct Estimate {
   double value = NAN, error = NAN;  ///< central value; jackknife error over the samples
   bool found() const { return std::isfinite(value); }

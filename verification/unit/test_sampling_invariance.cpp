@@ -26,13 +26,6 @@ const std::vector<std::string> kQuantities = {"formation_phase", "exit_phase", "
                                               "shock_speed", "shock_width_mean",
                                               "width_over_mfp_mean", "max_mach_peak"};
 
-an::AnalysisOptions options() {
-  an::AnalysisOptions o;
-  o.periodic = true;
-  o.frequency = kFrequency;
-  return o;
-}
-
 struct Estimate {
   double value = NAN, error = NAN;
 };
