@@ -141,7 +141,7 @@ class Operator {
   /// The primitives and closure of the interior, then copied to the ghosts; with a halo every
   /// rank fails alike (DomainError with the first failing rank's message) if any rank fails.
   void evaluate_closure(const State& U, bool need_transport);
-  void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp
+  void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp, primitives.cpp
   void copy_closure_to_ghosts();                                             // boundary.cpp
   /// The fields whose ghosts are filled: the primitives, then the closure values the fluxes
   /// read beside a cell (boundary.cpp).
