@@ -152,7 +152,7 @@ class Operator {
   /// Copies row `first`'s periodic x ghosts of the ghosted fields (its interior cells filled).
   void copy_row_to_x_ghosts(std::ptrdiff_t first);                          // boundary.cpp
   /// The faces of planes k0 .. k1 - 1 (along z: faces k0 .. k1 - 1, and nz with the last).
-  void add_inviscid_fluxes(State& dUdt, int k0, int k1);                     // riemann.cpp
+  void add_inviscid_fluxes(State& dUdt, int k0, int k1);                     // inviscid_sweep.cpp
   void add_diffusive_fluxes(State& dUdt, int k0, int k1);                    // viscous_flux.cpp
   void add_sources(double t, const State& U, State& dUdt);                   // sources.cpp
 
