@@ -30,7 +30,14 @@ allowed); names contain no commas.
       asymptotic range, Fs 3 outside it, at least half the range where the triple does not
       converge monotonically). The judge (GciRow::pass) places the triple in the asymptotic
       range when it converges monotonically at an order within order_tolerance of
-      design_order. A two-grid row (convergence "two-grids"; h3, phi3, gci32 and pass nan;
+      design_order. For the real problem's grid studies (study real-*, but for a time-step
+      study's own rows, real-time-* without -grid, judged at their integrator's temporal order)
+      design_order is the quantity's theoretical order, declared once with its reason in
+      THEORETICAL_ORDERS (verification/grid-studies/theoretical_orders.csv, explained in
+      verification/README.md): a quantity it does not declare, or a row judged at another
+      order (rejudge the table: rejudge_gci --orders), is unreadable input. The report shows
+      each row's theoretical order and the short name of its reason. A two-grid row
+      (convergence "two-grids"; h3, phi3, gci32 and pass nan;
       assumed order, Fs = 3) is shown as "not checked" and is not counted as a check. Each
       study gets a figure below the table: phi against h per quantity, with phi_extrapolated
       and the band phi1 ± uncertainty1.
@@ -152,6 +159,63 @@ PHASE_SUFFIX = re.compile(r"_ft[0-9.]+(-[0-9.]+)?$")
 
 class InputProblem(Exception):
     pass
+
+
+REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The order of grid convergence each real-problem quantity can reach, with its reason: one
+# table, read here and by verification/grid-studies/test_real_problem.cpp and rejudge_gci.
+THEORETICAL_ORDERS = os.path.join(REPOSITORY, "verification", "grid-studies",
+                                  "theoretical_orders.csv")
+THEORY_SECTION = "verification/README.md, \"What order the real problem's quantities can reach\""
+
+
+def read_theoretical_orders(path):
+    """{quantity: (order, reason)} of a `quantity,order,reason` table ('#' comment lines)."""
+    try:
+        with open(path, newline="") as f:
+            lines = [line for line in f if line.strip() and not line.startswith("#")]
+    except OSError as error:
+        raise InputProblem(f"theoretical orders: {error}") from None
+    rows = list(csv.reader(lines))
+    if not rows or rows[0] != ["quantity", "order", "reason"]:
+        raise InputProblem(f"{path}: first line must be 'quantity,order,reason'")
+    orders = {}
+    for row in rows[1:]:
+        try:
+            quantity, order, reason = row
+            order = float(order)
+        except ValueError:
+            raise InputProblem(f"{path}: '{','.join(row)}' is not quantity,order,reason") from None
+        if quantity in orders or not reason or not 0.5 <= order <= 10:
+            raise InputProblem(f"{path}: '{','.join(row)}': a quantity once, an order in "
+                               "[0.5, 10] and a reason")
+        orders[quantity] = (order, reason)
+    return orders
+
+
+def is_time_step_triple(study):
+    """A time-step study's own rows (refining the step, not the grid): judged at the
+    integrator's temporal order, not at a quantity's spatial one."""
+    return study.startswith("real-time-") and not study.endswith("-grid")
+
+
+def theory_of(row, orders):
+    """(order, reason) a GCI row is judged against; InputProblem where a real-problem spatial
+    row's quantity has no declared order or the table judged it at another."""
+    if is_time_step_triple(row["study"]):
+        return row["design_order"], "integrator's temporal order"
+    if not row["study"].startswith("real-"):
+        return row["design_order"], "design order"
+    if row["quantity"] not in orders:
+        raise InputProblem(f"GCI {row['study']} / {row['quantity']}: no theoretical order "
+                           f"declared in {rc.repository_path(THEORETICAL_ORDERS)}")
+    order, reason = orders[row["quantity"]]
+    if row["design_order"] != order:
+        raise InputProblem(f"GCI {row['study']} / {row['quantity']}: judged at order "
+                           f"{rc.fmt(row['design_order'])}, its theoretical order is "
+                           f"{rc.fmt(order)} ({reason}): judge the table anew "
+                           "(rejudge_gci --orders)")
+    return order, reason
 
 
 def units_of(name):
@@ -535,27 +599,69 @@ def gci_line(r, mark):
     return rc.table_row(
         [r["study"], r["quantity"], units_of(r["quantity"])]
         + [rc.fmt(r[k], 6) for k in ("phi1", "phi2", "phi3")]
-        + [rc.fmt(r["order"], 4), rc.fmt(r["phi_extrapolated"], 6)] + percent
+        + [rc.fmt(r["order"], 4), rc.fmt(r["design_order"]), r["theory"],
+           rc.fmt(r["phi_extrapolated"], 6)] + percent
         + [rc.fmt(r["uncertainty1"], 3), r["convergence"], gci_result_text(r, mark)])
 
 
 def gci_failure(r):
     return (f"GCI {r['study']} / {r['quantity']}: observed order {rc.fmt(r['order'], 4)} "
             f"({r['convergence']}) outside the asymptotic range "
-            f"{rc.fmt(r['design_order'])} ± {rc.fmt(r['order_tolerance'])}")
+            f"{rc.fmt(r['design_order'])} ± {rc.fmt(r['order_tolerance'])} "
+            f"(theory: {r['theory']})")
 
 
-def bound_line(r, mark):
+INTEGRATOR_STUDY = "real-1d-integrator-"
+
+
+def own_time_error(r, bounds):
+    """For a fast integrator's difference from the reference (real-1d-integrator-<setting>):
+    the time-step study of the same setting at the same cell (real-time-d1-<setting>), its
+    bound row of the same quantity: the measured time error of the setting's production step.
+    None for other studies or where that study is not in the input."""
+    if not r["study"].startswith(INTEGRATOR_STUDY):
+        return None
+    study = "real-time-d1-" + r["study"][len(INTEGRATOR_STUDY):]
+    return next((b for b in bounds if b["study"] == study and b["quantity"] == r["quantity"]),
+                None)
+
+
+def time_error_cell(r, bounds):
+    if not r["study"].startswith(INTEGRATOR_STUDY):
+        return ""
+    own = own_time_error(r, bounds)
+    return rc.fmt(own["value"], 4) if own else "no time-step study"
+
+
+def bound_line(r, mark, bounds=()):
     ratio = r["value"] / r["bound"] if r["bound"] > 0 else float("nan")
     return rc.table_row(
         [r["study"], r["quantity"], units_of(r["quantity"]), rc.fmt(r["value"], 4),
-         r["value_basis"], rc.fmt(r["bound"], 4), r["bound_basis"], rc.fmt(ratio, 3), mark])
+         r["value_basis"], rc.fmt(r["bound"], 4), r["bound_basis"], rc.fmt(ratio, 3),
+         time_error_cell(r, bounds), mark])
 
 
-def bound_failure(r, gci_rows=()):
+def bound_failure(r, gci_rows=(), bounds=()):
     text = (f"bound {r['study']} / {r['quantity']}: {rc.fmt(r['value'], 4)} "
             f"({r['value_basis']}) above {rc.fmt(r['bound'], 4)} ({r['bound_basis']})")
-    return text + step_to_meet_the_bound(r, gci_rows)
+    return text + step_to_meet_the_bound(r, gci_rows) + time_error_explanation(r, bounds)
+
+
+def time_error_explanation(r, bounds):
+    """Whether a fast integrator's failing difference is its own time error: the two runs share
+    the grid, so their difference is the difference of their time errors; where the setting's
+    measured time error at its step covers the difference, that is the explanation."""
+    if not r["study"].startswith(INTEGRATOR_STUDY):
+        return ""
+    own = own_time_error(r, bounds)
+    if own is None:
+        return ("; unexplained by measurement: no time-step study of this setting "
+                f"(real-time-d1-{r['study'][len(INTEGRATOR_STUDY):]}) in the input")
+    if own["value"] >= r["value"]:
+        return (f"; explained: this setting's own time error at its step, "
+                f"{rc.fmt(own['value'], 4)} ({own['study']}), covers the difference")
+    return (f"; not explained by its time error at its step, {rc.fmt(own['value'], 4)} "
+            f"({own['study']}), which is smaller than the difference")
 
 
 def step_to_meet_the_bound(r, gci_rows):
@@ -586,12 +692,20 @@ def bound_section(data, failures):
         return [], 0
     table, checks = judged_table(
         "| study | quantity | units | value | value basis | bound | bound basis | "
-        "value / bound [1] | result |", rows, bound_line,
-        lambda r: bound_failure(r, data["gci"]), failures, "no bound checks found")
+        "value / bound [1] | time error of this integrator at its step | result |", rows,
+        lambda r, mark: bound_line(r, mark, data["bounds"]),
+        lambda r: bound_failure(r, data["gci"], data["bounds"]), failures,
+        "no bound checks found")
     return ["## Errors within their uncertainty", "",
             "Each row: an error of the study (value) and the uncertainty it must not exceed "
             "(bound), in the units of the row; the time-step studies compare the time error of "
-            "the production step with the grid error at the production cell.", ""] + table, checks
+            "the production step with the grid error at the production cell. For a fast "
+            "integrator (real-1d-integrator-*), whose difference from the reference at cell 0.1 "
+            "is the difference of the two settings' time errors (same grid), the column 'time "
+            "error of this integrator at its step' gives that setting's time error measured by "
+            "its time-step study (real-time-d1-*, same quantity; the row's value there): a "
+            "failing difference that this time error covers is explained by it.", ""] + table, \
+        checks
 
 
 def awaiting_section(data):
@@ -602,7 +716,8 @@ def awaiting_section(data):
         return []
     former = {1: "former: pass", 0: "former: fail"}
     header = ("| study | quantity | units | value | value basis | bound | bound basis | "
-              "value / bound [1] | former verdict |")
+              "value / bound [1] | time error of this integrator at its step | "
+              "former verdict |")
     lines = ["## Bound checks awaiting a rerun", "",
              f"Tables in {AWAITING_RERUN}/: computed with a former rule for the grid uncertainty "
              "and the time error, or under a former protocol of the studies (a transient too short "
@@ -611,7 +726,7 @@ def awaiting_section(data):
              "and not counted in this report's checks. The nightly rerun "
              "of their studies replaces them; until then their former verdicts are shown for "
              "information.", "", header, "|---" * (header.count("|") - 1) + "|"]
-    lines += [bound_line(r, former.get(r["pass"], "not checked")) for r in rows]
+    lines += [bound_line(r, former.get(r["pass"], "not checked"), data["bounds"]) for r in rows]
     return lines + [""]
 
 
@@ -643,11 +758,14 @@ def order_section(data, failures):
     return ["## Observed orders against the design order", ""] + table, checks
 
 
-def gci_section(data, out_dir, failures):
+def gci_section(data, out_dir, failures, orders):
     """The GCI of the quantities of interest, then a figure per study; returns (lines, checks)."""
     rows = sorted(data["gci"], key=lambda r: (r["study"], r["quantity"]))
+    for r in rows:
+        r["theory"] = theory_of(r, orders)[1]
     table, checks = judged_table(
-        "| study | quantity | units | phi1 (fine) | phi2 | phi3 | p [1] | phi extrapolated | "
+        "| study | quantity | units | phi1 (fine) | phi2 | phi3 | p [1] | theoretical p [1] | "
+        "reason | phi extrapolated | "
         "e21 [%] | GCI21 [%] | GCI32 [%] | uncertainty of phi1 | convergence | result |",
         rows, gci_line, gci_failure, failures, "no GCI studies found")
     plots = []
@@ -655,6 +773,13 @@ def gci_section(data, out_dir, failures):
         name = plot_gci_study(study, [r for r in rows if r["study"] == study], out_dir)
         plots += [f"![{study}]({name})", ""]
     return ["## Grid convergence index of the quantities of interest", "",
+            "Each row is judged against its quantity's theoretical order (column "
+            "'theoretical p'): for the real problem's grid triples the order theory allows that "
+            f"quantity, declared with the short name of its reason in "
+            f"{rc.repository_path(THEORETICAL_ORDERS)} and explained in {THEORY_SECTION} "
+            "(Engquist and Sjogreen 1998 and Casper and Carpenter 1998 on why a captured shock "
+            "would limit it to first order, and why these grids resolve the shock instead); for "
+            "a time-step study's own rows the integrator's temporal order. "
             "GCI in percent of the fine-grid value (Fs = 1.25, the observed order); the "
             "uncertainty of phi1 in the units of its row: the GCI with Fs 1.25 where the grids "
             "are in the asymptotic range (monotonic, observed order within the band of the "
@@ -768,6 +893,8 @@ def main(argv=None):
     parser.add_argument("--build-type", help="overrides the build type read from --build-dir")
     parser.add_argument("--commit", help="defaults to git rev-parse HEAD of this repository")
     parser.add_argument("--strict", action="store_true", help="exit 1 when any check fails")
+    parser.add_argument("--theoretical-orders", default=THEORETICAL_ORDERS,
+                        help="table quantity,order,reason of the real problem's quantities")
     args = parser.parse_args(argv)
 
     if not os.path.isdir(args.input):
@@ -775,18 +902,21 @@ def main(argv=None):
         return 2
     try:
         data, files = read_inputs(args.input)
+        orders = read_theoretical_orders(args.theoretical_orders)
+        for row in data["gci"]:  # every row judged at its order before anything is written
+            theory_of(row, orders)
     except InputProblem as problem:
         print(f"make_convergence_report: {problem}", file=sys.stderr)
         return 2
 
     out_dir = os.path.dirname(os.path.abspath(args.output))
-    repository = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    repository = REPOSITORY
     commit = args.commit or rc.git_commit(repository)
     build_type = args.build_type or rc.build_type_of(args.build_dir)
 
     failures = []
     order_lines, order_checks = order_section(data, failures)
-    gci_lines, gci_checks = gci_section(data, out_dir, failures)
+    gci_lines, gci_checks = gci_section(data, out_dir, failures, orders)
     bound_lines, bound_checks = bound_section(data, failures)
     sampling_lines, sampling_checks = sampling_section(data, out_dir, failures)
 

@@ -321,9 +321,9 @@ def test_report_on_a_synthetic_study(work_dir):
     assert "not checked (a diagnostic" in diagnostic and "FAIL" not in diagnostic, \
         f"a time-step study's GCI row must be shown but not checked: '{diagnostic}'"
     within = line_with(text, "| real-time-x | max_mach | 1 | 0.001 |")
-    assert within.endswith("| 0.5 | PASS |"), f"bound 0.001 <= 0.002 must pass: '{within}'"
+    assert within.endswith("| 0.5 |  | PASS |"), f"bound 0.001 <= 0.002 must pass: '{within}'"
     above = line_with(text, "| real-time-x | shock_speed | sqrt(g sigma) | 0.005 |")
-    assert above.endswith("| 2.5 | **FAIL** |"), f"bound 0.005 > 0.002 must fail: '{above}'"
+    assert above.endswith("| 2.5 |  | **FAIL** |"), f"bound 0.005 > 0.002 must fail: '{above}'"
     assert line_with(text, "- bound real-time-x / shock_speed: 0.005 (time error of the "
                      "production step (extrapolated)) above 0.002") != "", \
         "the failing bound is not listed with its measured value"
@@ -584,7 +584,7 @@ def test_bounds_awaiting_a_rerun_are_shown_apart_and_not_counted(work_dir):
     assert "1 checks: 1 pass, 0 fail." in text, "a former verdict was counted as a check"
     apart = text.split("## Bound checks awaiting a rerun")[-1].split("\n## ")[0]
     old = line_with(apart, "| real-time-y | shock_speed |")
-    assert old.endswith("| 2.5 | former: fail |"), f"former verdict not shown: '{old}'"
+    assert old.endswith("| 2.5 |  | former: fail |"), f"former verdict not shown: '{old}'"
     assert "real-time-y" not in text.split("## Bound checks awaiting a rerun")[0], \
         "a former verdict is shown among the judged checks"
     copied = os.path.join(work_dir, "out", "convergence-tables", "awaiting-rerun",
@@ -655,3 +655,145 @@ def test_known_failures_are_listed_with_their_reasons(work_dir):
         cells = table_cells(row)
         assert cells[1] == f"`{pattern}`" and cells[2] == reason, \
             f"row '{row}' is not the status line {pattern}: {reason}"
+
+
+def theoretical_orders_file(directory, declared):
+    path = os.path.join(directory, "orders.csv")
+    with open(path, "w") as f:
+        f.write("# synthetic\nquantity,order,reason\n")
+        f.writelines(f"{q},{p},{why}\n" for q, p, why in declared)
+    return path
+
+
+def first_order_rows(study, judged):
+    """A triple of phi = 3 + h per (quantity, design order, pass) as the C++ judge writes it:
+    observed order exactly 1."""
+    rows = []
+    for quantity, design, verdict in judged:
+        h, phi = (0.1, 0.2, 0.4), (3.1, 3.2, 3.4)
+        uncertainty = (1.25 if verdict else 3.0) * 0.1
+        rows.append((study, quantity, *h, *phi, 1.0, 3.0, 0.1 / 3.1, 0.1, 0.04, 0.08,
+                     "monotonic", design, 0.1, uncertainty, verdict))
+    return rows
+
+
+def test_each_real_problem_row_is_judged_at_its_theoretical_order(work_dir):
+    """A real-problem grid triple is judged against its quantity's theoretical order, declared
+    once with its reason: the report shows both, and a first-order triple passes where the
+    order is 1 and fails where it is 2 (the judge: support.GciRows.EachQuantityIsJudgedAt
+    ItsTheoreticalOrder). A table judged at another order than the declared one is refused,
+    so that no stale verdict is shown."""
+    orders = theoretical_orders_file(work_dir, [("width_over_mfp_ft0.25", 1, "whole-cells"),
+                                                ("max_mach", 2, "sampled-maximum")])
+    inputs = os.path.join(work_dir, "input")
+    os.makedirs(inputs)
+    write(os.path.join(inputs, "r.gci.csv"), GCI_HEADER, first_order_rows(
+        "real-1d-base-finest", [("width_over_mfp_ft0.25", 1, 1), ("max_mach", 2, 0)]))
+    report = os.path.join(work_dir, "out", "convergence.md")
+    result = run("--input", inputs, "--output", report, "--commit", "abc",
+                 "--theoretical-orders", orders)
+    assert result.returncode == 0, result.stderr
+    text = open(report).read()
+    rows = markdown_tables(text)["## Grid convergence index of the quantities of interest"]
+    shown = {r["quantity"]: r for r in rows}
+    first = shown["width_over_mfp_ft0.25"]
+    assert (first["theoretical p [1]"], first["reason"]) == ("1", "whole-cells"), first
+    assert first["result"].startswith("PASS"), f"order 1 against 1 not passed: {first}"
+    second = shown["max_mach"]
+    assert (second["theoretical p [1]"], second["reason"]) == ("2", "sampled-maximum"), second
+    assert second["result"].startswith("**FAIL**"), f"order 1 against 2 passed: {second}"
+    failure = next(f for f in failure_list(text) if "max_mach" in f)
+    assert "outside the asymptotic range 2 ± 0.1 (theory: sampled-maximum)" in failure, failure
+    assert "verification/README.md" in text.split("## Grid convergence index")[1], \
+        "the GCI section does not cite the theory"
+
+    stale = os.path.join(work_dir, "stale")
+    os.makedirs(stale)
+    write(os.path.join(stale, "r.gci.csv"), GCI_HEADER, first_order_rows(
+        "real-1d-base-finest", [("width_over_mfp_ft0.25", 2, 0)]))
+    out = os.path.join(work_dir, "stale-out", "convergence.md")
+    result = run("--input", stale, "--output", out, "--theoretical-orders", orders)
+    assert result.returncode == 2 and "judged at order 2, its theoretical order is 1" in \
+        result.stderr, f"exit {result.returncode}: {result.stderr.strip()}"
+    assert not os.path.exists(out), "a report was written from a table judged at another order"
+
+
+def test_a_real_problem_quantity_without_a_theoretical_order_is_refused(work_dir):
+    """A grid triple of the real problem whose quantity has no declared order has nothing to
+    be judged against: unreadable input, no report. A time-step study's own triple is judged
+    at its integrator's temporal order and needs none."""
+    orders = theoretical_orders_file(work_dir, [("max_mach", 2, "sampled-maximum")])
+    studies = (("real-1d-base-fine", True), ("real-time-d1-paper-implicit-s2-grid", True),
+               ("real-time-d1-paper-implicit-s2", False))
+    for study, refused in studies:
+        inputs = os.path.join(work_dir, study)
+        os.makedirs(inputs)
+        write(os.path.join(inputs, "r.gci.csv"), GCI_HEADER,
+              first_order_rows(study, [("shock_speed", 1, float("nan"))]))
+        out = os.path.join(work_dir, study + "-out", "convergence.md")
+        result = run("--input", inputs, "--output", out, "--theoretical-orders", orders)
+        if refused:
+            assert result.returncode == 2 and "'shock_speed'" not in result.stderr and \
+                "shock_speed: no theoretical order declared" in result.stderr, \
+                f"{study}: exit {result.returncode}: {result.stderr.strip()}"
+            assert not os.path.exists(out), f"{study}: a report was written"
+        else:
+            assert result.returncode == 0, f"{study}: {result.stderr}"
+
+
+def test_the_theoretical_orders_cover_every_quantity_of_the_grid_studies():
+    """The repository's table declares an order for every quantity the real problem's grid
+    studies write: those of the stored tables and those test_real_problem.cpp names."""
+    orders = make_convergence_report.read_theoretical_orders(
+        make_convergence_report.THEORETICAL_ORDERS)
+    tables = os.path.join(REPORTS, "convergence-tables")
+    written = {row["quantity"] for kind in ("gci", "bounds")
+               for path in glob.glob(os.path.join(tables, "**", f"real-*.{kind}.csv"),
+                                     recursive=True)
+               for row in csv_rows(path)}
+    source = os.path.join(os.path.dirname(REPORTS), "verification", "grid-studies",
+                          "test_real_problem.cpp")
+    named = set(re.findall(r'q\["([^"]+)"\]', open(source).read()))
+    assert len(named) >= 7 and len(written) >= 11, (named, written)
+    undeclared = sorted((written | named) - set(orders))
+    assert not undeclared, f"no theoretical order declared for {undeclared}"
+    assert {p for p, _ in orders.values()} <= {1.0, 2.0}, orders
+
+
+def test_an_integrator_difference_is_set_against_its_own_time_error(work_dir):
+    """A fast integrator's failing difference from the reference is explained where the
+    time-step study of the same setting measures a time error at its step that covers it, and
+    said to be unexplained where it does not, or where no such study exists."""
+    inputs = os.path.join(work_dir, "input")
+    os.makedirs(inputs)
+    write(os.path.join(inputs, "b.bounds.csv"), BOUNDS_HEADER, [
+        ("real-1d-integrator-paper-implicit-s2", "max_mach", 0.02, "difference", 0.01,
+         "grid uncertainty", 0),
+        ("real-1d-integrator-paper-implicit-s2", "shock_speed", 0.02, "difference", 0.01,
+         "grid uncertainty", 0),
+        ("real-1d-integrator-paper-implicit-s4", "max_mach", 0.02, "difference", 0.01,
+         "grid uncertainty", 0),
+        ("real-time-d1-paper-implicit-s2", "max_mach", 0.03, "time error", 0.01,
+         "grid uncertainty", 0),
+        ("real-time-d1-paper-implicit-s2", "shock_speed", 0.015, "time error", 0.01,
+         "grid uncertainty", 0)])
+    report = os.path.join(work_dir, "out", "convergence.md")
+    result = run("--input", inputs, "--output", report, "--commit", "abc")
+    assert result.returncode == 0, result.stderr
+    text = open(report).read()
+    rows = markdown_tables(text)["## Errors within their uncertainty"]
+    column = "time error of this integrator at its step"
+    cells = {(r["study"], r["quantity"]): r[column] for r in rows}
+    assert cells[("real-1d-integrator-paper-implicit-s2", "max_mach")] == "0.03", cells
+    assert cells[("real-1d-integrator-paper-implicit-s4", "max_mach")] == "no time-step study"
+    assert cells[("real-time-d1-paper-implicit-s2", "max_mach")] == "", cells
+    failures = failure_list(text)
+
+    def failure(study, quantity):
+        return next(f for f in failures if f"{study} / {quantity}:" in f)
+    assert "explained: this setting's own time error at its step, 0.03" in \
+        failure("real-1d-integrator-paper-implicit-s2", "max_mach")
+    assert "not explained by its time error at its step, 0.015" in \
+        failure("real-1d-integrator-paper-implicit-s2", "shock_speed")
+    assert "unexplained by measurement: no time-step study" in \
+        failure("real-1d-integrator-paper-implicit-s4", "max_mach")

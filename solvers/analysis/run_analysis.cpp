@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include "common/errors.hpp"
 #include "common/granular_model.hpp"
@@ -49,43 +50,49 @@ std::optional<FrontFit> fitted_front(const Profile& p, const Shock& shock, const
   return fit;
 }
 
-/// The phases of the shock's life: the longest run of stored phases with a shock (the first on
-/// a tie), in which one phase without a shock between two with one counts as a missed
-/// detection and does not end the life (the shock rule's thresholds are in standard errors, so
-/// at MD noise a real shock is missed at isolated phases). In a periodic run the last stored
-/// phase is followed by the first. Returns the phases with a shock, in time order.
-std::vector<std::size_t> longest_life(const std::vector<PhaseQuantities>& q, bool periodic) {
+/// The phases of the shock's life: the longest stretch of stored phases with a shock (the
+/// first on a tie), in which phases without a shock between two with one, lasting together at
+/// most max_gap (each stands for one phase spacing), are missed detections and do not end the
+/// life (the shock rule's thresholds are in standard errors, so at MD noise a real shock is
+/// missed at isolated phases). In a periodic run the last stored phase is followed by the
+/// first. Returns the phases with a shock, in time order.
+std::vector<std::size_t> longest_life(const std::vector<PhaseQuantities>& q, const AnalysisOptions& o) {
   const std::size_t m = q.size();
-  const auto has = [&](std::size_t k) { return q[k % m].shock.has_value(); };
-  const auto exists = [&](std::size_t k) { return periodic || k < m; };
-  // Phase k belongs to a life if it has a shock or is a one-phase gap inside one.
-  const auto alive = [&](std::size_t k) {
-    if (!exists(k)) return false;
-    if (has(k)) return true;
-    const bool before = k > 0 ? has(k - 1) : periodic && has(m - 1);
-    return before && exists(k + 1) && has(k + 1);
+  std::vector<std::size_t> seen;
+  for (std::size_t k = 0; k < m; ++k)
+    if (q[k].shock) seen.push_back(k);
+  const std::size_t d = seen.size();
+  if (d == 0 || d == m) return seen;
+  const double spacing = 1.0 / static_cast<double>(m);
+  // Stored phases without a shock before detection i (none before a run's first phase).
+  const auto missed_before = [&](std::size_t i) -> std::optional<std::size_t> {
+    if (i > 0) return seen[i] - seen[i - 1] - 1;
+    if (!o.periodic) return std::nullopt;
+    return seen[0] + m - seen[d - 1] - 1;
   };
+  const auto starts_a_life = [&](std::size_t i) {
+    const auto missed = missed_before(i);
+    return !missed || static_cast<double>(*missed) * spacing > o.max_gap * (1.0 + 1e-9);
+  };
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 0; i < d; ++i)
+    if (starts_a_life(i)) starts.push_back(i);
+  // Periodic with every gap bridged: one life round the cycle, starting after any gap.
+  const bool round_the_cycle = starts.empty();
+  if (round_the_cycle)
+    for (std::size_t i = 0; i < d; ++i)
+      if (*missed_before(i) > 0) starts.push_back(i);
+  std::size_t best_start = 0, best_count = 0, best_span = 0;
+  for (std::size_t i : starts) {
+    std::size_t count = 1;
+    while (count < d && (o.periodic || i + count < d) &&
+           (round_the_cycle || !starts_a_life((i + count) % d)))
+      ++count;
+    const std::size_t span = (seen[(i + count - 1) % d] + m - seen[i]) % m;
+    if (best_count == 0 || span > best_span) best_start = i, best_count = count, best_span = span;
+  }
   std::vector<std::size_t> life;
-  if (std::all_of(q.begin(), q.end(), [](const auto& x) { return x.shock.has_value(); })) {
-    for (std::size_t k = 0; k < m; ++k) life.push_back(k);
-    return life;
-  }
-  // With every phase alive (periodic, one-phase gaps only) a life starts after any gap.
-  bool every_phase_alive = true;
-  for (std::size_t k = 0; k < m; ++k) every_phase_alive = every_phase_alive && alive(k);
-  std::size_t best_start = 0, best_length = 0;
-  for (std::size_t start = 0; start < m; ++start) {
-    const std::size_t previous = start > 0 ? start - 1 : m - 1;
-    const bool continues = every_phase_alive ? has(previous)
-                           : start > 0 ? alive(start - 1) : periodic && alive(m - 1);
-    if (!has(start) || continues) continue;
-    std::size_t length = 0;
-    while (length < m && alive(start + length)) ++length;
-    while (length > 0 && !has(start + length - 1)) --length;  // a life ends on a shock
-    if (length > best_length) best_start = start, best_length = length;
-  }
-  for (std::size_t j = 0; j < best_length; ++j)
-    if (has(best_start + j)) life.push_back((best_start + j) % m);
+  for (std::size_t j = 0; j < best_count; ++j) life.push_back(seen[(best_start + j) % d]);
   return life;
 }
 
@@ -171,9 +178,18 @@ double fitted_curvature(const std::vector<double>& x, const std::vector<double>&
   return 2.0 * dc / d;
 }
 
+/// The height above the plate from which a front is resolved (AnalysisOptions::plate_clearance).
+double clear_of_plate(const AnalysisOptions& o, double bin_height) {
+  return std::max(o.plate_clearance, 2.0 * bin_height);
+}
+
+double mean(const std::vector<double>& v) {
+  return v.empty() ? nan : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
 std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
                                     const AnalysisOptions& o, double bin_height) {
-  const auto life = longest_life(q, o.periodic);
+  const auto life = longest_life(q, o);
   if (life.empty()) return std::nullopt;
   ShockLife s;
   s.phases = life;
@@ -197,26 +213,38 @@ std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
   const double spacing = m > 1 ? 1.0 / static_cast<double>(m) : 1.0;
   const bool seen_before = o.periodic || life.front() > 0;
   s.formation_phase = phase.front() - (seen_before ? 0.5 * spacing : 0.0);
-  // Exit: where the line through the last two gaps (layer top - shock) reaches zero, between
-  // the last phase with a shock and the next stored phase.
+  // Exit: where the gap (layer top - shock) reaches zero, on a line through the gaps of the
+  // life's last exit_window cycles (a time, so that finer sampling does not fit a line through
+  // two close, noisy points), at most exit_reach after the last phase with a shock (one
+  // spacing if coarser): near the layer's top the shock rule no longer sees the front, so the
+  // next stored phase without a shock does not bound the exit.
   const std::size_t last = life.back();
-  const double next_phase = phase.back() + spacing;
-  double exit = next_phase;
-  if (life.size() >= 2) {
-    const std::size_t before = life[life.size() - 2];
-    const double gap_last = q[last].layer->top - q[last].shock->location;
-    const double gap_before = q[before].layer->top - q[before].shock->location;
-    if (gap_before > gap_last)
-      exit = phase.back() + (phase.back() - phase[phase.size() - 2]) * gap_last / (gap_before - gap_last);
+  const double reach = std::max(spacing, o.exit_reach);
+  double exit = phase.back() + reach;
+  std::vector<double> late_phase, late_gap;
+  for (std::size_t j = 0; j < life.size(); ++j)
+    if (phase[j] >= phase.back() - o.exit_window || j + 2 >= life.size()) {
+      late_phase.push_back(phase[j]);
+      late_gap.push_back(q[life[j]].layer->top - q[life[j]].shock->location);
+    }
+  if (late_phase.size() >= 2) {
+    const double closing = -fitted_slope(late_phase, late_gap).first;
+    if (closing > 0.0) exit = mean(late_phase) + mean(late_gap) / closing;
   }
-  s.exit_phase = std::clamp(exit, phase.back(), next_phase);
+  s.exit_phase = std::clamp(exit, phase.back(), phase.back() + reach);
   if (!o.periodic && last + 1 == m) s.exit_phase = nan;  // the run ended with the shock inside
   s.lifetime = s.exit_phase - s.formation_phase;
-  // A front within two bins of the plate sits in the lowest bins, whatever its true
-  // height: those phases locate the bin, not the front, and are left out of the speed's fit.
-  std::vector<double> t_resolved, height_resolved;
+  // A front near the plate sits in the lowest bins, whatever its true height: those phases
+  // locate the bin, not the front, and are left out of the speed's fit and of d and d/xi.
+  std::vector<double> t_resolved, height_resolved, width, width_over_mfp;
   for (std::size_t j = 0; j < t.size(); ++j)
-    if (height[j] >= 2.0 * bin_height) t_resolved.push_back(t[j]), height_resolved.push_back(height[j]);
+    if (height[j] >= clear_of_plate(o, bin_height)) {
+      t_resolved.push_back(t[j]), height_resolved.push_back(height[j]);
+      width.push_back(q[life[j]].shock->width);
+      width_over_mfp.push_back(q[life[j]].shock->width_over_mfp());
+    }
+  s.width_mean = mean(width);
+  s.width_over_mfp_mean = mean(width_over_mfp);
   if (t_resolved.size() >= 3) std::tie(s.speed, s.speed_fit_error) = robust_slope(t_resolved, height_resolved, 2.0 * bin_height);
   else if (t.size() >= 2) std::tie(s.speed, s.speed_fit_error) = robust_slope(t, height, 2.0 * bin_height);
   else s.speed = s.speed_fit_error = nan;
@@ -252,6 +280,7 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
   for (const auto& q : r.phases) {
     com += q.center_of_mass;
     r.center_of_mass_apex = std::max(r.center_of_mass_apex, q.center_of_mass);
+    r.max_mach_peak = std::max(r.max_mach_peak, q.max_mach);
     if (std::isfinite(q.layer_temperature) && !(q.layer_temperature <= r.layer_temperature_peak))
       r.layer_temperature_peak = q.layer_temperature;
   }
@@ -262,7 +291,8 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
   if (r.shock) {
     double best = -1.0;
     for (std::size_t k : r.shock->phases)
-      if (r.phases[k].shock->width_over_mfp() > best) {
+      if (r.phases[k].shock->location - r.phases[k].plate_z >= clear_of_plate(options, r.bin_height) &&
+          r.phases[k].shock->width_over_mfp() > best) {
         best = r.phases[k].shock->width_over_mfp();
         r.width_over_mfp_peak_phase = r.phases[k].phase;
       }
@@ -333,6 +363,10 @@ std::vector<NamedValues> run_values(const RunQuantities& r) {
       {"shock_speed_fit_error", "sqrt(g sigma)", {life(&ShockLife::speed_fit_error)}},
       {"shock_curvature", "g", {life(&ShockLife::curvature)}},
       {"shock_phases", "1", {r.shock ? static_cast<double>(r.shock->phases.size()) : 0.0}, {1.0}},
+      {"shock_width_mean", "sigma", {life(&ShockLife::width_mean)}, {r.bin_height}},
+      {"width_over_mfp_mean", "1", {life(&ShockLife::width_over_mfp_mean)},
+       {r.bin_height * life(&ShockLife::width_over_mfp_mean) / life(&ShockLife::width_mean)}},
+      {"max_mach_peak", "1", {r.max_mach_peak}},
       {"center_of_mass_mean", "sigma", {r.center_of_mass_mean}},
       {"center_of_mass_apex", "sigma", {r.center_of_mass_apex}},
       {"width_over_mfp_peak_phase", "1", {r.width_over_mfp_peak_phase}, {spacing}},

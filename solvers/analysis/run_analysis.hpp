@@ -42,6 +42,8 @@ struct ShockLife {
   double speed = 0.0;               ///< slope of location - plate_z against t, plate frame
   double speed_fit_error = 0.0;     ///< standard error of that slope from the fit residuals
   double curvature = 0.0;           ///< 2 x the t^2 coefficient of location(t); NaN if < 4 points
+  /// Means over the phases of the life with the front clear of the plate (NaN without one).
+  double width_mean = 0.0, width_over_mfp_mean = 0.0;
 };
 
 struct RunQuantities {
@@ -50,6 +52,7 @@ struct RunQuantities {
   double center_of_mass_mean = 0.0, center_of_mass_apex = 0.0;
   double width_over_mfp_peak_phase = 0.0;  ///< phase of the largest d/xi in the life (NaN)
   double layer_temperature_peak = 0.0;     ///< largest layer_temperature over the phases
+  double max_mach_peak = 0.0;              ///< largest max_mach over the phases
   double bin_height = 0.0;                 ///< of the profiles (MD bin or continuum cell)
 };
 
@@ -58,6 +61,17 @@ inline constexpr double gas_span_above_layer = 10.0;
 
 struct AnalysisOptions {
   ShockCriteria criteria;
+  /// The longest time, in cycles, for which the shock rule may miss a shock without ending its
+  /// life: each stored phase without a shock between two with one stands for one phase
+  /// spacing. A time, not a count of phases, so that the life does not depend on how finely
+  /// the run is stored (docs/analysis.md).
+  double max_gap = 0.02;
+  /// A front closer to the plate than this (sigma), or than two bins, sits in the lowest bins
+  /// whatever its true height: such phases are left out of the speed and of d and d/xi.
+  double plate_clearance = 2.0;
+  /// The exit is extrapolated from the gap (layer top - shock) over the life's last
+  /// exit_window cycles, at most exit_reach cycles beyond the last phase with a shock.
+  double exit_window = 0.06, exit_reach = 0.05;
   bool periodic = true;  ///< the stored phases are one periodic cycle (a life may wrap)
   double frequency = 1.0;  ///< f, to place phases of a wrapped life on one time axis
 };

@@ -24,6 +24,24 @@ config::Config load(const RunOptions& options) {
 
 }  // namespace
 
+CLI::Validator finite_between(double low, double high) {
+  const std::string allowed = fmt::format("allowed: a number with {} <= value <= {}", low, high);
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double value = 0.0;
+        std::size_t used = 0;
+        try {
+          value = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != text.size() || !std::isfinite(value) || value < low || value > high)
+          return fmt::format("value '{}' is not a finite number in range; {}", text, allowed);
+        return {};
+      },
+      fmt::format("NUMBER in [{}, {}]", low, high));
+}
+
 CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::string& help,
                              RunOptions& options) {
   auto* sub = app.add_subcommand(name, help);
@@ -43,6 +61,7 @@ CLI::App* add_solver_subcommand(CLI::App& app, const std::string& name, const st
                   fmt::format("seconds between progress lines when stderr is not a terminal "
                               "(a terminal gets one live line); allowed: {}",
                               progress_interval_range.describe()))
+      ->check(finite_between(progress_interval_range.lo, progress_interval_range.hi))
       ->capture_default_str();
   return sub;
 }
@@ -126,6 +145,20 @@ void require_comparable_profiles(const RunRecord& run, const std::string& path) 
     throw InputError(fmt::format("run file '{}' stores no profile; compare needs at least one phase "
                                  "with at least 2 bins", path));
 }
+
+/// compare matches the runs phase by phase: both must store the same phases.
+void require_same_phases(const RunRecord& a, const RunRecord& b, const std::string& first,
+                         const std::string& second) {
+  if (a.profiles.size() != b.profiles.size())
+    throw InputError(fmt::format("run file '{}' stores {} phases, the reference '{}' {}; allowed: "
+                                 "runs of the same run.phases_per_cycle", first, a.profiles.size(),
+                                 second, b.profiles.size()));
+  for (std::size_t k = 0; k < a.profiles.size(); ++k)
+    if (std::abs(a.profiles[k].phase - b.profiles[k].phase) > 1e-9)
+      throw InputError(fmt::format("run file '{}' stores phase {} where the reference '{}' stores {}; "
+                                   "allowed: the same phases in both", first, a.profiles[k].phase,
+                                   second, b.profiles[k].phase));
+}
 }  // namespace
 
 int command_compare(const std::string& first, const std::string& second,
@@ -134,6 +167,7 @@ int command_compare(const std::string& first, const std::string& second,
   const RunRecord a = read_run_file(first), b = read_run_file(second);
   require_comparable_profiles(a, first);
   require_comparable_profiles(b, second);
+  require_same_phases(a, b, first, second);
   const auto r = analysis::compare_runs(a, b);
   const auto metrics = comparison_metrics(r);
   const auto replicates = comparison_replicates(a, b);

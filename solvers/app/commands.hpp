@@ -15,6 +15,10 @@ struct RunOptions {
   ProgressSettings progress;  ///< solvers only
 };
 
+/// A command-line number that must be finite and within [low, high]: refuses an empty value, a
+/// word, nan and inf (CLI::Range lets nan through, and an empty value keeps the default).
+CLI::Validator finite_between(double low, double high);
+
 /// A subcommand taking CONFIG and any number of --set key=value.
 CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::string& help,
                              RunOptions& options);

@@ -2,7 +2,9 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 
 #include "app/commands.hpp"
@@ -51,13 +53,13 @@ int main(int argc, char** argv) {
   analyze->add_flag("--quiet", analysis.quiet, "print nothing (with --json or --csv)");
   analyze->add_option("--relative-drop", analysis.criteria.relative_drop,
                       "shock rule: minimum (T_max - T_min) / T_max")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+      ->check(finite_between(0.0, 1.0))->capture_default_str();
   analyze->add_option("--standard-errors", analysis.criteria.standard_errors,
                       "shock rule: minimum drop in combined standard errors")
-      ->check(CLI::Range(0.0, 100.0))->capture_default_str();
+      ->check(finite_between(0.0, 100.0))->capture_default_str();
   analyze->add_option("--deceleration", analysis.criteria.deceleration,
                       "shock rule: minimum fraction of the incoming velocity lost")
-      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+      ->check(finite_between(0.0, 1.0))->capture_default_str();
 
   std::string first, second, compare_csv;
   auto* compare = app.add_subcommand(
@@ -82,13 +84,22 @@ int main(int argc, char** argv) {
   struct FinalizeRanks {
     ~FinalizeRanks() { Ranks::finalize(); }
   } finalize_ranks;
-  try {
+  const auto run_command = [&] {
     if (app.got_subcommand("md")) return command_md(run_md);
     if (app.got_subcommand("continuum")) return command_continuum(run_continuum);
     if (app.got_subcommand("config"))
       return describe ? command_describe(markdown) : command_config(show_config);
     if (app.got_subcommand("analyze")) return command_analyze(analysis);
     if (app.got_subcommand("compare")) return command_compare(first, second, compare_csv);
+    return 2;
+  };
+  try {
+    const int code = run_command();
+    // What a command printed (a table, a summary) is part of its result: lost output (a full
+    // disk, a closed pipe) is a failure, not a success.
+    if (code == 0 && (std::fflush(stdout) != 0 || std::ferror(stdout)))
+      throw std::runtime_error(fmt::format("cannot write to standard output ({})", std::strerror(errno)));
+    return code;
   } catch (const StopRequested& stop) {
     if (*stop.what() != '\0') fmt::print(stderr, "{}\n", stop.what());
     return stop.exit_code();

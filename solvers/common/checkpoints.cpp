@@ -25,8 +25,7 @@ CheckpointSettings CheckpointSettings::from(const config::Config& config) {
 
 std::filesystem::path CheckpointSettings::stop_file() const {
   if (!file.empty()) return file;
-  std::filesystem::path beside_output = run_output;
-  return beside_output.replace_extension(".checkpoint.h5");
+  return derived_name(run_output, ".checkpoint.h5");
 }
 
 std::vector<NamedPath> CheckpointSettings::outputs() const {
@@ -53,7 +52,7 @@ std::string restart_source(const std::filesystem::path& path) {
 }
 
 std::filesystem::path previous_checkpoint(std::filesystem::path file) {
-  return file.replace_extension(".previous.h5");
+  return derived_name(std::move(file), ".previous.h5");
 }
 
 void write_checkpoint_header(hid_t file, const std::string& kind, const SchedulePosition& position,
@@ -146,6 +145,15 @@ void CheckpointObserver::at_run_end(double t) {
   const int signal = ranks_.agree(DeferredStop::requested());
   if (!settings_.file.empty() && signal == 0) save(settings_.file);
   stop_if_asked(t, signal);
+  // A signal that came while the final checkpoint was written stops the run after it.
+  if (const int late = ranks_.agree(DeferredStop::requested()); late != 0) {
+    if (settings_.file.empty()) stop_if_asked(t, late);
+    throw StopRequested(late, !ranks_.writer ? std::string() : fmt::format(
+        "{}: stopped by signal {} ({}) while the final checkpoint was written, at t = {:.10g}; the "
+        "checkpoint {} is complete (at the end of the run's cycles); no run file was written: to "
+        "go on, raise run.sampled_cycles and --set run.restart_from={}", label_, late,
+        late == SIGINT ? "SIGINT" : "SIGTERM", t, settings_.file.string(), settings_.file.string()));
+  }
   // From here on the run writes its outputs: a signal removes them and exits at once.
   deferred_.reset();
 }

@@ -14,6 +14,7 @@
 #include <toml.hpp>
 
 #include "common/errors.hpp"
+#include "common/hdf5_file.hpp"
 
 namespace shaker::config {
 
@@ -439,6 +440,7 @@ Config Config::load(const std::filesystem::path& file, const std::vector<std::st
     if (std::filesystem::is_directory(file))
       throw InputError(fmt::format("configuration file '{}' is a directory: give the case file (TOML)",
                                    file.string()));
+    check_input_file({"configuration file", file});
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(fmt::format("cannot open configuration file '{}'", file.string()));
     config = parse_document(in, file.string(), false);

@@ -133,15 +133,23 @@ template <class S> struct ConstitutiveValues {
   S G, chi, pressure, sound_speed, collisional_loss, bulk_viscosity, shear_viscosity,
       thermal_conductivity;
 };
-template <class S>
-ConstitutiveValues<S> constitutive_values(const S& n, const S& T, double e, Transport transport) {
-  using std::pow;
+/// x^a for x = nu / nu_max, a = detail::g0_exponent: pow. A caller may pass its own (the
+/// continuum's closure remembers the values per cell, continuum/transport.cpp).
+struct G0Power {
+  template <class S> S operator()(const S& x) const {
+    using std::pow;
+    return pow(x, detail::g0_exponent);
+  }
+};
+template <class S, class Power = G0Power>
+ConstitutiveValues<S> constitutive_values(const S& n, const S& T, double e, Transport transport,
+                                          const Power& g0_power = {}) {
   using std::sqrt;
   const S nu = volume_fraction(n);
   detail::require_volume_fraction(nu, "constitutive_values");
   detail::require_temperature(T, "constitutive_values");
   detail::require_restitution(e, "constitutive_values");
-  const S power = pow(nu / nu_max, detail::g0_exponent);
+  const S power = g0_power(nu / nu_max);
   const S g = 1.0 / (1.0 - power);
   ConstitutiveValues<S> r;
   r.G = nu * g;

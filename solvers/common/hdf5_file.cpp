@@ -131,6 +131,7 @@ void close_file(Handle& file) {
 Handle open_file(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path))
     throw InputError(fmt::format("file '{}' does not exist", path.string()));
+  check_input_file({"file", path});
   if (H5Fis_hdf5(path.c_str()) <= 0)
     throw InputError(fmt::format("file '{}' is not an HDF5 file", path.string()));
   const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -366,9 +367,43 @@ void install_signal_cleanup() {
   for (int s : {SIGTERM, SIGINT, SIGHUP}) ::sigaction(s, &action, nullptr);
 }
 
-AtomicOutput::AtomicOutput(std::filesystem::path final_path) : final_(std::move(final_path)) {
-  temporary_ = final_;
-  temporary_ += fmt::format(".partial-{}", ::getpid());
+namespace {
+/// The longest file name in `directory` (NAME_MAX of its file system; 255 if unknown).
+std::size_t longest_name(const std::filesystem::path& directory) {
+  const long limit = ::pathconf(directory.empty() ? "." : directory.c_str(), _PC_NAME_MAX);
+  return limit > 0 ? static_cast<std::size_t>(limit) : 255;
+}
+
+/// NAME.partial-PID beside NAME; when that is longer than the file system allows, NAME is
+/// shortened and a hash of it keeps temporary names of different outputs apart.
+std::filesystem::path temporary_name(const std::filesystem::path& final_path) {
+  const std::string suffix = fmt::format(".partial-{}", ::getpid());
+  const std::string name = final_path.filename().string();
+  const std::size_t limit = longest_name(final_path.parent_path());
+  if (name.size() + suffix.size() <= limit) return final_path.string() + suffix;
+  const std::string tag = fmt::format("~{:016x}", std::hash<std::string>{}(name));
+  const std::string kept = name.substr(0, limit - std::min(limit, suffix.size() + tag.size()));
+  return final_path.parent_path() / (kept + tag + suffix);
+}
+}  // namespace
+
+std::filesystem::path derived_name(std::filesystem::path path, const std::string& extension) {
+  const std::string stem = path.stem().string();
+  const std::size_t limit = longest_name(path.parent_path());
+  if (stem.size() + extension.size() <= limit) return path.replace_extension(extension);
+  return path.parent_path() / (stem.substr(0, limit - std::min(limit, extension.size())) + extension);
+}
+
+/// Where an output goes: the file a symbolic link points to (the link is kept), else the path.
+std::filesystem::path output_target(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::is_symlink(path, error)) return path;
+  const auto target = std::filesystem::weakly_canonical(path, error);
+  return error ? path : target;
+}
+
+AtomicOutput::AtomicOutput(const std::filesystem::path& final_path)
+    : final_(output_target(final_path)), temporary_(temporary_name(final_)) {
   cleanup_slot_ = register_for_cleanup(temporary_);
 }
 
@@ -395,15 +430,45 @@ std::filesystem::path resolved(const std::filesystem::path& path) {
 }
 }  // namespace
 
+std::string file_type_name(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  switch (fs::status(path).type()) {
+    case fs::file_type::regular: return "a regular file";
+    case fs::file_type::directory: return "a directory";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    case fs::file_type::fifo: return "a FIFO (named pipe)";
+    case fs::file_type::socket: return "a socket";
+    case fs::file_type::not_found: return "missing";
+    default: return "not a regular file";
+  }
+}
+
+void check_input_file(const NamedPath& input) {
+  if (std::filesystem::exists(input.path) && !std::filesystem::is_regular_file(input.path))
+    throw InputError(fmt::format("{} '{}' is {}; allowed: a regular file", input.what,
+                                 input.path.string(), file_type_name(input.path)));
+}
+
 void check_output_paths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
   namespace fs = std::filesystem;
   for (std::size_t k = 0; k < outputs.size(); ++k) {
     const auto& [what, path] = outputs[k];
     if (path.empty())
       throw InputError(fmt::format("{} is empty: it must name the output file", what));
+    if (path.filename().string().size() > longest_name(path.parent_path()))
+      throw InputError(fmt::format("{} = \"{}\": the file name has {} bytes; allowed: at most {} "
+                                   "(the file system's longest name)", what, path.string(),
+                                   path.filename().string().size(), longest_name(path.parent_path())));
     if (fs::is_directory(path))
       throw InputError(fmt::format("{} = \"{}\" is a directory: it must name a file", what, path.string()));
-    const fs::path directory = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    // A new output is renamed over the old file: a device or a FIFO would be replaced.
+    if (fs::exists(path) && !fs::is_regular_file(path))
+      throw InputError(fmt::format("{} = \"{}\" is {}: an output replaces the file under its name, "
+                                   "so it must name a regular file or a new one", what,
+                                   path.string(), file_type_name(path)));
+    const fs::path target = output_target(path);
+    const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(directory))
       throw InputError(fmt::format("{} = \"{}\": the directory '{}' does not exist", what,
                                    path.string(), directory.string()));

@@ -73,7 +73,8 @@ namespace shaker {
 /// and nothing exists under the final name.
 class AtomicOutput {
  public:
-  explicit AtomicOutput(std::filesystem::path final_path);
+  /// A symbolic link under `final_path` stays: the file it points to is replaced.
+  explicit AtomicOutput(const std::filesystem::path& final_path);
   AtomicOutput(const AtomicOutput&) = delete;
   AtomicOutput& operator=(const AtomicOutput&) = delete;
   ~AtomicOutput();
@@ -85,6 +86,11 @@ class AtomicOutput {
   bool committed_ = false;
   int cleanup_slot_ = -1;  ///< slot in the signal handler's registry
 };
+
+/// `path` with its extension replaced by `extension` (".previous.h5"), the stem shortened where
+/// the name would be longer than its file system allows: the files derived from an output
+/// whose own name is at that limit.
+std::filesystem::path derived_name(std::filesystem::path path, const std::string& extension);
 
 /// Writes an HDF5 file atomically: `fill` writes into the new file (given its id), which is
 /// then flushed and closed; any failure (a full disk) throws std::runtime_error naming `path`
@@ -119,8 +125,15 @@ struct NamedPath {
   std::filesystem::path path;
 };
 /// Checked before any work (InputError naming the key and the path): every output is not empty,
-/// not a directory, in an existing writable directory, and differs from every input and from
-/// every other output (compared after resolving ".", ".." and symbolic links).
+/// a regular file if it exists (never a directory, device, FIFO or socket: it is replaced by a
+/// rename), a name the file system allows, in an existing writable directory, and differs from
+/// every input and from every other output (compared after resolving ".", ".." and symbolic
+/// links).
 void check_output_paths(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
+/// An input that exists must be a regular file (InputError naming it otherwise): opening a
+/// FIFO would wait for a writer forever, a device would be read without end.
+void check_input_file(const NamedPath& input);
+/// "a regular file", "a FIFO (named pipe)", "a character device", ... (symbolic links followed).
+std::string file_type_name(const std::filesystem::path& path);
 
 }  // namespace shaker

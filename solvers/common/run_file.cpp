@@ -12,6 +12,7 @@
 #include <utility>
 #include <sstream>
 
+#include "common/config.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/version.hpp"
@@ -230,8 +231,17 @@ TimeSeries read_series(hid_t parent, const std::string& name) {
   h5::Handle group = h5::open_group(parent, name);
   TimeSeries series;
   std::stringstream names(h5::read_string_attribute(group.id(), "columns"));
-  for (std::string column; std::getline(names, column, ',');)
-    series.add(column, h5::read_doubles(group.id(), column));
+  for (std::string column; std::getline(names, column, ',');) {
+    auto values = h5::read_doubles(group.id(), column);
+    if (series.has(column))
+      throw InputError(fmt::format("{}: column '{}' is listed twice in attribute 'columns'; allowed: "
+                                   "each column once", name, column));
+    if (!series.columns.empty() && values.size() != series.columns.front().size())
+      throw InputError(fmt::format("{}/{} has {} rows; allowed: {}, the rows of {}/{} (the columns "
+                                   "of a series have equal lengths)", name, column, values.size(),
+                                   series.columns.front().size(), name, series.names.front()));
+    series.add(column, std::move(values));
+  }
   return series;
 }
 
@@ -325,6 +335,10 @@ RunRecord read_run_file(const std::filesystem::path& path) {
     record.model_variant = h5::read_string_attribute(file.id(), "model_variant");
     record.configuration = h5::read_string_attribute(file.id(), "configuration");
     record.e = h5::read_double_attribute(file.id(), "restitution_for_analysis");
+    const config::Range restitution = config::find_spec("material.e").range;
+    if (!std::isfinite(record.e) || !restitution.contains(record.e))
+      throw InputError(fmt::format("attribute 'restitution_for_analysis' = {}; allowed: {} (material.e)",
+                                   record.e, restitution.describe()));
     record.profiles = read_profiles(file.id());
     record.samples = read_samples(file.id(), record.profiles.size(),
                                   record.profiles.empty() ? 0 : record.profiles.front().size());

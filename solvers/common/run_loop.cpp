@@ -69,6 +69,17 @@ void PhaseSchedule::resume_at(const SchedulePosition& p, double time, const std:
     throw InputError(fmt::format("{} is not a valid checkpoint: its time t = {} lies after the "
                                  "stored phase it continues at (cycle {}, phase {}: t = {})",
                                  source, time, p.cycle, p.phase, next));
+  // The checkpoint was written at the stored phase before (in its own phases), or at the start:
+  // a time or schedule_start_time that puts it earlier would run for ever towards `next`.
+  const double previous = p.cycle == 0 && p.phase == 0
+                              ? start_time_
+                              : time_of(origin_ + static_cast<double>(p.cycle) +
+                                        static_cast<double>(p.phase - 1) / static_cast<double>(p.phases));
+  if (!(time >= previous - 1e-9 * time_of(1.0)))
+    throw InputError(fmt::format("{} is not a valid checkpoint: its time t = {} lies before the stored "
+                                 "phase it was written at (t = {}, from schedule_start_time = {}, "
+                                 "cycle {}, phase {} of {}); allowed: {} <= t <= {}", source, time,
+                                 previous, start_time_, p.cycle, p.phase, p.phases, previous, next));
   first_ = first;
 }
 

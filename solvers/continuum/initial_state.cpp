@@ -20,6 +20,13 @@ double flat_layer(const Grid& g, const LayerSpecification& layer, State& state) 
         layer.background_volume_fraction, layer.volume_fraction));
   // n_layer top + n_background (height - top) = mass per area
   const double top = (layer.mass_per_area - n_background * height) / (n_layer - n_background);
+  if (!(n_background * height < layer.mass_per_area))
+    throw InputError(fmt::format(
+        "continuum.background_volume_fraction = {} fills the height continuum.ceiling = {} with "
+        "{:.4g} particles per unit area, more than the layer's {:.4g}; allowed: "
+        "continuum.background_volume_fraction < {:.4g} here", layer.background_volume_fraction,
+        height, n_background * height, layer.mass_per_area,
+        layer.background_volume_fraction * layer.mass_per_area / (n_background * height)));
   if (!(top > 0.0) || top >= height)
     throw InputError(fmt::format(
         "continuum.ceiling = {} is below the initial layer: {} particles per unit area at "

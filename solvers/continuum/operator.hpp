@@ -163,7 +163,7 @@ class Operator {
   /// The primitives and closure of the interior, then copied to the ghosts; with a halo every
   /// rank fails alike (DomainError with the first failing rank's message) if any rank fails.
   void evaluate_closure(const State& U, bool need_transport);
-  void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp
+  void update_primitives_and_closure(const State& U, bool need_transport);  // transport.cpp, primitives.cpp
   void copy_closure_to_ghosts();                                             // boundary.cpp
   /// The fields whose ghosts are filled: the primitives, then the closure values the fluxes
   /// read beside a cell (boundary.cpp).
@@ -174,7 +174,7 @@ class Operator {
   /// Copies row `first`'s periodic x ghosts of the ghosted fields (its interior cells filled).
   void copy_row_to_x_ghosts(std::ptrdiff_t first);                          // boundary.cpp
   /// The faces of planes k0 .. k1 - 1 (along z: faces k0 .. k1 - 1, and nz with the last).
-  void add_inviscid_fluxes(State& dUdt, int k0, int k1);                     // riemann.cpp
+  void add_inviscid_fluxes(State& dUdt, int k0, int k1);                     // inviscid_sweep.cpp
   void add_diffusive_fluxes(State& dUdt, int k0, int k1);                    // viscous_flux.cpp
   /// The face-based artificial dissipation forms (artificial_dissipation.cpp).
   void add_artificial_fluxes(State& dUdt);

@@ -215,9 +215,7 @@ void write_fields(const std::filesystem::path& h5_path, const Grid& g,
         h5::write(group.id(), column.name, f.*column.values, shape, column.units);
     }
   });
-  std::filesystem::path sidecar = h5_path;
-  sidecar.replace_extension(".xdmf");
-  write_text_atomically(sidecar, xdmf_text(h5_path.filename().string(), g, snapshots));
+  write_text_atomically(derived_name(h5_path, ".xdmf"), xdmf_text(h5_path.filename().string(), g, snapshots));
 }
 
 }  // namespace shaker::continuum

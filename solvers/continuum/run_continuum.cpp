@@ -240,8 +240,8 @@ class DrivenIntegrator final : public DrivenSolver {
 };
 
 /// Where a step failure leaves the last good state: OUTPUT.last_good.h5.
-std::filesystem::path last_good_path(std::filesystem::path output) {
-  return output.replace_extension(".last_good.h5");
+std::filesystem::path last_good_path(const std::filesystem::path& output) {
+  return derived_name(output, ".last_good.h5");
 }
 
 /// Every file the run may write, none equal to an input or to another (checked before work).
@@ -250,9 +250,9 @@ void check_outputs(const ContinuumCase& c, const CheckpointSettings& checkpoints
   std::vector<NamedPath> outputs{{"run.output", output}};
   if (!output.empty()) outputs.push_back({"run.output's last-good checkpoint", last_good_path(output)});
   if (!c.field_phases.empty() && !output.empty()) {
-    std::filesystem::path fields = output;
-    outputs.push_back({"run.output's fields file", fields.replace_extension(".fields.h5")});
-    outputs.push_back({"run.output's fields sidecar", fields.replace_extension(".xdmf")});
+    const std::filesystem::path fields = derived_name(output, ".fields.h5");
+    outputs.push_back({"run.output's fields file", fields});
+    outputs.push_back({"run.output's fields sidecar", derived_name(fields, ".xdmf")});
   }
   checkpoints.check_paths(outputs, inputs);
 }
@@ -418,9 +418,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   record.profiles = profiles.averages();
   record.series = recorder.series();
   if (!fields.snapshots.empty()) {
-    std::filesystem::path fields_path = output;
-    fields_path.replace_extension(".fields.h5");
-    write_fields(fields_path, c.grid, fields.snapshots, record);
+    write_fields(derived_name(output, ".fields.h5"), c.grid, fields.snapshots, record);
   }
   write_run_file(output, record);
   const Counters counters = box.view().scalars.counters;

@@ -7,6 +7,7 @@
 
 #include "common/errors.hpp"
 #include "common/ranks.hpp"
+#include "common/units.hpp"
 #include "continuum/halo.hpp"
 
 namespace shaker::continuum {
@@ -53,6 +54,21 @@ std::vector<std::int64_t> field_phase_indices(const config::Config& config, int 
   return indices;
 }
 
+/// A 3D layer's cells are drawn up to (1 + p) times the layer's density and then all scaled
+/// by the mass correction, at most 1 / (1 - p): both keys together must keep every cell below
+/// the clamp at 0.999 nu_max, where the constitutive functions end.
+void check_perturbation(const LayerSpecification& l, int dimension) {
+  if (dimension != 3) return;
+  const double ratio = 0.999 * nu_max / l.volume_fraction;
+  const double largest = (ratio - 1.0) / (ratio + 1.0);
+  if (l.perturbation >= largest)
+    throw InputError(fmt::format(
+        "continuum.perturbation = {} with continuum.initial_volume_fraction = {} can put a cell of "
+        "the initial layer at nu = {:.4g} (after the mass correction), at or past 0.999 nu_max = {:.4g}; allowed: "
+        "0 <= continuum.perturbation < {:.4g} at this volume fraction (or a lower "
+        "continuum.initial_volume_fraction)", l.perturbation, l.volume_fraction,
+        l.volume_fraction * (1.0 + l.perturbation) / (1.0 - l.perturbation), 0.999 * nu_max, largest));
+}
 }  // namespace
 
 ContinuumCase continuum_case(const config::Config& config) {
@@ -101,6 +117,7 @@ ContinuumCase continuum_case(const config::Config& config) {
   l.background_volume_fraction = config.real("continuum.background_volume_fraction");
   l.temperature = config.real("continuum.initial_temperature");
   l.perturbation = config.real("continuum.perturbation");
+  check_perturbation(l, c.grid.dimension);
   l.seed = c.parameters.run.seed;
   c.field_phases = field_phase_indices(config, c.grid.dimension, c.parameters.run.phases_per_cycle);
   // The layer must fit under the ceiling: checked now, before anything runs or is written, on

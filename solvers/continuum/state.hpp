@@ -36,6 +36,11 @@ inline Primitive to_primitive(const State& s, std::size_t c) {
   return w;
 }
 
+/// to_primitive of the cells first .. first + length - 1 into w (n, ux, uy, uz, T), adjacent
+/// cells at once, per cell bit for bit to_primitive (primitives.cpp).
+void to_primitives(const State& U, std::array<std::vector<double>, variable_count>& w, std::ptrdiff_t first,
+                   int length);
+
 inline void store_primitive(State& s, std::size_t c, const Primitive& w) {
   s.q[density][c] = w.n;
   s.q[momentum_x][c] = w.n * w.ux;

@@ -1,5 +1,6 @@
-// Primitive variables and the closure (pressure, sound speed, transport coefficients) per
-// cell, from the constitutive functions of common/granular_model.hpp only.
+// The closure (pressure, sound speed, transport coefficients, collisional loss) per cell, from
+// the constitutive functions of common/granular_model.hpp only, and the row loop that forms
+// the primitives (primitives.cpp) and the closure a row at a time.
 //
 // Transport variants (docs/models.md): `full` keeps every term of mu and kappa; `paper` drops
 // their 1/G terms (the model functions do that) and adds the artificial dissipation of
@@ -52,31 +53,31 @@ template <int W> struct Lanes {
 /// of the density alone, and the split integrators evaluate the closure twice at the same
 /// density (the diffusive half steps change u and T only): a lane whose argument equals the
 /// one remembered for its cell takes the remembered value (the same bits), the others call
-/// std::pow and remember. The memo of the lane group being evaluated, per thread.
+/// std::pow and remember. The memo of the lane group being evaluated.
 struct PowMemo {
   double argument[4], value[4];
 };
-thread_local PowMemo* pow_memo = nullptr;
-
-template <int W> Lanes<W> pow(const Lanes<W>& a, double b) {
-  static_assert(W == 4, "PowMemo holds four lanes");
-  Lanes<W> r;
-  PowMemo* memo = b == model::detail::g0_exponent ? pow_memo : nullptr;
-  for (int l = 0; l < W; ++l) {
-    if (memo && a.v[l] == memo->argument[l]) {
-      r.v[l] = memo->value[l];
-    } else {
-      r.v[l] = std::pow(a.v[l], b);
-      if (memo) {
-        memo->argument[l] = a.v[l];
-        memo->value[l] = r.v[l];
-      }
-    }
-  }
-  return r;
-}
 constexpr int lane_count = 4;
 using Cells = Lanes<lane_count>;
+
+/// The model's g0 power (model::constitutive_values' g0_power) of a lane group, through its memo.
+struct RememberedG0Power {
+  PowMemo& memo;
+  Cells operator()(const Cells& a) const {
+    static_assert(lane_count == 4, "PowMemo holds four lanes");
+    Cells r;
+    for (int l = 0; l < lane_count; ++l) {
+      if (a.v[l] == memo.argument[l]) {
+        r.v[l] = memo.value[l];
+      } else {
+        r.v[l] = std::pow(a.v[l], model::detail::g0_exponent);
+        memo.argument[l] = a.v[l];
+        memo.value[l] = r.v[l];
+      }
+    }
+    return r;
+  }
+};
 
 template <class S> struct CellClosure {
   S p, c, mu, lambda, kappa, loss;
@@ -90,10 +91,22 @@ bool needs_model(const PhysicsSettings& s, bool need_transport) {
   return (terms.pressure && !ideal) || terms.collisional_loss || transport;
 }
 
+/// The `transport_coefficients` artificial dissipation (ArtificialDissipation, operator.hpp),
+/// added to the cell's mu and kappa.
+template <class S> void add_artificial_transport(const PhysicsSettings& s, const S& n, double h, CellClosure<S>& r) {
+  const Terms& terms = s.terms;
+  const S x = volume_fraction(n) / s.artificial.volume_fraction;
+  const S x2 = x * x;
+  const S weight = n * h * r.c / (1.0 + x2 * x2);
+  if (terms.shear_viscosity) r.mu += s.artificial.viscosity * weight;
+  if (terms.conduction) r.kappa += s.artificial.conductivity * weight;
+}
+
 // One fused evaluation of the model per cell (model::constitutive_values: G once), and only
 // when some enabled term needs it.
-template <class S>
-CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double h, bool need_transport) {
+template <class S, class Power = model::G0Power>
+CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double h, bool need_transport,
+                        const Power& g0_power = {}) {
   using std::sqrt;
   CellClosure<S> r{0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   const Terms& terms = s.terms;
@@ -106,7 +119,7 @@ CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double
     r.c = sqrt(5.0 / 3.0 * T);
   }
   if (!needs_model(s, need_transport)) return r;
-  const model::ConstitutiveValues<S> m = model::constitutive_values(n, T, s.e, s.transport);
+  const model::ConstitutiveValues<S> m = model::constitutive_values(n, T, s.e, s.transport, g0_power);
   if (terms.pressure && !ideal) {
     r.p = m.pressure;
     r.c = m.sound_speed;
@@ -116,13 +129,7 @@ CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double
   if (terms.shear_viscosity) r.mu = m.shear_viscosity;
   if (terms.bulk_viscosity) r.lambda = m.bulk_viscosity;
   if (terms.conduction) r.kappa = m.thermal_conductivity;
-  if (effective_artificial_form(s) == ArtificialForm::transport_coefficients) {
-    const S x = volume_fraction(n) / s.artificial.volume_fraction;
-    const S x2 = x * x;
-    const S weight = n * h * r.c / (1.0 + x2 * x2);
-    if (terms.shear_viscosity) r.mu += s.artificial.viscosity * weight;
-    if (terms.conduction) r.kappa += s.artificial.conductivity * weight;
-  }
+  if (effective_artificial_form(s) == ArtificialForm::transport_coefficients) add_artificial_transport(s, n, h, r);
   return r;
 }
 
@@ -130,29 +137,25 @@ CellClosure<S> evaluate(const PhysicsSettings& s, const S& n, const S& T, double
 /// need_transport leave unused are then never computed (transport coefficients in the
 /// hyperbolic stages of a split step).
 template <bool need_transport>
-[[gnu::flatten]] CellClosure<Cells> evaluate_cells(const PhysicsSettings& s, const Cells& n, const Cells& T, double h) {
-  return evaluate(s, n, T, h, need_transport);
+[[gnu::flatten]] CellClosure<Cells> evaluate_cells(const PhysicsSettings& s, const Cells& n, const Cells& T, double h,
+                                                   PowMemo& memo) {
+  return evaluate(s, n, T, h, need_transport, RememberedG0Power{memo});
 }
-}  // namespace
 
-void Operator::update_primitives_and_closure(const State& U, bool need_transport) {
-  const Grid& g = grid_;
-  const double h = g.h;
-  transport_evaluated_ = need_transport;
-  const bool model_needed = needs_model(settings_, need_transport);
-  const bool e_valid = settings_.e >= 0.0 && settings_.e <= 1.0;
-  const double* N = U.q[density].data();
-  const double* Mx = U.q[momentum_x].data();
-  const double* My = U.q[momentum_y].data();
-  const double* Mz = U.q[momentum_z].data();
-  const double* E = U.q[energy].data();
-  double* wn = w_[0].data();
-  double* wx = w_[1].data();
-  double* wy = w_[2].data();
-  double* wz = w_[3].data();
-  double* wT = w_[4].data();
-  Closure& cl = closure_;
-  const auto store = [&](std::ptrdiff_t c, const CellClosure<double>& r) {
+/// The closure of runs of cells: the primitives n and T it reads, the closure arrays and pow
+/// memo it writes (ghosts included in the arrays).
+struct ClosureRun {
+  const PhysicsSettings& settings;
+  double h;
+  bool need_transport, model_needed, e_valid;
+  const double* wn;
+  const double* wT;
+  Operator::Closure& closure;
+  double* pow_argument;
+  double* pow_value;
+
+  void store(std::ptrdiff_t c, const CellClosure<double>& r) const {
+    Operator::Closure& cl = closure;
     cl.p[c] = r.p;
     cl.c[c] = r.c;
     cl.chi[c] = wT[c] > 0.0 ? r.p / (wn[c] * wT[c]) : 1.0;
@@ -160,103 +163,124 @@ void Operator::update_primitives_and_closure(const State& U, bool need_transport
     cl.lambda[c] = r.lambda;
     cl.kappa[c] = r.kappa;
     cl.loss[c] = r.loss;
-  };
+  }
+
+  /// Every lane's state in the model's domain (where the settings need the model).
+  bool in_domain(const Cells& n, const Cells& T) const {
+    bool valid = e_valid;
+    for (int l = 0; l < lane_count; ++l) {
+      const double nu = volume_fraction(n.v[l]);
+      valid = valid && T.v[l] >= 0.0 && (!model_needed || (nu > 0.0 && nu < nu_max));
+    }
+    return valid;
+  }
+
+  /// The lane group of cells c .. c + lanes - 1; a short group repeats its last cell.
+  void load(std::ptrdiff_t c, int lanes, Cells& n, Cells& T, PowMemo& memo) const {
+    if (lanes == lane_count) {  // whole-group copies (no scalar stores read back as pairs)
+      n.v = load_lanes<Cells::Vector>(wn + c);
+      T.v = load_lanes<Cells::Vector>(wT + c);
+      std::copy_n(pow_argument + c, lane_count, memo.argument);
+      std::copy_n(pow_value + c, lane_count, memo.value);
+      return;
+    }
+    for (int l = 0; l < lane_count; ++l) {
+      const std::ptrdiff_t cell = c + std::min(l, lanes - 1);
+      n.v[l] = wn[cell];
+      T.v[l] = wT[cell];
+      memo.argument[l] = pow_argument[cell];
+      memo.value[l] = pow_value[cell];
+    }
+  }
+
+  void store(std::ptrdiff_t c, int lanes, const Cells& n, const Cells& T, const PowMemo& memo,
+             const CellClosure<Cells>& r) const {
+    if (lanes == lane_count) {  // whole vectors: per lane the arithmetic of `store`
+      Operator::Closure& cl = closure;
+      std::copy_n(memo.argument, lane_count, pow_argument + c);
+      std::copy_n(memo.value, lane_count, pow_value + c);
+      store_lanes(cl.p.data() + c, r.p.v);
+      store_lanes(cl.c.data() + c, r.c.v);
+      store_lanes(cl.chi.data() + c, T.v > 0.0 ? r.p.v / (n.v * T.v) : Cells::Vector{} + 1.0);
+      store_lanes(cl.mu.data() + c, r.mu.v);
+      store_lanes(cl.lambda.data() + c, r.lambda.v);
+      store_lanes(cl.kappa.data() + c, r.kappa.v);
+      store_lanes(cl.loss.data() + c, r.loss.v);
+      return;
+    }
+    for (int l = 0; l < lanes; ++l) {
+      pow_argument[c + l] = memo.argument[l];
+      pow_value[c + l] = memo.value[l];
+    }
+    for (int l = 0; l < lanes; ++l)
+      store(c + l, CellClosure<double>{r.p.v[l], r.c.v[l], r.mu.v[l], r.lambda.v[l], r.kappa.v[l], r.loss.v[l]});
+  }
+
+  /// Cells first .. end - 1, lane group by lane group.
+  void evaluate_run(std::ptrdiff_t first, std::ptrdiff_t end) const {
+    for (std::ptrdiff_t c = first; c < end; c += lane_count) {
+      const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(lane_count, end - c));
+      Cells n, T;
+      PowMemo memo;
+      load(c, lanes, n, T, memo);
+      if (!in_domain(n, T)) {  // cell by cell: the first cell outside the domain throws
+        for (int l = 0; l < lanes; ++l) store(c + l, evaluate(settings, wn[c + l], wT[c + l], h, need_transport));
+        continue;
+      }
+      const CellClosure<Cells> r = need_transport ? evaluate_cells<true>(settings, n, T, h, memo)
+                                                  : evaluate_cells<false>(settings, n, T, h, memo);
+      store(c, lanes, n, T, memo, r);
+    }
+  }
+};
+
+/// Calls run(row) for every row, on the threads if `threaded`. Rows of x; dynamic scheduling:
+/// on a shared machine a thread that is held up does not hold up the other. An exception must
+/// not leave an OpenMP region: the first failure is kept and rethrown.
+template <class Run> void for_rows(int rows, bool threaded, const Run& run) {
+  if (!threaded) {
+    for (int row = 0; row < rows; ++row) run(row);
+    return;
+  }
+  std::exception_ptr failure;
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int row = 0; row < rows; ++row) {
+    try {
+      run(row);
+    } catch (...) {
+#pragma omp critical(shaker_closure_failure)
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+}  // namespace
+
+void Operator::update_primitives_and_closure(const State& U, bool need_transport) {
+  const Grid& g = grid_;
+  transport_evaluated_ = need_transport;
+  const ClosureRun closure{settings_,
+                           g.h,
+                           need_transport,
+                           needs_model(settings_, need_transport),
+                           settings_.e >= 0.0 && settings_.e <= 1.0,
+                           w_[0].data(),
+                           w_[4].data(),
+                           closure_,
+                           pow_argument_.data(),
+                           pow_value_.data()};
   const bool x_by_rows = x_ghosts_by_rows();
   // One contiguous run of interior cells (its x ghosts, where x is periodic in this process,
   // copied while the row is in cache; the other ghosts afterwards): the primitives
   // (what to_primitive computes, as one vectorisable loop), then the closure lane group by
   // lane group.
   const int length = g.row_length();
-  const auto run = [&](int row) {
-    const std::ptrdiff_t first = g.row_start(row), end = first + length;
-    // Adjacent cells at once (simd_pair.hpp), per lane what to_primitive computes.
-    for_lanes(length, [&](int i, auto lanes) {
-      using S = decltype(lanes);
-      const std::ptrdiff_t c = first + i;
-      const S n = load_lanes<S>(N + c), mx = load_lanes<S>(Mx + c), my = load_lanes<S>(My + c),
-              mz = load_lanes<S>(Mz + c);
-      const S inv = 1.0 / n;
-      const S ux = mx * inv, uy = my * inv, uz = mz * inv;
-      const S kinetic = 0.5 * (mx * ux + my * uy + mz * uz);
-      // E - kinetic loses digits in fast, cold, dilute cells: a round-off negative is zero.
-      const S thermal = (load_lanes<S>(E + c) - kinetic) * inv / 1.5;
-      store_lanes(wn + c, n);
-      store_lanes(wx + c, ux);
-      store_lanes(wy + c, uy);
-      store_lanes(wz + c, uz);
-      store_lanes(wT + c, 0.0 < thermal ? thermal : S{});  // std::max(0.0, thermal) per lane
-    });
-    for (std::ptrdiff_t c = first; c < end; c += lane_count) {
-      const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(lane_count, end - c));
-      Cells n, T;
-      bool valid = e_valid;
-      PowMemo memo;
-      if (lanes == lane_count) {  // whole-group copies (no scalar stores read back as pairs)
-        n.v = load_lanes<Cells::Vector>(wn + c);
-        T.v = load_lanes<Cells::Vector>(wT + c);
-        std::copy_n(pow_argument_.data() + c, lane_count, memo.argument);
-        std::copy_n(pow_value_.data() + c, lane_count, memo.value);
-      } else {
-        for (int l = 0; l < lane_count; ++l) {
-          const std::ptrdiff_t cell = c + std::min(l, lanes - 1);  // a short group repeats its last cell
-          n.v[l] = wn[cell];
-          T.v[l] = wT[cell];
-          memo.argument[l] = pow_argument_[cell];
-          memo.value[l] = pow_value_[cell];
-        }
-      }
-      for (int l = 0; l < lane_count; ++l) {
-        const double nu = volume_fraction(n.v[l]);
-        valid = valid && T.v[l] >= 0.0 && (!model_needed || (nu > 0.0 && nu < nu_max));
-      }
-      if (!valid) {  // cell by cell: the first cell outside the domain throws
-        for (int l = 0; l < lanes; ++l) store(c + l, evaluate(settings_, wn[c + l], wT[c + l], h, need_transport));
-        continue;
-      }
-      pow_memo = &memo;
-      const CellClosure<Cells> r = need_transport ? evaluate_cells<true>(settings_, n, T, h)
-                                                  : evaluate_cells<false>(settings_, n, T, h);
-      pow_memo = nullptr;
-      if (lanes == lane_count) {  // whole vectors: per lane the arithmetic of `store`
-        std::copy_n(memo.argument, lane_count, pow_argument_.data() + c);
-        std::copy_n(memo.value, lane_count, pow_value_.data() + c);
-        store_lanes(cl.p.data() + c, r.p.v);
-        store_lanes(cl.c.data() + c, r.c.v);
-        store_lanes(cl.chi.data() + c, T.v > 0.0 ? r.p.v / (n.v * T.v) : Cells::Vector{} + 1.0);
-        store_lanes(cl.mu.data() + c, r.mu.v);
-        store_lanes(cl.lambda.data() + c, r.lambda.v);
-        store_lanes(cl.kappa.data() + c, r.kappa.v);
-        store_lanes(cl.loss.data() + c, r.loss.v);
-        continue;
-      }
-      for (int l = 0; l < lanes; ++l) {
-        pow_argument_[c + l] = memo.argument[l];
-        pow_value_[c + l] = memo.value[l];
-      }
-      for (int l = 0; l < lanes; ++l)
-        store(c + l, CellClosure<double>{r.p.v[l], r.c.v[l], r.mu.v[l], r.lambda.v[l], r.kappa.v[l], r.loss.v[l]});
-    }
+  for_rows(g.interior_rows(), g.threaded(), [&](int row) {
+    const std::ptrdiff_t first = g.row_start(row);
+    to_primitives(U, w_, first, length);
+    closure.evaluate_run(first, first + length);
     if (x_by_rows) copy_row_to_x_ghosts(first);
-  };
-  const int rows = g.interior_rows();
-  if (g.threaded()) {
-    // Rows of x; dynamic scheduling: on a shared machine a thread that is held up does not
-    // hold up the other. An exception must not leave an OpenMP region: the first failure is
-    // kept and rethrown.
-    std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic, 16)
-    for (int row = 0; row < rows; ++row) {
-      try {
-        run(row);
-      } catch (...) {
-#pragma omp critical(shaker_closure_failure)
-        if (!failure) failure = std::current_exception();
-      }
-    }
-    if (failure) std::rethrow_exception(failure);
-  } else {
-    for (int row = 0; row < rows; ++row) run(row);
-  }
+  });
 }
 
 }  // namespace shaker::continuum

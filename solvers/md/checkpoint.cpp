@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "common/checkpoints.hpp"
@@ -18,10 +19,39 @@ std::vector<std::int64_t> widen(const auto& values) {
   return std::vector<std::int64_t>(values.begin(), values.end());
 }
 
-template <class T> std::vector<T> narrow(const std::vector<std::int64_t>& values) {
+/// The integers of dataset `name` as T, each in [low, the largest T] (InputError otherwise: a
+/// wrapped counter or index would pass every later check).
+template <class T> std::vector<T> narrow(const std::vector<std::int64_t>& values, const char* name,
+                                         std::int64_t low) {
+  const auto high = static_cast<std::int64_t>(std::numeric_limits<T>::max());
   std::vector<T> out(values.size());
-  for (std::size_t k = 0; k < values.size(); ++k) out[k] = static_cast<T>(values[k]);
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (values[k] < low || values[k] > high)
+      throw InputError(fmt::format("dataset '{}' holds {} at entry {}; allowed: {} <= value <= {}",
+                                   name, values[k], k, low, high));
+    out[k] = static_cast<T>(values[k]);
+  }
   return out;
+}
+
+/// The run's tallies: counts >= 0 and finite energies (a NaN would run on into every energy
+/// column of the continued run).
+void read_tally(hid_t f, Tally& t) {
+  const auto counts = narrow<std::int64_t>(h5::read_integers(f, "tally_counts"), "tally_counts", 0);
+  const auto energy = h5::read_doubles(f, "tally_energy");
+  if (counts.size() != 7 || energy.size() != 4)
+    throw InputError(fmt::format("datasets 'tally_counts' and 'tally_energy' have {} and {} entries; "
+                                 "allowed: 7 and 4 (fixed length)", counts.size(), energy.size()));
+  for (std::size_t k = 0; k < energy.size(); ++k)
+    if (!std::isfinite(energy[k]))
+      throw InputError(fmt::format("dataset 'tally_energy' holds {} at entry {} (plate work, pair "
+                                   "loss, wall loss, virial); allowed: finite values", energy[k], k));
+  std::uint64_t* fields[] = {&t.pair, &t.plate, &t.ceiling, &t.cell, &t.stale, &t.guard_activations, &t.grazes};
+  for (std::size_t k = 0; k < 7; ++k) *fields[k] = static_cast<std::uint64_t>(counts[k]);
+  t.plate_work = energy[0];
+  t.pair_loss = energy[1];
+  t.wall_loss = energy[2];
+  t.virial = energy[3];
 }
 
 }  // namespace
@@ -115,9 +145,10 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     }
     const auto event_time = h5::read_doubles(f, "event_time");
     const auto cell_time = h5::read_doubles(f, "event_cell_time");
-    const auto partner = h5::read_integers(f, "event_partner");
-    const auto partner_counter = h5::read_integers(f, "event_partner_counter");
-    const auto kind = h5::read_integers(f, "event_kind");
+    const auto partner = narrow<std::int32_t>(h5::read_integers(f, "event_partner"), "event_partner", -1);
+    const auto partner_counter =
+        narrow<std::uint32_t>(h5::read_integers(f, "event_partner_counter"), "event_partner_counter", 0);
+    const auto kind = narrow<std::int16_t>(h5::read_integers(f, "event_kind"), "event_kind", 0);
     require_length("event_time", event_time.size(), n);
     require_length("event_cell_time", cell_time.size(), n);
     require_length("event_partner", partner.size(), n);
@@ -126,39 +157,27 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     d.events.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       d.events[i].time = event_time.at(i);
-      d.events[i].partner = static_cast<std::int32_t>(partner.at(i));
-      d.events[i].partner_counter = static_cast<std::uint32_t>(partner_counter.at(i));
+      d.events[i].partner = partner.at(i);
+      d.events[i].partner_counter = partner_counter.at(i);
       d.events[i].cell_time = cell_time.at(i);
       d.events[i].kind = static_cast<EventKind>(kind.at(i) % 256);
       d.events[i].cell_direction = static_cast<std::int8_t>(kind.at(i) / 256);
     }
-    const auto counters = narrow<std::uint32_t>(h5::read_integers(f, "counters"));
-    const auto streaks = narrow<std::uint32_t>(h5::read_integers(f, "streaks"));
+    const auto counters = narrow<std::uint32_t>(h5::read_integers(f, "counters"), "counters", 0);
+    const auto streaks = narrow<std::uint32_t>(h5::read_integers(f, "streaks"), "streaks", 0);
     require_length("counters", counters.size(), n);
     require_length("streaks", streaks.size(), n);
     for (std::size_t i = 0; i < n; ++i) {
       d.particles[i].counter = counters[i];
       d.particles[i].streak = streaks[i];
     }
-    d.cell_head = narrow<std::int32_t>(h5::read_integers(f, "cell_head"));
-    d.cell_next = narrow<std::int32_t>(h5::read_integers(f, "cell_next"));
-    d.cell_prev = narrow<std::int32_t>(h5::read_integers(f, "cell_prev"));
-    d.cell_of = narrow<std::int32_t>(h5::read_integers(f, "cell_of"));
-    const auto counts = h5::read_integers(f, "tally_counts");
-    const auto energy = h5::read_doubles(f, "tally_energy");
-    require_length("tally_counts", counts.size(), 7);
-    require_length("tally_energy", energy.size(), 4);
+    for (auto [name, cells] : {std::pair{"cell_head", &d.cell_head}, {"cell_next", &d.cell_next},
+                               {"cell_prev", &d.cell_prev}, {"cell_of", &d.cell_of}})
+      *cells = narrow<std::int32_t>(h5::read_integers(f, name), name, -1);
+    read_tally(f, d.tally);
     require_length("cell_next", d.cell_next.size(), n);
     require_length("cell_prev", d.cell_prev.size(), n);
     require_length("cell_of", d.cell_of.size(), n);
-    Tally& t = d.tally;
-    std::uint64_t* fields[] = {&t.pair, &t.plate, &t.ceiling, &t.cell, &t.stale,
-                               &t.guard_activations, &t.grazes};
-    for (std::size_t k = 0; k < 7; ++k) *fields[k] = static_cast<std::uint64_t>(counts.at(k));
-    t.plate_work = energy.at(0);
-    t.pair_loss = energy.at(1);
-    t.wall_loss = energy.at(2);
-    t.virial = energy.at(3);
   } catch (const std::exception& error) {
     throw InputError(fmt::format("{} is not a valid checkpoint: {}", restart_source(path), error.what()));
   }

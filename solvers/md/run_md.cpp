@@ -67,10 +67,15 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
                                  "allowed: {}", n, source, saved.data.particles.size(),
                                  saved.data.particles.size()));
   // The restart rule (README); another box is allowed (see below). The schedule's times
-  // are counted in the checkpoint's cycles.
-  config::require_same_keys(config, saved.configuration, {"material.restitution", "material.e", "shaker.frequency"},
-                            source);
-  validate_state(g, saved.data);
+  // are counted in the checkpoint's cycles; the plate's amplitude (shaker.gamma) sets the
+  // saved cell grid's lowest row.
+  config::require_same_keys(config, saved.configuration,
+                            {"material.restitution", "material.e", "shaker.frequency", "shaker.gamma"}, source);
+  try {
+    validate_state(g, saved.data);
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("{} is not a valid checkpoint: {}", source, error.what()));
+  }
   position = saved.position;
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).

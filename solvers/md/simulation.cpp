@@ -35,10 +35,23 @@ Simulation::Simulation(const Geometry& geometry, const CollisionRules& rules, co
 }
 
 void Simulation::advance_to(double t) {
-  if (use_calendar_) {
-    while (calendar_.top_time() <= t) step();
-  } else {
-    while (heap_.top_time() <= t) step();
+  // Collapse the per-particle detector cannot see (events that are not collisions, at e = 0
+  // pairs that touch without approaching): the clock stops while events go on, and the run
+  // would never reach t nor a stored phase where a stop signal is acted on.
+  const std::uint64_t limit = stalled_events_per_particle * data_.particles.size() + stalled_events_floor;
+  std::uint64_t stalled = 0;
+  double since = data_.time;
+  while ((use_calendar_ ? calendar_.top_time() : heap_.top_time()) <= t) {
+    step();
+    if (data_.time - since >= collapse_interval) {
+      since = data_.time;
+      stalled = 0;
+    } else if (++stalled > limit) {
+      throw CollapseError(fmt::format(
+          "inelastic collapse at t = {:.9g}: {} events without the time advancing by {:g} (the "
+          "particles in contact no longer separate); set md.collapse_guard = \"tc\" or use a larger "
+          "e (material.e, run.switch_e)", data_.time, stalled, collapse_interval));
+    }
   }
   data_.time = t;
 }

@@ -58,6 +58,10 @@ struct SimulationData {
 /// collapse_interval more than collapse_streak times in a row is taken to be collapsing.
 inline constexpr double collapse_interval = 1e-9;
 inline constexpr std::uint32_t collapse_streak = 100;
+/// The same for the whole system: more than this many events per particle (plus the floor)
+/// while the time advances by less than collapse_interval.
+inline constexpr std::uint64_t stalled_events_per_particle = 100;
+inline constexpr std::uint64_t stalled_events_floor = 10000;
 
 /// Thrown when inelastic collapse starts and no guard is on (exit code 1, not bad input).
 class CollapseError : public std::runtime_error {

@@ -70,8 +70,9 @@ template <class Damage> std::string checkpoint_with(const std::filesystem::path&
   SimulationData data = sim.save();
   damage(data);
   const auto path = dir / "bad-checkpoint.h5";
-  // Continued at the start of cycle 1: after the few events, before its first stored phase.
-  write_checkpoint(path, data, g, SchedulePosition{0.0, 1, 0, 50}, config::Config().to_toml());
+  // The few events end between stored phases 1 and 2 of cycle 0 (f t = 0.038 of 50 phases): the
+  // checkpoint continues at phase 2, as one written by a stop signal at phase 1 would.
+  write_checkpoint(path, data, g, SchedulePosition{0.0, 0, 2, 50}, config::Config().to_toml());
   return "--set run.restart_from=" + path.string();
 }
 
@@ -87,7 +88,7 @@ template <class Damage> void expect_checkpoint_rejected(Damage damage, const std
 TEST(MdBadInput, UndamagedCheckpointIsAccepted) {  // the checks below refuse only the damage
   const auto dir = testing::test_directory();
   const Outcome outcome =
-      run_shaker(dir, checkpoint_with(dir, [](SimulationData&) {}) + " --set run.transient_cycles=0 --set run.sampled_cycles=2");
+      run_shaker(dir, checkpoint_with(dir, [](SimulationData&) {}) + " --set run.transient_cycles=1 --set run.sampled_cycles=1");
   EXPECT_EQ(outcome.exit_code, 0) << outcome.errors;
   EXPECT_TRUE(std::filesystem::exists(dir / "out.h5"));
 }

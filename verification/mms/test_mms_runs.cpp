@@ -582,7 +582,7 @@ INSTANTIATE_TEST_SUITE_P(SspRungeKutta, MmsTime1D, ::testing::Values(2, 3));
 // off 2 on these grids, and the solution is tuned so that both are small beside the
 // second-order error: the Riemann fluxes' upwind dissipation, proportional to |u| + c (u_x and
 // u_z approach 2 from below), which a faster manufactured flow (U0 = 1.2 in place of 0.3)
-// outweighs; and the wall cells' one-sided slope (riemann.cpp), an O(h^3) excess of n's error
+// outweighs; and the wall cells' one-sided slope (reconstruction.hpp), an O(h^3) excess of n's error
 // in the second cell above each wall, proportional to n's fourth vertical derivative there,
 // which dominates n's maximum norm and which n's main vertical shape with 3 half-wavelengths
 // (in place of 4) shrinks. Every term stays active (MmsTermShares3D checks each one's part of
@@ -703,7 +703,7 @@ INSTANTIATE_TEST_SUITE_P(Variants, NightlyMmsSpace3D,
 
 // --- The wall cells' closure, which sets n's maximum norm in 3D.
 //
-// Beside a wall the reconstruction takes a one-sided slope (riemann.cpp), exact for
+// Beside a wall the reconstruction takes a one-sided slope (reconstruction.hpp), exact for
 // quadratics but with a different O(h^2) error from the interior's central slope. For fields
 // with zero normal gradient at the wall the difference is O(h^3) in the slope, and through
 // the Riemann flux's dissipation it leaves an O(h^3) excess in the error of the second cell

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -312,7 +313,9 @@ std::string gci_to_csv(std::span<const GciRow> rows) {
   return text;
 }
 
-std::vector<GciRow> gci_from_csv(const std::string& text, double design_order) {
+namespace {
+std::vector<GciRow> judged_gci_rows(const std::string& text,
+                                    const std::function<double(const std::string&)>& order_of) {
   std::stringstream stream(text);
   std::string line;
   if (!std::getline(stream, line)) throw std::runtime_error("GCI table: empty");
@@ -339,10 +342,71 @@ std::vector<GciRow> gci_from_csv(const std::string& text, double design_order) {
     std::array<double, 6> x{};
     for (std::size_t k = 0; k < grid.size(); ++k) x[k] = parse_number(cells[grid[k]], line_number);
     rows.push_back(make_gci_row(cells[study], cells[quantity], x[0], x[1], x[2], x[3], x[4],
-                                x[5], design_order));
+                                x[5], order_of(cells[quantity])));
     rows.back().asymptotic_range_claimed = cells[pass] != "nan";
   }
   return rows;
+}
+}  // namespace
+
+std::vector<GciRow> gci_from_csv(const std::string& text, double design_order) {
+  return judged_gci_rows(text, [&](const std::string&) { return design_order; });
+}
+
+std::vector<GciRow> gci_from_csv(const std::string& text, const TheoreticalOrders& orders) {
+  return judged_gci_rows(
+      text, [&](const std::string& quantity) { return theoretical_order(orders, quantity).order; });
+}
+
+TheoreticalOrders theoretical_orders_from_csv(const std::string& text) {
+  std::stringstream stream(text);
+  std::string line;
+  std::size_t line_number = 0;
+  const auto next_line = [&] {
+    while (std::getline(stream, line)) {
+      ++line_number;
+      if (!line.empty() && line.front() != '#') return true;
+    }
+    return false;
+  };
+  if (!next_line() || line != "quantity,order,reason")
+    throw std::runtime_error("theoretical orders: the first line must be 'quantity,order,reason'");
+  TheoreticalOrders orders;
+  while (next_line()) {
+    const auto cells = split(line);
+    if (cells.size() != 3 || cells[0].empty() || cells[2].empty())
+      throw std::runtime_error(fmt::format(
+          "theoretical orders line {}: expected a quantity, an order and a reason", line_number));
+    const double order = parse_number(cells[1], line_number);
+    if (!(order >= 0.5 && order <= 10.0))
+      throw std::runtime_error(fmt::format(
+          "theoretical orders line {}: order {} outside [0.5, 10]", line_number, cells[1]));
+    if (!orders.emplace(cells[0], TheoreticalOrder{order, cells[2]}).second)
+      throw std::runtime_error(fmt::format("theoretical orders line {}: '{}' declared twice",
+                                           line_number, cells[0]));
+  }
+  return orders;
+}
+
+TheoreticalOrders read_theoretical_orders(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("theoretical orders: cannot read " + path.string());
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    return theoretical_orders_from_csv(text.str());
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(path.string() + ": " + e.what());
+  }
+}
+
+const TheoreticalOrder& theoretical_order(const TheoreticalOrders& orders,
+                                          const std::string& quantity) {
+  const auto found = orders.find(quantity);
+  if (found == orders.end())
+    throw std::runtime_error("no theoretical order declared for '" + quantity +
+                             "' (verification/grid-studies/theoretical_orders.csv)");
+  return found->second;
 }
 
 std::string bounds_to_csv(std::span<const BoundCheck> rows) {

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
+#include <map>
 #include <span>
 #include <string>
 #include <utility>
@@ -160,6 +161,26 @@ std::string gci_to_csv(std::span<const GciRow> rows);
 /// (pass nan) stays unclaimed. Throws std::runtime_error on a malformed table or a two-grid
 /// row.
 std::vector<GciRow> gci_from_csv(const std::string& text, double design_order);
+
+/// The order a quantity of interest can reach by theory, and the short name of the reason
+/// (the grid studies' table, verification/grid-studies/theoretical_orders.csv; its reasons are
+/// explained in verification/README.md).
+struct TheoreticalOrder {
+  double order = 0.0;
+  std::string reason;
+};
+using TheoreticalOrders = std::map<std::string, TheoreticalOrder>;
+/// A table `quantity,order,reason` (first line that header; lines starting with '#' are
+/// comments). Throws std::runtime_error on a malformed table, a repeated quantity, an order
+/// outside [0.5, 10] or an empty reason.
+TheoreticalOrders theoretical_orders_from_csv(const std::string& text);
+TheoreticalOrders read_theoretical_orders(const std::filesystem::path& path);
+/// The declared order of `quantity`; throws std::runtime_error naming it if it has none.
+const TheoreticalOrder& theoretical_order(const TheoreticalOrders& orders,
+                                          const std::string& quantity);
+/// gci_from_csv with each row judged at its quantity's theoretical order (throws
+/// std::runtime_error for a quantity the table does not declare).
+std::vector<GciRow> gci_from_csv(const std::string& text, const TheoreticalOrders& orders);
 void write_gci_csv(const std::filesystem::path& path, std::span<const GciRow> rows);
 
 /// Environment variable naming the directory that collects study tables for the nightly

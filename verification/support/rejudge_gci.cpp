@@ -3,7 +3,11 @@
 // of two judges side by side. The nightly regenerates its tables; this is for tables kept in
 // the repository (reports/convergence-tables) when the judge changes.
 //
-// usage: rejudge_gci [--design-order P] FILE...   (P: the scheme's order, 2 unless given)
+// usage: rejudge_gci [--design-order P | --orders TABLE] FILE...
+//   P: one order for every row (2 unless given); TABLE: each row at its quantity's theoretical
+//   order (verification/grid-studies/theoretical_orders.csv; a quantity it does not declare is
+//   an error). The time-step studies' own tables (real-time-*.gci.csv without "-grid") are
+//   judged at their integrator's temporal order: give them --design-order.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
@@ -17,9 +21,14 @@
 int main(int argc, char** argv) {
   CLI::App app{"Judge stored GCI tables anew and rewrite them in the current schema"};
   double design_order = 2.0;
+  std::string orders_file;
   std::vector<std::string> files;
-  app.add_option("--design-order", design_order, "the scheme's order for these tables")
-      ->check(CLI::Range(0.5, 10.0));
+  auto* single = app.add_option("--design-order", design_order, "the scheme's order for these tables")
+                     ->check(CLI::Range(0.5, 10.0));
+  app.add_option("--orders", orders_file,
+                 "table quantity,order,reason: each row judged at its quantity's order")
+      ->check(CLI::ExistingFile)
+      ->excludes(single);
   app.add_option("files", files, "GCI tables (*.gci.csv), rewritten in place")
       ->required()
       ->check(CLI::ExistingFile);
@@ -29,12 +38,20 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   namespace conv = shaker::convergence;
+  conv::TheoreticalOrders orders;
+  try {
+    if (!orders_file.empty()) orders = conv::read_theoretical_orders(orders_file);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "rejudge_gci: {}\n", e.what());
+    return 2;
+  }
   for (const auto& file : files) {
     std::ifstream in(file);
     std::stringstream text;
     text << in.rdbuf();
     try {
-      const auto rows = conv::gci_from_csv(text.str(), design_order);
+      const auto rows = orders_file.empty() ? conv::gci_from_csv(text.str(), design_order)
+                                            : conv::gci_from_csv(text.str(), orders);
       conv::write_gci_csv(file, rows);
       int checked = 0, passed = 0;
       for (const auto& row : rows) {

@@ -439,6 +439,43 @@ TEST(GciRows, AStoredTableIsJudgedAnewFromItsGridsAndValues) {
   EXPECT_THROW(cv::gci_from_csv("study,quantity\n", 2.0), std::runtime_error);
 }
 
+// Each quantity judged at its own theoretical order: a first-order triple is in the
+// asymptotic range of its declared order 1 and out of that of order 2; a quantity the table
+// does not declare, or a malformed table, is an error, not a default.
+TEST(GciRows, EachQuantityIsJudgedAtItsTheoreticalOrder) {
+  const cv::TheoreticalOrders orders = cv::theoretical_orders_from_csv(
+      "# comment\nquantity,order,reason\nfirst,1,whole-cells\nsecond,2,resolved-flow\n");
+  ASSERT_EQ(orders.size(), 2u);
+  EXPECT_EQ(cv::theoretical_order(orders, "first").reason, "whole-cells");
+  // phi = 3 + h (first order) for both quantities.
+  const std::string csv =
+      "study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,relative_difference21,"
+      "extrapolated_error21,gci21,gci32,convergence,design_order,order_tolerance,uncertainty1,"
+      "pass\n"
+      "s,first,0.1,0.2,0.4,3.1,3.2,3.4,1,3,0,0,0,0,monotonic,2,0.1,0,0\n"
+      "s,second,0.1,0.2,0.4,3.1,3.2,3.4,1,3,0,0,0,0,monotonic,2,0.1,0,0\n";
+  const auto judged = cv::gci_from_csv(csv, orders);
+  ASSERT_EQ(judged.size(), 2u);
+  EXPECT_DOUBLE_EQ(judged[0].design_order, 1.0);
+  EXPECT_TRUE(judged[0].pass());
+  EXPECT_DOUBLE_EQ(judged[1].design_order, 2.0);
+  EXPECT_FALSE(judged[1].pass());
+  // Outside the asymptotic range of order 2 its uncertainty takes Fs 3 at the order 1 it
+  // shows; in the range of order 1, Fs 1.25.
+  EXPECT_NEAR(cv::fine_grid_uncertainty(judged[0]), 1.25 * 0.1, 1e-12);
+  EXPECT_NEAR(cv::fine_grid_uncertainty(judged[1]), 3.0 * 0.1, 1e-12);
+  EXPECT_THROW(cv::gci_from_csv(csv + "s,third,0.1,0.2,0.4,1,2,3,1,3,0,0,0,0,monotonic,2,0.1,0,0\n",
+                                orders),
+               std::runtime_error);
+  EXPECT_THROW(cv::theoretical_orders_from_csv("quantity,order\nq,1\n"), std::runtime_error);
+  EXPECT_THROW(cv::theoretical_orders_from_csv("quantity,order,reason\nq,0,why\n"),
+               std::runtime_error);
+  EXPECT_THROW(cv::theoretical_orders_from_csv("quantity,order,reason\nq,1,\n"),
+               std::runtime_error);
+  EXPECT_THROW(cv::theoretical_orders_from_csv("quantity,order,reason\nq,1,a\nq,2,b\n"),
+               std::runtime_error);
+}
+
 // The error bound of the coarsest of three levels (the production step of a time-step study).
 namespace {
 cv::GciRow levels(double phi1, double phi2, double phi3, double design_order = 2.0) {

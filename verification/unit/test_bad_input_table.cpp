@@ -8,12 +8,16 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/mount.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -72,33 +76,104 @@ struct Outcome {
   std::string output;  // stdout and stderr together
 };
 
-/// Runs shaker ARGS in `dir`; sends `signal` after `delay` seconds if signal > 0.
-Outcome run_shaker(const fs::path& dir, const std::vector<std::string>& args, int signal = 0,
-                   double delay = 0.0) {
+/// How a case runs shaker beyond its arguments.
+struct Launch {
+  int signal = 0;       ///< sent after `delay` seconds if > 0
+  double delay = 0.0;
+  std::string stdout_file;  ///< stdout goes there (opened for writing, not created) if not empty
+  std::vector<std::string> prefix;  ///< a program that runs shaker (unshare ...), if not empty
+};
+
+/// A case still running after this long hangs: it is killed and fails with exit code -2.
+constexpr double hang_seconds = 120.0;
+
+/// Runs shaker ARGS in `dir` as `launch` says.
+Outcome run_shaker(const fs::path& dir, const std::vector<std::string>& args, const Launch& launch = {}) {
   const fs::path log = dir / ".shaker-output";
   const pid_t pid = ::fork();
   if (pid == 0) {
     if (::chdir(dir.c_str()) != 0) ::_exit(99);
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 1);
+    const int out = launch.stdout_file.empty() ? fd : ::open(launch.stdout_file.c_str(), O_WRONLY);
+    ::dup2(out, 1);
     ::dup2(fd, 2);
-    std::vector<char*> argv{const_cast<char*>(SHAKER_PROGRAM)};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    std::vector<std::string> words = launch.prefix;
+    words.push_back(SHAKER_PROGRAM);
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& w : words) argv.push_back(w.data());
     argv.push_back(nullptr);
-    ::execv(SHAKER_PROGRAM, argv.data());
+    ::execvp(argv.front(), argv.data());
     ::_exit(98);
   }
-  if (signal > 0) {
-    std::this_thread::sleep_for(std::chrono::duration<double>(delay));
-    ::kill(pid, signal);
-  }
+  const auto start = std::chrono::steady_clock::now();
+  const auto seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  bool signalled = launch.signal == 0, hung = false;
   int status = 0;
-  ::waitpid(pid, &status, 0);
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (!signalled && seconds() >= launch.delay) {
+      ::kill(pid, launch.signal);
+      signalled = true;
+    }
+    if (seconds() > hang_seconds) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      hung = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   Outcome r;
   r.output = read_text(log);
   fs::remove(log);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.exit_code = hung ? -2 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  if (hung) r.output += "\n[killed: still running after the test's limit]";
   return r;
+}
+
+/// Whether this process may make a private mount namespace (`unshare -rm`).
+bool private_mounts_available() {
+  static const bool available = std::system("unshare -rm true >/dev/null 2>&1") == 0;
+  return available;
+}
+
+/// The type a special file of `kind` has outside the case's mount namespace.
+fs::file_type special_file_type(const std::string& kind) {
+  if (kind == "fifo") return fs::file_type::fifo;
+  if (kind == "socket") return fs::file_type::socket;
+  if (kind == "directory") return fs::file_type::directory;
+  return fs::file_type::regular;  // the file a device was mounted on
+}
+
+/// Makes the special files of a case's `special` table: fifo, socket, directory; or
+/// "device:/dev/X" (an empty file here, on which that device is bind-mounted in the case's own
+/// mount namespace: the real device node is never an output).
+void make_special_files(const fs::path& dir, const toml::value& row, Launch& launch) {
+  for (const auto& [name, kind_value] : toml::find<toml::table>(row, "special")) {
+    const fs::path path = dir / name;
+    const std::string kind = kind_value.as_string().str;
+    if (kind == "fifo") {
+      ASSERT_EQ(::mkfifo(path.c_str(), 0644), 0) << path;
+    } else if (kind == "directory") {
+      fs::create_directories(path);
+    } else if (kind == "socket") {
+      const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+      sockaddr_un address{};
+      address.sun_family = AF_UNIX;
+      ASSERT_LT(path.native().size(), sizeof(address.sun_path)) << path;
+      std::strcpy(address.sun_path, path.c_str());
+      ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0) << path;
+      ::close(fd);
+    } else if (kind.starts_with("device:")) {
+      std::ofstream(path).put('\0');
+      launch.prefix = {"unshare", "-rm", "sh", "-c", "mount --bind \"$1\" \"$2\" && shift 2 && exec \"$@\"",
+                       "sh", kind.substr(7), path.string()};
+    } else {
+      FAIL() << "unknown special file kind " << kind;
+    }
+  }
 }
 
 class Fixtures : public ::testing::Environment {
@@ -190,14 +265,19 @@ void apply_damage(const fs::path& dir, const toml::value& step) {
     for (const auto& full : names) {
       const auto dims = shaker::h5::shape(file, full);
       // cycle_samples/cycles counts cycles per [phase x sample], not bins: it keeps its shape.
-      if (dims.size() != 2 || (op == "bins" && full.ends_with("/cycles"))) continue;
+      // "phases" also cuts the per-phase vectors of a group (profiles/phase, profiles/time).
+      const bool matrix = dims.size() == 2, per_phase = dims.size() == 1 && names.size() > 1;
+      if (!(matrix || (op == "phases" && per_phase)) || (op == "bins" && full.ends_with("/cycles")))
+        continue;
       const auto data = shaker::h5::read_doubles(file, full);
+      const std::size_t width = matrix ? dims[1] : 1;
       const std::size_t rows = op == "phases" ? toml::find<std::size_t>(step, "rows") : dims[0];
-      const std::size_t cols = op == "bins" ? toml::find<std::size_t>(step, "bins") : dims[1];
+      const std::size_t cols = op == "bins" ? toml::find<std::size_t>(step, "bins") : width;
       std::vector<double> cut;
       for (std::size_t r = 0; r < rows; ++r)
-        for (std::size_t c = 0; c < cols; ++c) cut.push_back(data[r * dims[1] + c]);
-      replace_dataset(file, full, cut, {rows, cols});
+        for (std::size_t c = 0; c < cols; ++c) cut.push_back(data[r * width + c]);
+      replace_dataset(file, full, cut, matrix ? std::vector<std::size_t>{rows, cols}
+                                              : std::vector<std::size_t>{rows});
     }
   } else {
     ADD_FAILURE() << "unknown damage op " << op;
@@ -244,9 +324,18 @@ TEST_P(BadInput, MeetsTheContract) {
 
   std::vector<std::string> args;
   for (const auto& a : strings(row, "args")) args.push_back(expand(a));
-  const int signal = row.contains("signal") ? toml::find<int>(row, "signal") : 0;
-  const double delay = row.contains("signal_after") ? toml::find<double>(row, "signal_after") : 0.0;
-  const Outcome r = run_shaker(dir, args, signal, delay);
+  Launch launch;
+  launch.signal = row.contains("signal") ? toml::find<int>(row, "signal") : 0;
+  launch.delay = row.contains("signal_after") ? toml::find<double>(row, "signal_after") : 0.0;
+  if (row.contains("stdout")) launch.stdout_file = toml::find<std::string>(row, "stdout");
+  if (row.contains("special")) make_special_files(dir, row, launch);
+  if (HasFatalFailure()) return;
+  if (!launch.prefix.empty() && !private_mounts_available()) {
+    fs::remove_all(dir);
+    GTEST_SKIP() << "no private mount namespace (unshare -rm): the device case is not run here; "
+                    "the FIFO and socket cases check the same refusal by file type";
+  }
+  const Outcome r = run_shaker(dir, args, launch);
 
   SCOPED_TRACE(c.name + " in " + dir.string());
   EXPECT_EQ(r.exit_code, toml::find<int>(row, "exit")) << r.output.substr(0, 4000);
@@ -257,11 +346,17 @@ TEST_P(BadInput, MeetsTheContract) {
     EXPECT_EQ(r.output.find(fragment), std::string::npos)
         << "the output contains '" << fragment << "':\n" << r.output.substr(0, 4000);
   for (const auto& name : strings(row, "absent"))
-    EXPECT_FALSE(fs::exists(dir / name)) << name << " was written";
+    EXPECT_FALSE(fs::exists(dir / expand(name))) << name << " was written";
   for (const auto& name : strings(row, "present"))
-    EXPECT_TRUE(fs::exists(dir / name)) << name << " was not written";
+    EXPECT_TRUE(fs::exists(dir / expand(name))) << name << " was not written";
   for (const auto& [name, text] : before)
     EXPECT_TRUE(read_text(dir / name) == text) << name << " was changed";
+  if (row.contains("special")) {
+    for (const auto& [name, kind] : toml::find<toml::table>(row, "special")) {
+      EXPECT_EQ(fs::status(dir / name).type(), special_file_type(kind.as_string().str))
+          << name << " (" << kind.as_string().str << ") was replaced";
+    }
+  }
   for (const auto& sub : {dir, dir / "small"}) {
     if (!fs::is_directory(sub)) continue;
     for (const auto& entry : fs::directory_iterator(sub))

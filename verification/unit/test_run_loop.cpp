@@ -278,7 +278,7 @@ TEST(PhaseSchedule, ContinuedSingleShockSwitchesOnceWhereTheStraightRunDid) {
   }
 }
 
-TEST(PhaseSchedule, ResumeRefusesNothingLeftOtherPhasesMidCycleAndALaterState) {
+TEST(PhaseSchedule, ResumeRefusesNothingLeftOtherPhasesMidCycleAndAStateOutsideItsPhase) {
   const PhaseSchedule two = PhaseSchedule::whole_cycles(protocol(1, 1, 5), shaker_base, 0.0);
   const std::string source = "run.restart_from = \"c.h5\"";
   shaker::testing::expect_input_error([&] { PhaseSchedule(two).resume_at({0.0, 2, 0, 5}, two.end(), source); },
@@ -290,6 +290,14 @@ TEST(PhaseSchedule, ResumeRefusesNothingLeftOtherPhasesMidCycleAndALaterState) {
   shaker::testing::expect_input_error(
       [&] { PhaseSchedule(two).resume_at({0.0, 1, 0, 5}, two.target(1, 0) * (1 + 1e-12), source); },
       {source + " is not a valid checkpoint", "lies after the stored phase"});
+  // A time before the stored phase the checkpoint was written at (a schedule_start_time moved
+  // ahead) would never reach the next one.
+  shaker::testing::expect_input_error(
+      [&] { PhaseSchedule(two).resume_at({0.0, 1, 0, 5}, two.target(0, 4) - 1e-3, source); },
+      {source + " is not a valid checkpoint", "lies before the stored phase", "allowed"});
+  shaker::testing::expect_input_error(
+      [&] { PhaseSchedule(two).resume_at({0.0, 0, 0, 5}, -1.0, source); },
+      {"lies before the stored phase"});
   // At a cycle boundary the phases per cycle may change.
   PhaseSchedule other_phases = two;
   other_phases.resume_at({0.0, 1, 0, 4}, two.target(0, 4), source);
@@ -372,6 +380,34 @@ TEST(CheckpointObserver, StopSignalWritesACheckpointAtTheNextStoredPhaseAndStops
   }
 }
 
+TEST(CheckpointObserver, StopSignalDuringTheFinalCheckpointStopsAfterIt) {
+  shaker::install_signal_cleanup();
+  const shaker::testing::TemporaryDirectory dir;
+  const PhaseSchedule s = PhaseSchedule::whole_cycles(protocol(1, 1, 5), shaker_base, 0.0);
+  shaker::CheckpointSettings settings;
+  settings.run_output = dir / "run.h5";
+  settings.file = dir / "c.h5";
+  LoggingSolver solver(0.0);
+  int writes = 0;
+  const auto plain = text_writer(solver, writes);
+  // The signal arrives while the final checkpoint is being written (the only one: no every).
+  const shaker::CheckpointWriter signalling = [&](const std::filesystem::path& path,
+                                                  const shaker::SchedulePosition& p) {
+    std::raise(SIGTERM);
+    plain(path, p);
+  };
+  shaker::CheckpointObserver checkpoints(settings, s, signalling, "shaker test");
+  try {
+    s.run(solver, {&checkpoints});
+    ADD_FAILURE() << "the run ended with status 0 after a SIGTERM during its final checkpoint";
+  } catch (const shaker::StopRequested& stop) {
+    EXPECT_EQ(stop.exit_code(), 143);
+    EXPECT_NE(std::string(stop.what()).find("while the final checkpoint was written"), std::string::npos)
+        << stop.what();
+  }
+  EXPECT_EQ(writes, 1);
+  EXPECT_EQ(read_text(dir / "c.h5"), fmt::format("{} 2 0 5\n", s.end()));
+}
 
 /// Sets a stand-in for another rank's signal at stored phase k of cycle m.
 class PeerSignalAt final : public shaker::RunObserver {
