@@ -21,6 +21,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 
 if __package__:
     from . import report_common as rc
@@ -203,6 +204,113 @@ def figure(results, out_dir, link):
     return [f"![The variants against MD]({link}/variants.png)", ""]
 
 
+KNUDSEN_BINS = (0.0, 0.01, 0.03, 0.1, 0.3, math.inf)
+SOLVER_NAMES = {"md": "MD", "continuum": "continuum (validation settings)"}
+
+
+def read_profiles(path):
+    """`shaker analyze --profiles-csv`: per phase, the columns as arrays, Kn the larger of
+    Kn_n and Kn_T (NaN where neither is defined)."""
+    table = np.genfromtxt(path, delimiter=",", names=True)
+    phases = {}
+    for phase in np.unique(table["phase"]):
+        rows = table[table["phase"] == phase]
+        kn = np.fmax(rows["kn_n"], rows["kn_T"])
+        phases[round(float(phase), 6)] = dict(z=rows["z"], nu=rows["nu"], T=rows["T"], kn=kn)
+    return phases
+
+
+def knudsen_maps(profiles, out_dir, link):
+    fig, axes = plt.subplots(1, len(profiles), figsize=(6 * len(profiles), 4.5), sharey=True,
+                             squeeze=False)
+    image = None
+    for ax, (solver, phases) in zip(axes[0], profiles.items()):
+        keys = sorted(phases)
+        z = phases[keys[0]]["z"]
+        top = 60.0
+        rows = [np.interp(z, phases[k]["z"], np.log10(np.clip(phases[k]["kn"], 1e-6, None)),
+                          left=np.nan, right=np.nan) for k in keys]
+        grid = np.array(rows).T
+        grid[~np.isfinite(grid)] = np.nan
+        image = ax.pcolormesh(keys, z, grid, vmin=-3, vmax=1, cmap="viridis", shading="nearest")
+        ax.set_ylim(0, top)
+        ax.set_title(SOLVER_NAMES[solver])
+        ax.set_xlabel("phase f t [1]")
+    axes[0][0].set_ylabel("height z, lab frame [sigma]")
+    colorbar = fig.colorbar(image, ax=axes[0].tolist())
+    colorbar.set_label("log10 of the local Knudsen number max(Kn_n, Kn_T) [1]")
+    rc.save_figure_atomically(fig, os.path.join(out_dir, "knudsen-maps.png"))
+    plt.close(fig)
+    return [f"![Local Knudsen number, base case]({link}/knudsen-maps.png)", ""]
+
+
+def knudsen_fraction_figure(knudsen, out_dir, link):
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    for solver, data in knudsen.items():
+        phase, fraction = np.array(data["phase"]), np.array(data["fraction"], dtype=float)
+        errors = np.array(data.get("fraction_error") or [np.nan] * len(phase), dtype=float)
+        if solver == "md":
+            ax.errorbar(phase, fraction, yerr=np.nan_to_num(errors), fmt="o", ms=3, color="C3",
+                        label="MD (± standard error over cycles)")
+        else:
+            ax.plot(phase, fraction, "-", color="C0", label=SOLVER_NAMES[solver])
+    ax.set_xlabel("phase f t [1]")
+    ax.set_ylabel("fraction of the material with Kn > 0.1 [1]")
+    ax.legend(fontsize=8)
+    ax.grid(lw=0.3)
+    fig.tight_layout()
+    rc.save_figure_atomically(fig, os.path.join(out_dir, "knudsen-fraction.png"))
+    plt.close(fig)
+    return [f"![Material above Kn = 0.1]({link}/knudsen-fraction.png)", ""]
+
+
+def difference_by_knudsen(md, continuum):
+    """|nu_MD - nu_continuum| and |T_MD - T_continuum| at MD's bins, by MD's local Kn (the
+    continuum interpolated to MD's heights at the same phase)."""
+    rows = []
+    for lo, hi in zip(KNUDSEN_BINS[:-1], KNUDSEN_BINS[1:]):
+        dnu, dT = [], []
+        for phase, m in md.items():
+            c = continuum.get(phase)
+            if c is None:
+                continue
+            inside = (m["kn"] >= lo) & (m["kn"] < hi) & (m["nu"] > 0)
+            nu_c = np.interp(m["z"][inside], c["z"], c["nu"], left=np.nan, right=np.nan)
+            T_c = np.interp(m["z"][inside], c["z"], c["T"], left=np.nan, right=np.nan)
+            dnu += list(np.abs(m["nu"][inside] - nu_c))
+            dT += list(np.abs(m["T"][inside] - T_c))
+        dnu, dT = np.array(dnu), np.array(dT)
+        rows.append((lo, hi, int(np.isfinite(dnu).sum()), np.nanmean(dnu) if len(dnu) else None,
+                     np.nanmean(dT) if len(dT) else None, np.nansum(dnu)))
+    return rows
+
+
+def knudsen_section(results, out_dir, link):
+    knudsen = results.get("knudsen") or {}
+    lines = ["## Where Navier-Stokes order is in doubt: the local Knudsen number", ""]
+    if not knudsen:
+        return lines + ["Not measured: the study had no base-case runs.", ""]
+    lines += ["Kn_n = xi |dn/dz| / n and Kn_T = xi |dT/dz| / T per bin and phase "
+              "(docs/analysis.md), base case; MD and the continuum at the validation settings. "
+              "Navier-Stokes order assumes Kn << 1.", ""]
+    profiles = {solver: read_profiles(d["profiles_csv"]) for solver, d in knudsen.items()}
+    lines += knudsen_maps(profiles, out_dir, link)
+    lines += knudsen_fraction_figure(knudsen, out_dir, link)
+    if "md" in profiles and "continuum" in profiles:
+        rows = difference_by_knudsen(profiles["md"], profiles["continuum"])
+        total = sum(r[5] for r in rows if np.isfinite(r[5])) or math.nan
+        lines += ["The profiles' differences by MD's local Knudsen number (every phase and "
+                  "bin with MD material):", ""]
+        lines += rc.table_head(["Kn range [1]", "bins [1]", "mean |nu_MD - nu_continuum| [1]",
+                                "mean |T_MD - T_continuum| [g sigma]",
+                                "share of the summed |nu difference| [1]"])
+        for lo, hi, count, dnu, dT, summed in rows:
+            lines.append(rc.table_row([f"{lo:g} to {hi:g}", str(count), rc.fmt(dnu, 3),
+                                       rc.fmt(dT, 3), rc.fmt(summed / total, 3)]))
+        lines.append("")
+    return lines
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--results", required=True)
@@ -226,6 +334,7 @@ def main():
     lines += md_section(results)
     lines += decision_section(results)
     lines += ["## The variants against MD", ""] + figure(results, out_dir, link)
+    lines += knudsen_section(results, out_dir, link)
     lines += variants_table(results)
     rc.write_text_atomically(args.output, "\n".join(lines) + "\n")
     return 0

@@ -145,6 +145,27 @@ def md_reference(md_views, study):
                 exit_phase=exit_phase)
 
 
+def knudsen_inputs(md_views, runs, workdir, shaker):
+    """The base case's profiles with their local Knudsen numbers (`shaker analyze
+    --profiles-csv`) and per-phase Knudsen mass fractions, MD and the reference variant."""
+    out = {}
+    md = md_views.get(("base", "md"))
+    reference = next((r for r in runs if r.get("variant") == "validation"
+                      and r["case"] == "base" and r["record"]["status"] == "ok"), None)
+    views = [("md", md)]
+    if reference is not None:
+        view = rv.build_view(shaker, "base", "continuum", reference["record"], workdir)
+        views.append(("continuum", view))
+    for solver, view in views:
+        if view is None or view.status != "ok":
+            continue
+        out[solver] = dict(profiles_csv=view.path + ".profiles.csv",
+                           phase=list(view.analysis["phase"]),
+                           fraction=list(view.analysis["knudsen_mass_fraction"]),
+                           fraction_error=list(view.errors.get("knudsen_mass_fraction", [])))
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--shaker", required=True, help="path of the shaker program")
@@ -201,6 +222,7 @@ def main(argv=None):
                     for k, c in judged[-1]["claims"].items()]
         rv.log(f"{v['name']}: " + ", ".join(verdicts))
     summary = dict(commit=rv.git("rev-parse", "HEAD"),
+                   knudsen=knudsen_inputs(md_views, runs, workdir, shaker),
                    shaker_version=subprocess.run([shaker, "--version"], capture_output=True,
                                                  text=True).stdout.strip(),
                    wall_seconds=time.monotonic() - started,

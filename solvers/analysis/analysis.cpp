@@ -246,4 +246,39 @@ RunComparison compare_runs(const RunRecord& a, const RunRecord& b) {
   return r;
 }
 
+namespace {
+/// |df/dz| / f at bin i from the neighbours with material, NaN without one.
+double relative_gradient(const Profile& p, const std::vector<double>& f, std::size_t i) {
+  const auto usable = [&](std::size_t k) { return p.n[k] > 0.0 && f[k] > 0.0; };
+  if (!usable(i)) return std::numeric_limits<double>::quiet_NaN();
+  const bool below = i > 0 && usable(i - 1), above = i + 1 < p.size() && usable(i + 1);
+  const std::size_t lo = below ? i - 1 : i, hi = above ? i + 1 : i;
+  if (lo == hi) return std::numeric_limits<double>::quiet_NaN();
+  return std::abs(f[hi] - f[lo]) / (p.z[hi] - p.z[lo]) / f[i];
+}
+}  // namespace
+
+KnudsenNumbers knudsen_numbers(const Profile& p) {
+  KnudsenNumbers kn;
+  kn.density.assign(p.size(), std::numeric_limits<double>::quiet_NaN());
+  kn.temperature = kn.density;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!(p.n[i] > 0.0)) continue;
+    const double xi = model::mean_free_path(p.n[i]);
+    kn.density[i] = xi * relative_gradient(p, p.n, i);
+    kn.temperature[i] = xi * relative_gradient(p, p.T, i);
+  }
+  return kn;
+}
+
+double knudsen_mass_fraction(const Profile& p, const KnudsenNumbers& kn, double limit) {
+  double above = 0.0, total = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!(p.n[i] > 0.0)) continue;
+    total += p.n[i];
+    if (kn.density[i] > limit || kn.temperature[i] > limit) above += p.n[i];
+  }
+  return total > 0.0 ? above / total : std::numeric_limits<double>::quiet_NaN();
+}
+
 }  // namespace shaker::analysis

@@ -55,6 +55,21 @@ struct Shock {
 /// below the layer's top (see find_shock in analysis.cpp for why).
 std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& criteria = {});
 
+/// Local Knudsen numbers per bin (docs/analysis.md): the mean free path xi over the gradient
+/// length of density, Kn_n = xi |dn/dz| / n, and of temperature, Kn_T = xi |dT/dz| / T.
+/// Gradients are central differences over the neighbouring bins with material (one-sided at
+/// the ends and beside an empty bin); NaN where the bin has no material or no defined
+/// neighbour, and Kn_T NaN where T is not positive.
+struct KnudsenNumbers {
+  std::vector<double> density, temperature;
+};
+KnudsenNumbers knudsen_numbers(const Profile& p);
+
+/// Navier-Stokes order is expected to hold where Kn is well below this.
+inline constexpr double knudsen_limit = 0.1;
+/// The fraction of the material in bins where the larger of Kn_n and Kn_T exceeds `limit`.
+double knudsen_mass_fraction(const Profile& p, const KnudsenNumbers& kn, double limit = knudsen_limit);
+
 /// Everything `shaker analyze` prints for one phase.
 struct PhaseSummary {
   double phase = 0.0, plate_z = 0.0, center_of_mass = 0.0, max_mach = 0.0;

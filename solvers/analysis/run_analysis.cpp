@@ -267,6 +267,7 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
     q.layer = find_layer(p);
     q.mass_bottom = mass_quantile_height(p, 0.01);
     q.layer_temperature = layer_temperature(p, q.layer);
+    q.knudsen_mass_fraction = knudsen_mass_fraction(p, knudsen_numbers(p));
     q.temperature_slope_above = temperature_slope_above(p, q.layer);
     q.shock = find_shock(p, options.criteria);
     if (q.shock) q.front = fitted_front(p, *q.shock, *q.layer);
@@ -333,6 +334,7 @@ std::vector<NamedValues> phase_columns(const RunQuantities& r) {
       column("layer_gap", "sigma",
              [](auto& q) { return q.layer ? q.layer->bottom - q.plate_z : nan; }),
       column("mass_gap", "sigma", [](auto& q) { return q.mass_bottom - q.plate_z; }),
+      column("knudsen_mass_fraction", "1", [](auto& q) { return q.knudsen_mass_fraction; }),
       column("temperature_slope_above_layer", "g",
              [](auto& q) { return q.temperature_slope_above; }),
       column("max_mach", "1", [](auto& q) { return q.max_mach; }),

@@ -20,6 +20,8 @@ struct PhaseQuantities {
   /// volume-fraction threshold in the dilute gas.
   double mass_bottom = 0.0;
   double layer_temperature = 0.0;  ///< number-weighted mean T inside the layer (NaN without)
+  /// The fraction of the material where the local Knudsen number exceeds knudsen_limit.
+  double knudsen_mass_fraction = 0.0;
   /// dT/dz of a least-squares line through the bins with material in the span above the
   /// layer's top (the dilute gas above the layer); NaN with fewer than 3 such bins.
   double temperature_slope_above = 0.0;

@@ -206,14 +206,16 @@ void print_table(const std::string& title, const Estimates& phases, const Estima
                c.per_cycle.size());
 }
 
-// One row per stored phase and bin: the profile and its Mach number (for plots of Ma(z)).
+// One row per stored phase and bin: the profile, its Mach number (for plots of Ma(z)) and its
+// local Knudsen numbers (NaN where undefined).
 void write_profiles_csv(const RunRecord& run, const std::string& path) {
-  std::string csv = "phase,z,n,nu,uz,T,mach\n";
+  std::string csv = "phase,z,n,nu,uz,T,mach,kn_n,kn_T\n";
   for (const auto& p : run.profiles) {
     const auto mach = analysis::mach_number(p, run.e);
+    const auto kn = analysis::knudsen_numbers(p);
     for (std::size_t i = 0; i < p.size(); ++i)
-      csv += fmt::format("{},{},{},{},{},{},{}\n", p.phase, p.z[i], p.n[i], p.nu[i], p.uz[i],
-                         p.T[i], mach[i]);
+      csv += fmt::format("{},{},{},{},{},{},{},{},{}\n", p.phase, p.z[i], p.n[i], p.nu[i], p.uz[i],
+                         p.T[i], mach[i], kn.density[i], kn.temperature[i]);
   }
   write_text_atomically(path, csv);
 }

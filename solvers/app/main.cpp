@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   analyze->add_option("--json", analysis.json_file,
                       "also write every quantity with its unit, error and jackknife replicates");
   analyze->add_option("--profiles-csv", analysis.profiles_csv,
-                      "also write every profile with its Mach number (phase,z,n,nu,uz,T,mach)");
+                      "also write every profile with its Mach and Knudsen numbers (phase,z,n,nu,uz,T,mach,kn_n,kn_T)");
   analyze->add_option("--pooled", analysis.pooled_file,
                       "also write the pooled run (profiles and samples of all RUNs) to this file");
   analyze->add_flag("--quiet", analysis.quiet, "print nothing (with --json or --csv)");
