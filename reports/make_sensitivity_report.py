@@ -104,7 +104,9 @@ def variants_table(results):
         lines.append(rc.table_row(cells))
     notes = [f"- `{v['name']}`: `{' '.join(v['overrides']) or '(none)'}`"
              + (f". {v['note']}" if v.get("note") else "")
-             + (f". Runs that did not finish: {v['failed']}" if v.get("failed") else "")
+             + (". Not run or not finished (so their claims are not measured): "
+                + ", ".join(f"{c} ({status})" for c, status in v["failed"].items())
+                if v.get("failed") else "")
              for v in results["variants"]]
     return ["## Every variant", "",
             "Verdicts as the validation report gives them: pass or **FAIL** by more than two "
