@@ -21,17 +21,14 @@ bad arguments.
 """
 import argparse
 import json
-import math
 import os
 import subprocess
 import sys
 import time
 
 if __package__:
-    from . import quantities
     from . import run_validation as rv
 else:  # run as a script: its folder, validation/, is first on sys.path
-    import quantities
     import run_validation as rv
 
 HERE = rv.HERE
@@ -77,16 +74,11 @@ def cycles_of(config):
     return run.get("transient_cycles", 0) + run.get("sampled_cycles", 0)
 
 
-def mass_gap(view, phase):
-    """The 1 % mass bottom above the plate at a stored phase, with its jackknife error."""
-    try:
-        k = quantities._row_at(view.analysis, phase)
-    except quantities.NotMeasured:
-        return None, None
-    value = float(view.analysis["mass_gap"][k])
-    error = view.errors.get("mass_gap")
-    error = float(error[k]) if error is not None and math.isfinite(error[k]) else None
-    return value, error
+def mass_gap(phase, solver, views, comparer):
+    """The 1 % mass bottom above the plate at a stored phase of the base case, measured as the
+    validation study measures it (with its error over MD's samples): (value, error)."""
+    m = rv.measure("mass_gap_at", {"phase": phase}, ["base"], solver, views, comparer, False)
+    return m.get("value"), m.get("error")
 
 
 def judge_variant(variant, md_views, continuum_views, claims, study, comparer):
@@ -112,7 +104,7 @@ def judge_variant(variant, md_views, continuum_views, claims, study, comparer):
     gaps = {}
     if base is not None and base.status == "ok":
         for phase in study["mass_gap_phases"]:
-            gaps[f"{phase:g}"] = mass_gap(base, phase)
+            gaps[f"{phase:g}"] = mass_gap(phase, "continuum", views, comparer)
     speed = None
     shock = continuum_views.get("single_shock_e0p99")
     if shock is not None and shock.status == "ok":
@@ -126,12 +118,13 @@ def judge_variant(variant, md_views, continuum_views, claims, study, comparer):
                 single_shock_speed=speed, seconds_per_cycle=per_cycle, failed=failed)
 
 
-def md_reference(md_views, study):
+def md_reference(md_views, study, comparer):
     """MD's numbers the variants are judged against, with their errors."""
     base = md_views.get(("base", "md"))
     gaps = {}
     if base is not None and base.status == "ok":
-        gaps = {f"{p:g}": mass_gap(base, p) for p in study["mass_gap_phases"]}
+        gaps = {f"{p:g}": mass_gap(p, "md", md_views, comparer)
+                for p in study["mass_gap_phases"]}
     shock = md_views.get(("single_shock_e0p99", "md"))
     speed = None
     if shock is not None and shock.status == "ok":
@@ -145,18 +138,12 @@ def md_reference(md_views, study):
                 exit_phase=exit_phase)
 
 
-def knudsen_inputs(md_views, runs, workdir, shaker):
+def knudsen_inputs(md_base, continuum_base):
     """The base case's profiles with their local Knudsen numbers (`shaker analyze
-    --profiles-csv`) and per-phase Knudsen mass fractions, MD and the reference variant."""
+    --profiles-csv`, written beside each analysed run) and per-phase Knudsen mass fractions,
+    MD and the reference variant."""
     out = {}
-    md = md_views.get(("base", "md"))
-    reference = next((r for r in runs if r.get("variant") == "validation"
-                      and r["case"] == "base" and r["record"]["status"] == "ok"), None)
-    views = [("md", md)]
-    if reference is not None:
-        view = rv.build_view(shaker, "base", "continuum", reference["record"], workdir)
-        views.append(("continuum", view))
-    for solver, view in views:
+    for solver, view in (("md", md_base), ("continuum", continuum_base)):
         if view is None or view.status != "ok":
             continue
         out[solver] = dict(profiles_csv=view.path + ".profiles.csv",
@@ -213,22 +200,24 @@ def main(argv=None):
     md_views = {(r["case"], "md"): rv.build_view(shaker, r["case"], "md", r["record"], workdir)
                 for r in runs if r["solver"] == "md"}
     comparer = rv.Comparer(shaker, os.path.join(workdir, "derived"))
-    judged = []
+    judged, reference_base = [], None
     for v in variants:
         continuum = {r["case"]: rv.build_view(shaker, r["case"], "continuum", r["record"], workdir)
                      for r in runs if r.get("variant") == v["name"]}
+        if v["name"] == "validation":
+            reference_base = continuum.get("base")
         judged.append(judge_variant(v, md_views, continuum, claims, study, comparer))
         verdicts = [f"{k} {c['status']} {rv._format_value(c['value'])}"
                     for k, c in judged[-1]["claims"].items()]
         rv.log(f"{v['name']}: " + ", ".join(verdicts))
     summary = dict(commit=rv.git("rev-parse", "HEAD"),
-                   knudsen=knudsen_inputs(md_views, runs, workdir, shaker),
+                   knudsen=knudsen_inputs(md_views.get(("base", "md")), reference_base),
                    shaker_version=subprocess.run([shaker, "--version"], capture_output=True,
                                                  text=True).stdout.strip(),
                    wall_seconds=time.monotonic() - started,
                    simulated_seconds=sum(r["record"]["seconds"] for r in runs
                                          if not r["record"].get("reused")),
-                   study=study, md=md_reference(md_views, study), variants=judged,
+                   study=study, md=md_reference(md_views, study, comparer), variants=judged,
                    runs=[dict(case=r["case"], solver=r["solver"], variant=r.get("variant"),
                               status=r["record"]["status"], seconds=r["record"]["seconds"],
                               reused=r["record"].get("reused", False),

@@ -5,7 +5,9 @@ tests the build directory declares (`ctest --show-only=json-v1`) and checks that
 of every status.txt under the source tree matches at least one of them, and that the first
 matching line's labels are the labels the test carries.
 
-    check_status_files.py CTEST SOURCE_DIR BUILD_DIR
+    PYTHONPATH=SOURCE_DIR check_status_files.py CTEST SOURCE_DIR BUILD_DIR
+
+(ctest sets PYTHONPATH: it reads the status files with reports.report_common's reader.)
 """
 import fnmatch
 import json
@@ -13,11 +15,11 @@ import os
 import subprocess
 import sys
 
+from reports.report_common import status_lines
+
 
 def main():
     ctest, source_dir, build_dir = sys.argv[1], sys.argv[2], sys.argv[3]
-    sys.path.insert(0, source_dir)
-    from reports.report_common import status_lines
     listed = subprocess.run([ctest, "--test-dir", build_dir, "--show-only=json-v1"],
                             capture_output=True, text=True)
     if listed.returncode != 0:
