@@ -111,6 +111,9 @@ void Operator::add_inviscid_fluxes(State& dUdt, int k0, int k1) {
       return dispatch_riemann<Limiter::van_leer>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt, k0, k1);
     case Limiter::none:
       return dispatch_riemann<Limiter::none>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt, k0, k1);
+    case Limiter::first_order:
+      return dispatch_riemann<Limiter::first_order>(settings_.riemann, grid_, w_, closure_, settings_.terms.pressure, dUdt,
+                                                    k0, k1);
   }
 }
 

@@ -172,7 +172,9 @@ Limiter limiter_from_string(const std::string& name) {
   if (name == "mc") return Limiter::mc;
   if (name == "van_leer") return Limiter::van_leer;
   if (name == "none") return Limiter::none;
-  throw InputError(fmt::format("continuum.limiter = \"{}\": allowed values are minmod, mc, van_leer, none", name));
+  if (name == "first_order") return Limiter::first_order;
+  throw InputError(
+      fmt::format("continuum.limiter = \"{}\": allowed values are minmod, mc, van_leer, none, first_order", name));
 }
 
 RiemannSolver riemann_from_string(const std::string& name) {

@@ -18,8 +18,10 @@ namespace shaker::continuum {
 
 enum class EquationOfState { granular, ideal_gas };  ///< ideal_gas: p = n T, gamma = 5/3
 /// `none`: unlimited central slopes, for verifying smooth solutions (limiters clip smooth
-/// extrema to first order, which caps the Linf order near 1.3).
-enum class Limiter { minmod, mc, van_leer, none };
+/// extrema to first order, which caps the Linf order near 1.3). `first_order`: zero slopes
+/// everywhere (Godunov's scheme), the most dissipative reconstruction, for judging how much
+/// the result owes to the slopes near vacuum.
+enum class Limiter { minmod, mc, van_leer, none, first_order };
 enum class RiemannSolver { hllc, hll };              ///< hll is the simple reference
 
 /// Which terms enter the operator. `advection` is the whole inviscid (Riemann) flux;

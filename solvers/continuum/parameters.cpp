@@ -14,8 +14,9 @@ std::vector<ParameterSpec> continuum_parameters() {
            "volume fraction of the initial flat layer (below nu_max = 0.65)").in("1"),
       text("continuum.transport", "full", {"paper", "full"},
            "paper: 1/G terms dropped plus low-density artificial dissipation; full: all terms").in("-"),
-      text("continuum.limiter", "mc", {"minmod", "mc", "van_leer", "none"},
-           "slope limiter; none = unlimited central slopes (smooth-solution verification only)").in("-"),
+      text("continuum.limiter", "mc", {"minmod", "mc", "van_leer", "none", "first_order"},
+           "slope limiter; none = unlimited central slopes (smooth-solution verification only); "
+           "first_order = zero slopes (Godunov)").in("-"),
       text("continuum.riemann", "hllc", {"hllc", "hll"}, "approximate Riemann solver").in("-"),
       real("continuum.cfl", 0.4, positive(1.0), "Courant number of each forward-Euler stage of the adaptive step").in("1"),
       real("continuum.perturbation", 1e-3, closed(0.0, 0.5),

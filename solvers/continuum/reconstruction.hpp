@@ -1,7 +1,9 @@
 #pragma once
 // Limited MUSCL reconstruction: the face value of a cell is its average plus half a limited
 // slope. Every limiter here (not `none`) keeps face values between the neighbouring averages,
-// so positive fields (n, T, p, c) stay positive at faces.
+// so positive fields (n, T, p, c) stay positive at faces; with positive face states the HLL
+// and HLLC fluxes keep n and p positive under a Courant number of 1/2 (Perthame and Shu
+// 1996; Batten et al. 1997), which is why no separate positivity limiter is needed.
 //
 // Here: the limiters (limited_slope), the component-wise reconstruction (reconstruct_lanes),
 // the characteristic limiting of (n, u_n, p), and the wall cells' one-sided slopes and mirror
@@ -25,7 +27,9 @@ inline double minmod(double a, double b) {
 
 /// Limited slope (per cell width) from the backward and forward differences.
 template <Limiter L> inline double limited_slope(double backward, double forward) {
-  if constexpr (L == Limiter::minmod) {
+  if constexpr (L == Limiter::first_order) {
+    return 0.0;
+  } else if constexpr (L == Limiter::minmod) {
     return minmod(backward, forward);
   } else if constexpr (L == Limiter::mc) {
     if (backward * forward <= 0.0) return 0.0;
@@ -46,7 +50,9 @@ template <Limiter L, class V>
 inline V limited_slope(V backward, V forward) {
   using namespace pair_detail;
   const V zero = V{};
-  if constexpr (L == Limiter::minmod) {
+  if constexpr (L == Limiter::first_order) {
+    return zero;
+  } else if constexpr (L == Limiter::minmod) {
     const V smallest = magnitude(backward) < magnitude(forward) ? backward : forward;
     return backward * forward <= 0.0 ? zero : smallest;
   } else if constexpr (L == Limiter::mc) {
@@ -132,14 +138,18 @@ inline void characteristic_faces(const BlockContext& x, std::ptrdiff_t c, int q,
 // dissipation, was an O(h) truncation error in the wall cell and a first-order density
 // error there (MMS full_walls, n Linf pair orders 80 -> 640 cells: 1.58 1.46 1.11 with
 // x1 - x0; 1.97 2.00 to 320 cells with this slope).
-// sign: +1 when the wanted face lies on the interior side of the cell centre.
+// sign: +1 when the wanted face lies on the interior side of the cell centre. First order:
+// no slope, as everywhere else.
+template <Limiter L>
 inline void wall_cell(const BlockContext& x, std::ptrdiff_t c, std::ptrdiff_t interior_step, double sign,
                       FaceStates& face, int slot) {
   for (int v = 0; v < 7; ++v) {
     if (v == x.un_index) continue;
     const double* field = x.fields[v];
     const double x0 = field[c];
-    const double half_slope = 0.25 * (4.0 * field[c + interior_step] - 3.0 * x0 - field[c + 2 * interior_step]);
+    const double half_slope = L == Limiter::first_order
+                                  ? 0.0
+                                  : 0.25 * (4.0 * field[c + interior_step] - 3.0 * x0 - field[c + 2 * interior_step]);
     const double value = x0 + sign * half_slope, other = x0 - sign * half_slope;
     const bool keep = value >= 0.5 * x0 && value <= 2.0 * x0 && other >= 0.5 * x0 && other <= 2.0 * x0;
     face[v][slot] = keep ? value : x0;
@@ -154,20 +164,21 @@ inline void mirror(const BlockContext& x, const FaceStates& from, int from_slot,
 /// The face states of wall face f (0 or length) and of the wall cells' interior faces
 /// (1, length - 1) of the pencil whose first cell is `first`; the face's left state is
 /// plus[.][left], its right one minus[.][left + W].
+template <Limiter L>
 inline void wall_face(const BlockContext& x, std::ptrdiff_t first, int f, int left, int W, FaceStates& minus,
                       FaceStates& plus) {
   const std::ptrdiff_t s = x.s;
   const int right = left + W;
   const std::ptrdiff_t cR = first + f * s, cL = cR - s;
   if (f == 0) {
-    wall_cell(x, cR, s, -1.0, minus, right);
+    wall_cell<L>(x, cR, s, -1.0, minus, right);
     mirror(x, minus, right, plus, left);
   } else if (f == x.length) {
-    wall_cell(x, cL, -s, -1.0, plus, left);
+    wall_cell<L>(x, cL, -s, -1.0, plus, left);
     mirror(x, plus, left, minus, right);
   } else {
-    if (f == 1) wall_cell(x, cL, s, +1.0, plus, left);
-    if (f == x.length - 1) wall_cell(x, cR, -s, +1.0, minus, right);
+    if (f == 1) wall_cell<L>(x, cL, s, +1.0, plus, left);
+    if (f == x.length - 1) wall_cell<L>(x, cR, -s, +1.0, minus, right);
   }
 }
 
@@ -191,7 +202,7 @@ inline void reconstruct_block(const BlockContext& x, const Block& block, FaceSta
     for (int f = block.f0; f < block.f1; ++f)
       if (f <= 1 || f >= x.length - 1)
         for (int lane = 0; lane < block.W; ++lane)
-          wall_face(x, block.base + lane, f, (f - block.f0) * block.W + lane, block.W, minus, plus);
+          wall_face<L>(x, block.base + lane, f, (f - block.f0) * block.W + lane, block.W, minus, plus);
 }
 
 }  // namespace inviscid
