@@ -662,6 +662,36 @@ def width_section(results):
     return lines + [""]
 
 
+def sampling_section(results):
+    """The shock quantities of each resampled MD case at its own and at the finer phase
+    sampling (validation/phase_sampling.py), with their jackknife errors."""
+    entries = results.data.get("sampling", [])
+    lines = ["## Shock quantities against the phase sampling (MD)", "",
+             "The same MD runs (same seeds) stored at two phase samplings; a quantity agrees "
+             "when |difference| is within the stated number of combined standard errors "
+             "(validation/phase_sampling.py). – where the run has no shock.", ""]
+    if not entries:
+        return lines + ["Not run (a quick study, or no case of studies.toml [sampling]).", ""]
+    lines += [f"Agreement within {entries[0]['agreement']:g} combined standard errors.", ""]
+    disagreeing = [f"{e['case']} {r['quantity']}" for e in entries for r in e.get("rows", [])
+                   if r["agrees"] is False]
+    lines += rc.table_head(["case", "quantity", "units", "phases per cycle", "coarse", "fine",
+                            "|diff| / combined error", "agrees"])
+    for e in entries:
+        if e["status"] != "ok":
+            lines.append(f"| {e['case']} | – | | | {e['status']} | | | |")
+            continue
+        for r in e["rows"]:
+            units = rc.units_of(rc.ANALYSIS_UNITS, r["quantity"], "analysis quantity")
+            agrees = {True: "yes", False: "**no**", None: "–"}[r["agrees"]]
+            lines.append(f"| {e['case']} | {r['quantity']} | {units} | {e['phases'][0]} / "
+                         f"{e['phases'][1]} | {value_text(*r['coarse'])} | "
+                         f"{value_text(*r['fine'])} | {fmt(r['ratio'], 2)} | {agrees} |")
+    summary = (f"{len(disagreeing)} quantities disagree: {', '.join(disagreeing)}" if disagreeing
+               else "every measured quantity agrees")
+    return lines + ["", summary + ".", ""]
+
+
 def metrics_section(results):
     lines = ["## Agreement metrics (continuum against MD as reference)", ""]
     metrics = results.data["metrics"]
@@ -726,7 +756,7 @@ def main():
             body += figure(results, out_dir, link)
         claims, counts = claims_section(results)
         text = header(results, counts) + body + claims + diagnoses_section(results) \
-            + width_section(results) + metrics_section(results)
+            + width_section(results) + sampling_section(results) + metrics_section(results)
     except rc.UnknownUnits as unknown:
         print(f"make_validation_report: {unknown}", file=sys.stderr)
         return 2

@@ -129,6 +129,13 @@ ANALYSIS_UNITS = {
     "shock_speed": "sqrt(g sigma)",  # plate frame
     "center_of_mass_mean": "sigma",
     "center_of_mass_apex": "sigma",
+    # per-run shock quantities
+    "formation_phase": DIMENSIONLESS,  # f t
+    "exit_phase": DIMENSIONLESS,  # f t
+    "lifetime": "1/f",
+    "shock_width_mean": "sigma",
+    "width_over_mfp_mean": DIMENSIONLESS,
+    "max_mach_peak": DIMENSIONLESS,
 }
 
 

@@ -43,8 +43,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 if __package__:
-    from . import quantities
+    from . import phase_sampling, quantities
 else:  # run as a script: its folder, validation/, is first on sys.path
+    import phase_sampling
     import quantities
 
 SOLVERS = ("md", "continuum")
@@ -240,6 +241,36 @@ def plan_runs(shaker, studies, case_names, quick):
                              fallback=case.get("md_fallback", []) if solver == "md" else [],
                              expect_failure=case.get("expect_failure", False)))
     return plan
+
+
+def resampled_runs(studies, plan):
+    """The MD runs of studies.toml [sampling], again at its phases per cycle: copies of the
+    plan's MD runs of those cases with one more override (marked by `phases`)."""
+    sampling = studies.get("sampling", {})
+    phases = sampling.get("phases_per_cycle")
+    return [dict(r, overrides=r["overrides"] + [f"run.phases_per_cycle={phases}"], phases=phases)
+            for r in plan if r["solver"] == "md" and r["case"] in sampling.get("cases", [])]
+
+
+def phase_sampling_results(shaker, plan, views, workdir):
+    """Per resampled case: its shock quantities at the case's own phases per cycle and at the
+    finer sampling, compared by validation/phase_sampling.py."""
+    out = []
+    for r in plan:
+        if not r.get("phases"):
+            continue
+        coarse = views[(r["case"], "md")]
+        fine = build_view(shaker, r["case"], "md", r["record"], workdir)
+        entry = dict(case=r["case"], phases=[coarse.config.get("run", {}).get("phases_per_cycle"),
+                                             r["phases"]],
+                     status=fine.status if coarse.status == "ok" else coarse.status,
+                     agreement=phase_sampling.AGREEMENT)
+        if entry["status"] == "ok":
+            entry["rows"] = phase_sampling.compare(*[
+                {k: (v.per_run.get(k), v.per_run_errors.get(k))
+                 for k in phase_sampling.SHOCK_QUANTITIES} for v in (coarse, fine)])
+        out.append(entry)
+    return out
 
 
 def run_key(shaker, run):
@@ -679,12 +710,16 @@ def main(argv=None):
                      + ", ".join(studies["by_name"]))
 
     started = time.monotonic()
-    plan = execute_all(shaker, workdir, plan_runs(shaker, studies, names, args.quick), args.jobs,
+    plan = plan_runs(shaker, studies, names, args.quick)
+    if not args.quick:
+        plan += resampled_runs(studies, plan)
+    plan = execute_all(shaker, workdir, plan, args.jobs,
                        args.rerun, args.reuse_only, shlex.split(args.launcher))
     views = {}
     for name in names:
         for solver in studies["by_name"][name]["solvers"]:
-            record = next(r["record"] for r in plan if r["case"] == name and r["solver"] == solver)
+            record = next(r["record"] for r in plan
+                          if r["case"] == name and r["solver"] == solver and not r.get("phases"))
             views[(name, solver)] = build_view(shaker, name, solver, record, workdir)
     comparer = Comparer(shaker, os.path.join(workdir, "derived"))
     metrics = {}
@@ -699,7 +734,9 @@ def main(argv=None):
     results = evaluate_claims(claims, views, comparer, partial)
     diagnosed, undiagnosed = diagnose(diagnoses, results, views, comparer, partial)
 
+    sampling = phase_sampling_results(shaker, plan, views, workdir)
     runs = [dict(case=r["case"], solver=r["solver"], replicas=r["replicas"],
+                 phases_per_cycle=r.get("phases"),
                  status=r["record"]["status"], seconds=r["record"]["seconds"],
                  reused=r["record"].get("reused", False), path=r["record"].get("path"),
                  fallback=r["record"].get("fallback"), program=run_program(r["record"]),
@@ -714,7 +751,7 @@ def main(argv=None):
                                       text=True).stdout.strip(),
         wall_seconds=time.monotonic() - started,
         simulated_seconds=sum(r["seconds"] for r in runs if not r["reused"]),
-        runs=runs, metrics=metrics, claims=results, diagnoses=diagnosed,
+        runs=runs, metrics=metrics, claims=results, diagnoses=diagnosed, sampling=sampling,
         # Only metrics with declared units: the report refuses to show one without them.
         metric_units={name: COMPARISON_METRIC_UNITS[name] for m in metrics.values()
                       for name in m if name in COMPARISON_METRIC_UNITS},

@@ -170,8 +170,10 @@ def write_run(path, config_text, solver, seed):
 def write_runs(shaker, workdir, cases, quick):
     """The synthetic run files of `cases` (comma-separated) under workdir/runs."""
     studies = run_validation.load_studies(os.path.join(VALIDATION, "studies.toml"))
-    write_plan(shaker, workdir, run_validation.plan_runs(os.path.abspath(shaker), studies,
-                                                         cases.split(","), quick))
+    plan = run_validation.plan_runs(os.path.abspath(shaker), studies, cases.split(","), quick)
+    if not quick:
+        plan += run_validation.resampled_runs(studies, plan)
+    write_plan(shaker, workdir, plan)
 
 
 def write_plan(shaker, workdir, plan):

@@ -82,6 +82,8 @@ def test_every_planned_run_is_accepted(shaker):
     for quick in (False, True):
         names = sorted(LISTED) if not quick else STUDIES["quick"]["cases"]
         plan = run_validation.plan_runs(shaker, STUDIES, names, quick)
+        if not quick:
+            plan += run_validation.resampled_runs(STUDIES, plan)
         for run in plan:
             run_validation.run_key(shaker, run)
             if run["fallback"]:

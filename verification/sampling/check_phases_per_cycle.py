@@ -2,22 +2,19 @@
 
 Runs `shaker md CASE` at run.phases_per_cycle = 50 and 100 with the same seed (the same
 trajectory: the stored phases only add snapshots), analyses both with `shaker analyze --json`
-and checks that every per-run shock quantity agrees within twice the combined standard error
-of the two runs. Prints the table. Usage:
+and checks that every per-run shock quantity agrees as validation/phase_sampling.py judges it
+(within two combined standard errors of the two runs). Prints the table. Usage:
 
     check_phases_per_cycle.py SHAKER CASE.toml [--phases 50 100] [--keep DIR]
 """
 import argparse
 import json
-import math
 import os
 import subprocess
 import sys
 
 import keep_on_failure
-
-QUANTITIES = ["formation_phase", "exit_phase", "lifetime", "shock_speed", "shock_width_mean",
-              "width_over_mfp_mean", "max_mach_peak"]
+from validation import phase_sampling
 
 
 def analysed(shaker, case, phases, work):
@@ -30,10 +27,6 @@ def analysed(shaker, case, phases, work):
         return json.load(f)["per_run"]
 
 
-def number(x):
-    return float("nan") if x is None else float(x)
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("shaker")
@@ -44,16 +37,15 @@ def main():
     a, b = (analysed(args.shaker, args.case, p, work) for p in args.phases)
     problems = []
     print(f"{'quantity':>22} {args.phases[0]:>18} {args.phases[1]:>18} {'|diff|/combined':>16}")
-    for name in QUANTITIES:
-        va, ea = number(a[name]["value"]), number(a[name]["error"])
-        vb, eb = number(b[name]["value"]), number(b[name]["error"])
-        combined = math.hypot(ea, eb)
-        ratio = abs(va - vb) / combined if combined > 0 else float("nan")
-        print(f"{name:>22} {va:>10.4g}({ea:.2g}) {vb:>10.4g}({eb:.2g}) {ratio:>16.2f}")
-        if not ratio <= 2.0:
-            problems.append(f"{name}: {va} +- {ea} against {vb} +- {eb}")
+    pairs = [{k: (v["value"], v["error"]) for k, v in run.items()} for run in (a, b)]
+    for row in phase_sampling.compare(*pairs):
+        (va, ea), (vb, eb) = row["coarse"], row["fine"]
+        print(f"{row['quantity']:>22} {va:>10.4g}({ea:.2g}) {vb:>10.4g}({eb:.2g}) "
+              f"{row['ratio']:>16.2f}")
+        if not row["agrees"]:
+            problems.append(f"{row['quantity']}: {va} +- {ea} against {vb} +- {eb}")
     for p in problems:
-        print("differs by more than 2 combined standard errors:", p)
+        print(f"differs by more than {phase_sampling.AGREEMENT} combined standard errors:", p)
     return keep_on_failure.finish(work, problems, "every shock quantity agrees")
 
 
