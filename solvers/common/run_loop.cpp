@@ -58,7 +58,8 @@ void PhaseSchedule::resume_at(const SchedulePosition& p, double time, const std:
         "continued mid-cycle keeps the checkpoint's phases; allowed: run.phases_per_cycle = {}",
         phases_, source, p.phase, p.phases, p.cycle, p.phases));
   const std::int64_t first = p.cycle * phases_ + p.phase;
-  if (first >= cycles() * phases_)
+  // A stop at the last stored phase leaves the way to the run's end.
+  if (first > cycles() * phases_ || (first == cycles() * phases_ && !(time < end())))
     throw InputError(fmt::format(
         "{} was written at cycle {} (phase {} of {}) of its run, and run.transient_cycles + "
         "run.sampled_cycles = {} leaves nothing to run: a continued run counts its cycles from "

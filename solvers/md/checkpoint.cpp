@@ -9,6 +9,7 @@
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/run_file.hpp"
 
 namespace shaker::md {
 namespace {
@@ -54,10 +55,28 @@ void read_tally(hid_t f, Tally& t) {
   t.virial = energy[3];
 }
 
+/// The sampled sums, if any (group cycle_samples, as in a run file, with the attribute
+/// first_cycle).
+SampledCycles read_sampled(hid_t f, const SchedulePosition& position) {
+  if (!h5::exists(f, "cycle_samples")) return {};
+  SampledCycles sampled;
+  const h5::Handle group = h5::open_group(f, "cycle_samples");
+  sampled.first_cycle = h5::read_integer_attribute(group.id(), "first_cycle");
+  if (sampled.first_cycle < 0 || sampled.first_cycle > position.cycle)
+    throw InputError(fmt::format("attribute 'cycle_samples/first_cycle' = {}; allowed: 0 <= value <= {} "
+                                 "(schedule_cycle)", sampled.first_cycle, position.cycle));
+  const auto dims = h5::shape(group.id(), "count");
+  if (dims.size() != 2 || dims[1] == 0) throw InputError("dataset 'cycle_samples/count' is not a [rows x bins] matrix");
+  const auto phases = static_cast<std::size_t>(position.phases);
+  sampled.sums = read_samples(f, phases, dims[1], true);
+  return sampled;
+}
+
 }  // namespace
 
 void write_checkpoint(const std::filesystem::path& path, const SimulationData& d, const Geometry& geometry,
-                      const SchedulePosition& position, const std::string& configuration) {
+                      const SchedulePosition& position, const std::string& configuration,
+                      const SampledCycles& sampled) {
   write_hdf5_atomically(path, [&](const hid_t f) {
     write_checkpoint_header(f, checkpoint_kind, position, configuration);
     h5::write_attribute(f, "time", d.time);
@@ -105,6 +124,9 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
                                                            t.guard_activations, t.grazes}));
     h5::write(f, "tally_energy", std::vector<double>{t.plate_work, t.pair_loss, t.wall_loss, t.virial},
               {4}, "m g sigma");
+    if (sampled.sums.empty() || sampled.sums.samples(0) == 0) return;  // phase 0 is sampled first
+    write_samples(f, sampled.sums, true);
+    h5::write_attribute(h5::open_group(f, "cycle_samples").id(), "first_cycle", sampled.first_cycle);
   });
 }
 
@@ -178,6 +200,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     require_length("cell_next", d.cell_next.size(), n);
     require_length("cell_prev", d.cell_prev.size(), n);
     require_length("cell_of", d.cell_of.size(), n);
+    c.sampled = read_sampled(f, c.position);
   } catch (const std::exception& error) {
     throw InputError(fmt::format("{} is not a valid checkpoint: {}", restart_source(path), error.what()));
   }

@@ -48,11 +48,17 @@ std::string variant_name(const Restitution& r, const MdSettings& s) {
   return model + ", " + guard;
 }
 
+/// What a continued run takes from its checkpoint besides the simulation's state.
+struct Resumed {
+  SchedulePosition position;
+  SampledCycles sampled;
+};
+
 /// The simulation at the case's initial state, or at the checkpoint `restart_from` (whose
-/// schedule position goes to `position`).
+/// schedule position and sampled sums go to `resumed`).
 Simulation make_simulation(const config::Config& config, const CaseParameters& c, const MdSettings& s,
                            const Geometry& g, const CollisionRules& rules,
-                           const std::filesystem::path& restart_from, std::optional<SchedulePosition>& position) {
+                           const std::filesystem::path& restart_from, std::optional<Resumed>& resumed) {
   const auto n = static_cast<std::size_t>(c.particles);
   if (restart_from.empty()) {
     if (s.initial_state == "gas")
@@ -76,7 +82,7 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
   } catch (const InputError& error) {
     throw InputError(fmt::format("{} is not a valid checkpoint: {}", source, error.what()));
   }
-  position = saved.position;
+  resumed = Resumed{saved.position, std::move(saved.sampled)};
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
   State state{saved.data.time, std::move(saved.data.particles), std::move(saved.data.last_collision)};
@@ -85,11 +91,56 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
 
 /// The MD's schedule: a new one from the simulation's time, or the checkpoint's, continued.
 PhaseSchedule schedule_of(const CaseParameters& c, const Simulation& simulation,
-                          const std::optional<SchedulePosition>& resume, const std::filesystem::path& restart_from) {
+                          const std::optional<Resumed>& resume, const std::filesystem::path& restart_from) {
   if (!resume) return PhaseSchedule::whole_cycles(c.run, c.shaker, simulation.time());
-  PhaseSchedule schedule = PhaseSchedule::whole_cycles(c.run, c.shaker, resume->start_time);
-  schedule.resume_at(*resume, simulation.time(), restart_source(restart_from));
+  PhaseSchedule schedule = PhaseSchedule::whole_cycles(c.run, c.shaker, resume->position.start_time);
+  schedule.resume_at(resume->position, simulation.time(), restart_source(restart_from));
   return schedule;
+}
+
+/// A continued run past its first sampled cycle takes up the checkpoint's sums of the cycles
+/// sampled before it, so that its profiles are those of the uninterrupted run. InputError if
+/// the checkpoint's sums are not those cycles' in this run's phases and bins.
+void take_up_samples(PhaseSampler& sampler, const Resumed& resumed, const PhaseSchedule& schedule,
+                     const std::string& source) {
+  const SchedulePosition& at = resumed.position;
+  const std::int64_t first = schedule.transient_cycles();
+  if (at.cycle < first || (at.cycle == first && at.phase == 0)) return;  // nothing sampled yet
+  const CycleSamples& saved = resumed.sampled.sums;
+  const std::string sample_anew = fmt::format("or run.transient_cycles >= {} to sample only after it", at.cycle);
+  if (saved.empty())
+    throw InputError(fmt::format(
+        "run.transient_cycles = {}, but {} (cycle {}, phase {} of {}) holds no profile sums of the "
+        "sampled cycles before it (it was written in its run's transient, or by an earlier version); "
+        "allowed: run.transient_cycles >= {}, sampling only after it", first, source, at.cycle, at.phase,
+        at.phases, at.cycle));
+  if (resumed.sampled.first_cycle != first)
+    throw InputError(fmt::format("run.transient_cycles = {}, but {} holds the profile sums of the cycles "
+                                 "from {}; allowed: run.transient_cycles = {}, {}", first, source,
+                                 resumed.sampled.first_cycle, resumed.sampled.first_cycle, sample_anew));
+  if (saved.phases() != static_cast<std::size_t>(schedule.phases()))
+    throw InputError(fmt::format("run.phases_per_cycle = {}, but {} holds profile sums at {} phases; "
+                                 "allowed: run.phases_per_cycle = {}, {}", schedule.phases(), source,
+                                 saved.phases(), saved.phases(), sample_anew));
+  const CycleSamples& mine = sampler.store();
+  if (saved.bins() != mine.bins() || saved.bin_volume() != mine.bin_volume())
+    throw InputError(fmt::format(
+        "md.bin_height, md.ceiling and md.box_width give {} sampling bins of volume {}, but {} holds "
+        "profile sums in {} bins of volume {}; allowed: the checkpoint's md.bin_height, md.ceiling "
+        "and md.box_width, {}", mine.bins(), mine.bin_volume(), source, saved.bins(), saved.bin_volume(),
+        sample_anew));
+  for (std::size_t k = 0; k < saved.phases(); ++k) {
+    double cycles = 0.0;
+    for (double c : saved.cycles(k)) cycles += c;
+    const std::int64_t expected = at.cycle - first + (static_cast<std::int64_t>(k) < at.phase ? 1 : 0);
+    if (cycles != static_cast<double>(expected))
+      throw InputError(fmt::format("{} is not a valid checkpoint: dataset 'cycle_samples/cycles' holds {} "
+                                   "sampled cycles at phase {}; allowed: {} (cycles {} to {}, phase {})", source,
+                                   cycles, k, expected, first, at.cycle, at.phase));
+  }
+  std::vector<double> first_times;
+  for (std::int64_t k = 0; k < schedule.phases(); ++k) first_times.push_back(schedule.target(first, k));
+  sampler.resume(saved, first_times);
 }
 
 /// The memory of the particles, the cell list and the phase sampler, before any is allocated.
@@ -269,10 +320,12 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   for (std::int64_t r = ranks.rank(); r < replicas; r += ranks.size()) {
     const config::Config replica = replica_configuration(config, r);
     const CaseParameters replica_parameters = CaseParameters::from(replica);
-    std::optional<SchedulePosition> resume;
+    std::optional<Resumed> resume;
     Simulation simulation =
         make_simulation(replica, replica_parameters, settings, geometry, rules, checkpoints.restart_from, resume);
     const PhaseSchedule schedule = schedule_of(replica_parameters, simulation, resume, checkpoints.restart_from);
+    PhaseSampler sampler = make_sampler(simulation, schedule, settings);
+    if (resume) take_up_samples(sampler, *resume, schedule, restart_source(checkpoints.restart_from));
     ProgressReport progress(replicas == 1 ? "shaker md" : fmt::format("shaker md replica {}", r),
                             "collisions/s",
                             [&] { return static_cast<double>(simulation.tally().collisions()); },
@@ -284,12 +337,13 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
       checkpointing.emplace(
           checkpoints, schedule,
           [&](const std::filesystem::path& path, const SchedulePosition& position) {
-            write_checkpoint(path, simulation.save(), geometry, position, configuration);
+            write_checkpoint(path, simulation.save(), geometry, position, configuration,
+                             SampledCycles{sampler.store(), schedule.transient_cycles()});
           },
           "shaker md");
       also.push_back(&*checkpointing);
     }
-    const RunOutcome outcome = run_protocol(simulation, schedule, replica_parameters, settings, also);
+    const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, settings, also);
     summary_of(simulation, outcome).pack(mine);
     if (r == 0) {
       record.profiles = outcome.profiles;
