@@ -94,6 +94,11 @@ class PhaseSchedule {
   /// gave the checkpoint) if no stored phase of this schedule is left after the position,
   /// or if the position lies mid-cycle and run.phases_per_cycle differs from the checkpoint's.
   void resume_at(const SchedulePosition& position, double time, const std::string& source);
+  /// InputError (naming `source`) unless this run meets the single shock's switch as the run
+  /// that wrote the checkpoint at `time` (protocol `written_by`; its schedule started at the
+  /// same time) did: both switched before the checkpoint, at the same time to the same
+  /// restitution, or neither did. Otherwise the continued run would be neither run.
+  void check_switch(const RunProtocol& written_by, double time, const std::string& source) const;
   /// The position of stored phase k of cycle m; (cycles(), 0) is the end of the run.
   SchedulePosition position(std::int64_t m, std::int64_t k) const;
   /// Where run() starts: (0, 0), or where resume_at put it.
@@ -110,6 +115,8 @@ class PhaseSchedule {
   PhaseSchedule(const RunProtocol& run, const ShakerKinematics& shaker, Clock clock, double start_time,
                 double origin);
   double time_of(double cycle_count) const;
+  /// The time of `run`'s switch on this schedule's clock (a single shock's).
+  double switch_time_of(const RunProtocol& run) const;
   /// A continued run past the single shock's switch.
   bool switched_before_start() const;
 
@@ -120,7 +127,7 @@ class PhaseSchedule {
   std::int64_t first_ = 0;  ///< m * phases + k of the first stored phase run() reaches
   std::int64_t transient_, sampled_, phases_;
   std::optional<double> switch_time_;  ///< single shock only
-  Restitution after_switch_;
+  RunProtocol protocol_;
 };
 
 }  // namespace shaker

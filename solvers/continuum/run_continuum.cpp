@@ -346,7 +346,8 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
   const RunProtocol& run = c.parameters.run;
   if (restart_from.empty()) return PhaseSchedule::from_start(run, c.parameters.shaker, solver.time());
   const std::string source = restart_source(restart_from);
-  config::require_same_keys(config, checkpoint_configuration(restart_from),
+  const std::string saved = checkpoint_configuration(restart_from);
+  config::require_same_keys(config, saved,
                             {"material.restitution", "material.e", "layer.particles", "md.box_width", "shaker.frequency"},
                             source);
   const Halo* halo = solver.op().halo();
@@ -354,6 +355,7 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
                                          : read_checkpoint(restart_from, solver);
   PhaseSchedule schedule = PhaseSchedule::from_start(run, c.parameters.shaker, position.start_time);
   schedule.resume_at(position, solver.time(), source);
+  schedule.check_switch(CaseParameters::from(config::Config::from_toml(saved, source)).run, solver.time(), source);
   return schedule;
 }
 

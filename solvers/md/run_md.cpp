@@ -52,6 +52,7 @@ std::string variant_name(const Restitution& r, const MdSettings& s) {
 struct Resumed {
   SchedulePosition position;
   SampledCycles sampled;
+  RunProtocol written_by;  ///< the protocol of the run that wrote the checkpoint
 };
 
 /// The simulation at the case's initial state, or at the checkpoint `restart_from` (whose
@@ -82,7 +83,8 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
   } catch (const InputError& error) {
     throw InputError(fmt::format("{} is not a valid checkpoint: {}", source, error.what()));
   }
-  resumed = Resumed{saved.position, std::move(saved.sampled)};
+  resumed = Resumed{saved.position, std::move(saved.sampled),
+                    CaseParameters::from(config::Config::from_toml(saved.configuration, source)).run};
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
   State state{saved.data.time, std::move(saved.data.particles), std::move(saved.data.last_collision)};
@@ -95,6 +97,7 @@ PhaseSchedule schedule_of(const CaseParameters& c, const Simulation& simulation,
   if (!resume) return PhaseSchedule::whole_cycles(c.run, c.shaker, simulation.time());
   PhaseSchedule schedule = PhaseSchedule::whole_cycles(c.run, c.shaker, resume->position.start_time);
   schedule.resume_at(resume->position, simulation.time(), restart_source(restart_from));
+  schedule.check_switch(resume->written_by, simulation.time(), restart_source(restart_from));
   return schedule;
 }
 
