@@ -47,6 +47,11 @@
       after the first checkpoint, so that the next one cannot be written): the root says why
       and every rank ends, exit 1 within a minute (no rank left waiting for the others, nor
       the root for them), no run file written.
+  check_continuum_ranks.py SHAKER disagree [--mpirun CMD]
+      An MPMD launch (`mpirun -np 1 shaker ... : -np 1 shaker ...`) whose ranks get different
+      --set values (continuum.box_width 11 and 12; material.e of an MD ensemble; a value
+      refused on one rank alone): exit 2 on every rank, the message naming the rank and the key
+      that differ with both values, nothing written.
   check_continuum_ranks.py SHAKER refused [--mpirun CMD]
       A 1D column on 2 ranks, an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x), and a
       box too large for the machine's memory on 2 ranks (their blocks' needs added up, as both
@@ -476,12 +481,44 @@ def check_refused(shaker, work, launcher):
     return failures
 
 
+def check_disagreeing_ranks(shaker, work, launcher):
+    """An MPMD launch whose two ranks get different settings: exit 2 on every rank, naming the
+    rank and the key that differ (or the rank whose configuration did not load)."""
+    failures = []
+    words = shlex.split(launcher) + ["--oversubscribe", "--mca", "mpi_yield_when_idle", "1"]
+    if os.geteuid() == 0:
+        words.append("--allow-run-as-root")
+    for label, solver, ours, theirs, needles in (
+            ("continuum box widths 11 and 12", "continuum", "continuum.box_width=11",
+             "continuum.box_width=12",
+             ["rank 1 has continuum.box_width = 12.0 where rank 0 has continuum.box_width = 11.0"]),
+            ("MD ensemble with e 0.9 and 0.8", "md", "material.e=0.9", "material.e=0.8",
+             ["rank 1 has material.e = 0.8 where rank 0 has material.e = 0.9"]),
+            ("a setting refused on rank 1 alone", "continuum", "material.e=0.9", "material.e=1.5",
+             ["rank 1 has 'error: ", "material.e"])):
+        contexts = []
+        for setting in (ours, theirs):
+            contexts += ["-np", "1", shaker, solver, "case.toml", "--quiet", "--set",
+                         "run.output=disagree.h5", "--set", "md.replicas=2", "--set", setting, ":"]
+        result = run(words + contexts[:-1], work, expect=2)
+        for needle in needles + [
+                "the 2 ranks of this launch disagree on the effective configuration",
+                "allowed: the same case file and --set values on every rank"]:
+            if needle not in result.stderr:
+                failures.append(f"{label}: message lacks '{needle}': {result.stderr[-600:]}")
+        written = [n for n in os.listdir(work) if n.startswith("disagree")]
+        if written:
+            failures.append(f"{label}: wrote {written}")
+        print(f"{label}: exit 2, {len(failures)} problems so far")
+    return failures
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("shaker")
     parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit",
                                           "implicit_wall_stress", "restart", "column", "failure",
-                                          "signal", "root_failure", "refused"])
+                                          "signal", "root_failure", "refused", "disagree"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -510,6 +547,8 @@ def main():
         failures = check_signal(args.shaker, work, args.mpirun)
     elif args.check == "root_failure":
         failures = check_root_failure(args.shaker, work, args.mpirun)
+    elif args.check == "disagree":
+        failures = check_disagreeing_ranks(args.shaker, work, args.mpirun)
     else:
         failures = check_refused(args.shaker, work, args.mpirun)
     for failure in failures:
