@@ -123,7 +123,12 @@ bool PhaseSchedule::switched_before_start() const {
   return *switch_time_ <= target((first_ - 1) / phases_, (first_ - 1) % phases_);
 }
 
-void PhaseSchedule::run(DrivenSolver& solver, const std::vector<RunObserver*>& observers) const {
+void PhaseSchedule::run(DrivenSolver& solver, const std::vector<RunObserver*>& observers,
+                        StopBetweenPhases* stop) const {
+  const std::function<bool()> asked = [stop] { return stop != nullptr && stop->asked(); };
+  const auto advance = [&](double t, std::int64_t m, std::int64_t k) {
+    if (!solver.advance_to(t, asked)) stop->stop_between(position(m, k), solver.time());
+  };
   bool switched = !switch_time_;
   if (switched_before_start()) {
     solver.switch_restitution(protocol_.after_switch);
@@ -136,17 +141,17 @@ void PhaseSchedule::run(DrivenSolver& solver, const std::vector<RunObserver*>& o
     const std::int64_t m = i / phases_, k = i % phases_;
     const PhaseInstant instant{m, cycles(), k, phases_, target(m, k), m >= transient_, resumed_at};
     if (!switched && *switch_time_ <= instant.t) {
-      solver.advance_to(*switch_time_);
+      advance(*switch_time_, m, k);
       solver.switch_restitution(protocol_.after_switch);
       switched = true;
     }
-    solver.advance_to(instant.t);
+    advance(instant.t, m, k);
     for (RunObserver* observer : observers) observer->at_phase(instant);
     if (k + 1 < phases_) continue;
     const CycleEnd cycle_end{m, cycles(), instant.t, instant.sampled};
     for (RunObserver* observer : observers) observer->at_cycle_end(cycle_end);
   }
-  solver.advance_to(end());
+  advance(end(), cycles(), 0);
   for (RunObserver* observer : observers) observer->at_run_end(end());
 }
 

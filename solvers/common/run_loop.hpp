@@ -7,6 +7,7 @@
 // itself only moves the solver; observers only read it, so what is observed never changes
 // the trajectory.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +22,14 @@ class DrivenSolver {
   virtual double time() const = 0;
   /// Brings the solver to time t >= time().
   virtual void advance_to(double t) = 0;
+  /// Brings the solver towards time t >= time(), looking at `stop` before each of its steps:
+  /// false if it stopped short of t (at a step's end) because `stop` said so. A solver whose
+  /// steps cannot end between stored phases takes them all (the default).
+  virtual bool advance_to(double t, const std::function<bool()>& stop) {
+    (void)stop;
+    advance_to(t);
+    return true;
+  }
   /// The single shock's change of restitution, from now on.
   virtual void switch_restitution(const Restitution& after) = 0;
 
@@ -71,6 +80,19 @@ class RunObserver {
   virtual void at_run_end(double) {}
 };
 
+/// Stops a run between stored phases (PhaseSchedule::run): asked() is looked at before every
+/// step of the solver; once it is true the run stops there and stop_between() is called with
+/// the stored phase the run would have reached next and the solver's time.
+class StopBetweenPhases {
+ public:
+  virtual bool asked() = 0;
+  /// Never returns (it ends the run, e.g. with StopRequested after a checkpoint).
+  [[noreturn]] virtual void stop_between(const SchedulePosition& next, double t) = 0;
+
+ protected:
+  ~StopBetweenPhases() = default;
+};
+
 class PhaseSchedule {
  public:
   /// The MD's schedule: the run starts at the first whole cycle at or after t0 (so every run,
@@ -106,7 +128,9 @@ class PhaseSchedule {
 
   /// Takes the solver through every stored phase of every cycle and on to end(), calling each
   /// observer, in the order given, at each phase, at each cycle end and at the end.
-  void run(DrivenSolver& solver, const std::vector<RunObserver*>& observers) const;
+  /// With `stop`, the run may also end between stored phases, at a step of the solver.
+  void run(DrivenSolver& solver, const std::vector<RunObserver*>& observers,
+           StopBetweenPhases* stop = nullptr) const;
 
  private:
   // The two solvers turn cycle counts into times with different roundings (x / f against

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -229,6 +230,13 @@ class DrivenIntegrator final : public DrivenSolver {
   explicit DrivenIntegrator(TimeIntegrator& solver) : solver_(solver) {}
   double time() const override { return solver_.time(); }
   void advance_to(double t) override { solver_.advance_to(t); }
+  bool advance_to(double t, const std::function<bool()>& stop) override {
+    while (solver_.time() < t) {
+      if (stop()) return false;
+      solver_.step(t);
+    }
+    return true;
+  }
   void switch_restitution(const Restitution& after) override {
     solver_.op().settings().e = after.e;
     switched = true;
@@ -393,12 +401,13 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   };
   StopAcrossRanks stop_across_ranks{.writer = box.writer()};
   if (halo) stop_across_ranks.agree = [&](int signal) { return static_cast<int>(halo->max(signal)); };
+  stop_across_ranks.before_stop_between = [&] { box.gather(); };
   CheckpointObserver checkpointing(checkpoints, schedule, write, "shaker continuum", stop_across_ranks);
   std::vector<RunObserver*> observers{&box, &recorder, &profiles, &progress, &checkpointing};
   if (!c.field_phases.empty()) observers.insert(observers.end() - 1, &fields);
   DrivenIntegrator driven(solver);
   try {
-    schedule.run(driven, observers);
+    schedule.run(driven, observers, &checkpointing);
   } catch (const StepFailure& failure) {
     // Every rank fails alike (the step's decisions are agreed), so all take part in the gather.
     box.gather();

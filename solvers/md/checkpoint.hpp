@@ -38,6 +38,15 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
 /// malformed (sampled sums included: finite, counts >= 0).
 Checkpoint read_checkpoint(const std::filesystem::path& path);
 
+class PhaseSampler;
+
+/// A run continued from a checkpoint at `at` past its first sampled cycle takes up the
+/// checkpoint's sums of the cycles sampled before it (`sampled`) into its sampler, so that its
+/// profiles are those of the uninterrupted run. InputError (naming `source`) if the sums are
+/// not those cycles' in this run's phases and bins.
+void take_up_samples(PhaseSampler& sampler, const SampledCycles& sampled, const SchedulePosition& at,
+                     const PhaseSchedule& schedule, const std::string& source);
+
 /// Throws InputError naming the particle(s) if a particle lies outside the box (below the
 /// plate, above the ceiling, outside [0, width) horizontally) or two particles overlap by more
 /// than `tolerance` at time data.time.

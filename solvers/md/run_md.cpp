@@ -101,51 +101,6 @@ PhaseSchedule schedule_of(const CaseParameters& c, const Simulation& simulation,
   return schedule;
 }
 
-/// A continued run past its first sampled cycle takes up the checkpoint's sums of the cycles
-/// sampled before it, so that its profiles are those of the uninterrupted run. InputError if
-/// the checkpoint's sums are not those cycles' in this run's phases and bins.
-void take_up_samples(PhaseSampler& sampler, const Resumed& resumed, const PhaseSchedule& schedule,
-                     const std::string& source) {
-  const SchedulePosition& at = resumed.position;
-  const std::int64_t first = schedule.transient_cycles();
-  if (at.cycle < first || (at.cycle == first && at.phase == 0)) return;  // nothing sampled yet
-  const CycleSamples& saved = resumed.sampled.sums;
-  const std::string sample_anew = fmt::format("or run.transient_cycles >= {} to sample only after it", at.cycle);
-  if (saved.empty())
-    throw InputError(fmt::format(
-        "run.transient_cycles = {}, but {} (cycle {}, phase {} of {}) holds no profile sums of the "
-        "sampled cycles before it (it was written in its run's transient, or by an earlier version); "
-        "allowed: run.transient_cycles >= {}, sampling only after it", first, source, at.cycle, at.phase,
-        at.phases, at.cycle));
-  if (resumed.sampled.first_cycle != first)
-    throw InputError(fmt::format("run.transient_cycles = {}, but {} holds the profile sums of the cycles "
-                                 "from {}; allowed: run.transient_cycles = {}, {}", first, source,
-                                 resumed.sampled.first_cycle, resumed.sampled.first_cycle, sample_anew));
-  if (saved.phases() != static_cast<std::size_t>(schedule.phases()))
-    throw InputError(fmt::format("run.phases_per_cycle = {}, but {} holds profile sums at {} phases; "
-                                 "allowed: run.phases_per_cycle = {}, {}", schedule.phases(), source,
-                                 saved.phases(), saved.phases(), sample_anew));
-  const CycleSamples& mine = sampler.store();
-  if (saved.bins() != mine.bins() || saved.bin_volume() != mine.bin_volume())
-    throw InputError(fmt::format(
-        "md.bin_height, md.ceiling and md.box_width give {} sampling bins of volume {}, but {} holds "
-        "profile sums in {} bins of volume {}; allowed: the checkpoint's md.bin_height, md.ceiling "
-        "and md.box_width, {}", mine.bins(), mine.bin_volume(), source, saved.bins(), saved.bin_volume(),
-        sample_anew));
-  for (std::size_t k = 0; k < saved.phases(); ++k) {
-    double cycles = 0.0;
-    for (double c : saved.cycles(k)) cycles += c;
-    const std::int64_t expected = at.cycle - first + (static_cast<std::int64_t>(k) < at.phase ? 1 : 0);
-    if (cycles != static_cast<double>(expected))
-      throw InputError(fmt::format("{} is not a valid checkpoint: dataset 'cycle_samples/cycles' holds {} "
-                                   "sampled cycles at phase {}; allowed: {} (cycles {} to {}, phase {})", source,
-                                   cycles, k, expected, first, at.cycle, at.phase));
-  }
-  std::vector<double> first_times;
-  for (std::int64_t k = 0; k < schedule.phases(); ++k) first_times.push_back(schedule.target(first, k));
-  sampler.resume(saved, first_times);
-}
-
 /// The memory of the particles, the cell list and the phase sampler, before any is allocated.
 void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometry& g) {
   const double n = static_cast<double>(c.particles);
@@ -328,7 +283,8 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
         make_simulation(replica, replica_parameters, settings, geometry, rules, checkpoints.restart_from, resume);
     const PhaseSchedule schedule = schedule_of(replica_parameters, simulation, resume, checkpoints.restart_from);
     PhaseSampler sampler = make_sampler(simulation, schedule, settings);
-    if (resume) take_up_samples(sampler, *resume, schedule, restart_source(checkpoints.restart_from));
+    if (resume)
+      take_up_samples(sampler, resume->sampled, resume->position, schedule, restart_source(checkpoints.restart_from));
     ProgressReport progress(replicas == 1 ? "shaker md" : fmt::format("shaker md replica {}", r),
                             "collisions/s",
                             [&] { return static_cast<double>(simulation.tally().collisions()); },

@@ -42,6 +42,11 @@
       the root writes the checkpoint and says so once, no run file is written, and the run
       continued from the checkpoint on 4 ranks ends in the straight run's final checkpoint, bit
       for bit but the budget.
+  check_continuum_ranks.py SHAKER signal_repeated N [--mpirun CMD]
+      The stop signal to the launcher N times, each once the 2 ranks are in their cycles (the
+      first progress line): each time one stop message and the checkpoint at the stored phase
+      it names, no run file, no rank killed. (A signal before mpirun has started the ranks ends
+      the job before the program runs: nothing to stop, docs/parallel.md.)
   check_continuum_ranks.py SHAKER root_failure [--mpirun CMD]
       A failure of the root alone during a run on 2 ranks (its checkpoint's folder removed
       after the first checkpoint, so that the next one cannot be written): the root says why
@@ -407,6 +412,38 @@ def check_signal(shaker, work, launcher):
     return failures
 
 
+def check_signal_repeated(shaker, work, launcher, repeats):
+    """SIGTERM to the launcher `repeats` times, each once the ranks are in their cycles: every
+    time one stop message (the root's, exit 143), the checkpoint at the phase it names, no run
+    file, no rank killed (SIGKILL) and no other failure."""
+    failures = []
+    for attempt in range(repeats):
+        output = f"repeat{attempt}"
+        stderr, found = stopped_run(shaker, work, launcher, output, None)
+        stops = re.findall(r"stopped by signal 15 \(SIGTERM\).*stored phase (\d+) of \d+ in cycle "
+                           r"(\d+)", stderr)
+        checkpoint = os.path.join(work, f"{output}.checkpoint.h5")
+        if len(stops) != 1:
+            found.append(f"{output}: {len(stops)} stop messages, expected 1: {stderr[-600:]}")
+        elif not os.path.exists(checkpoint):
+            found.append(f"{output}: no checkpoint: {os.listdir(work)}")
+        else:
+            with h5py.File(checkpoint, "r") as f:
+                position = (int(f.attrs["schedule_phase"]), int(f.attrs["schedule_cycle"]))
+            if position != tuple(int(x) for x in stops[0]):
+                found.append(f"{output}: checkpoint at {position}, the message says {stops[0]}")
+        for needle in ("shaker: failed", "signal 9", "Killed", "shaker: error"):
+            if needle in stderr:
+                found.append(f"{output}: '{needle}' in the output: {stderr[-600:]}")
+        if os.path.exists(os.path.join(work, f"{output}.h5")):
+            found.append(f"{output}: a run file was written")
+        print(f"SIGTERM {attempt + 1} of {repeats} to the launcher: "
+              f"{'stopped at ' + str(stops[0]) if len(stops) == 1 else 'no single stop'}, "
+              f"{len(found)} problems")
+        failures += found
+    return failures
+
+
 def check_root_failure(shaker, work, launcher):
     folder = os.path.join(work, "checkpoints")
     os.mkdir(folder)
@@ -518,7 +555,8 @@ def main():
     parser.add_argument("shaker")
     parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit",
                                           "implicit_wall_stress", "restart", "column", "failure",
-                                          "signal", "root_failure", "refused", "disagree"])
+                                          "signal", "signal_repeated", "root_failure", "refused",
+                                          "disagree"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -545,6 +583,8 @@ def main():
         failures = check_failure(args.shaker, work, args.mpirun)
     elif args.check == "signal":
         failures = check_signal(args.shaker, work, args.mpirun)
+    elif args.check == "signal_repeated":
+        failures = check_signal_repeated(args.shaker, work, args.mpirun, args.ranks[0])
     elif args.check == "root_failure":
         failures = check_root_failure(args.shaker, work, args.mpirun)
     elif args.check == "disagree":
