@@ -26,18 +26,12 @@ shaker::testing::Continuation small_case(const std::filesystem::path& dir, const
                                          std::int64_t cycles) {
   shaker::testing::Continuation c;
   c.run = [](const config::Config& config, const ProgressSettings& progress) { return run(config, {}, progress); };
-  c.make_case = [=](const std::string& name) {
-    config::Config config;
-    for (const std::string& setting : std::vector<std::string>{
-             "layer.particles=200", "md.box_width=6.0", "md.ceiling=60.0", "md.crossing_heights=[12.5]",
-             "run.phases_per_cycle=" + std::to_string(phases), "run.transient_cycles=" + std::to_string(transient),
-             "run.sampled_cycles=" + std::to_string(sampled)})
-      config.set(setting);
-    for (const std::string& setting : settings) config.set(setting);
-    config.set("run.output=" + (dir / (name + ".h5")).string());
-    config.set("run.checkpoint=" + (dir / (name + ".ckpt.h5")).string());
-    return config;
-  };
+  std::vector<std::string> all{"layer.particles=200", "md.box_width=6.0", "md.ceiling=60.0",
+                               "md.crossing_heights=[12.5]", "run.phases_per_cycle=" + std::to_string(phases),
+                               "run.transient_cycles=" + std::to_string(transient),
+                               "run.sampled_cycles=" + std::to_string(sampled)};
+  all.insert(all.end(), settings.begin(), settings.end());
+  c.make_case = shaker::testing::case_in(dir, all);
   c.phases = phases;
   c.cycles = cycles;
   c.run_relative = run_relative;

@@ -508,14 +508,18 @@ def check_refused(shaker, work, launcher):
         result = run(mpirun_prefix(launcher, ranks) + [shaker, "continuum", "case.toml", "--set",
                                                        "run.output=refused.h5", "--quiet"]
                      + [w for s in settings for w in ("--set", s)], work, expect=2)
-        for needle in needles:
-            if needle not in result.stderr:
-                failures.append(f"{label}: message lacks '{needle}': {result.stderr[-600:]}")
-        written = [n for n in os.listdir(work) if n.startswith("refused")]
-        if written:
-            failures.append(f"{label}: wrote {written}")
+        failures += refusal_problems(label, result.stderr, needles, work, "refused")
         print(f"{label}: exit 2, {len(failures)} problems so far")
     return failures
+
+
+def refusal_problems(label, stderr, needles, work, output):
+    """What a refusal lacks: fragments of its message, or an empty folder of outputs named
+    `output`*."""
+    problems = [f"{label}: message lacks '{needle}': {stderr[-600:]}"
+                for needle in needles if needle not in stderr]
+    written = [n for n in os.listdir(work) if n.startswith(output)]
+    return problems + ([f"{label}: wrote {written}"] if written else [])
 
 
 def check_disagreeing_ranks(shaker, work, launcher):
@@ -538,14 +542,11 @@ def check_disagreeing_ranks(shaker, work, launcher):
             contexts += ["-np", "1", shaker, solver, "case.toml", "--quiet", "--set",
                          "run.output=disagree.h5", "--set", "md.replicas=2", "--set", setting, ":"]
         result = run(words + contexts[:-1], work, expect=2)
-        for needle in needles + [
-                "the 2 ranks of this launch disagree on the effective configuration",
-                "allowed: the same case file and --set values on every rank"]:
-            if needle not in result.stderr:
-                failures.append(f"{label}: message lacks '{needle}': {result.stderr[-600:]}")
-        written = [n for n in os.listdir(work) if n.startswith("disagree")]
-        if written:
-            failures.append(f"{label}: wrote {written}")
+        failures += refusal_problems(
+            label, result.stderr,
+            needles + ["the 2 ranks of this launch disagree on the effective configuration",
+                       "allowed: the same case file and --set values on every rank"],
+            work, "disagree")
         print(f"{label}: exit 2, {len(failures)} problems so far")
     return failures
 

@@ -137,6 +137,18 @@ struct Continuation {
   bool same_run_file = false;  ///< the run file's datasets outside /timeseries equal too
 };
 
+/// Continuation::make_case for a case of `settings` whose outputs go to `dir`.
+inline std::function<config::Config(const std::string&)> case_in(const std::filesystem::path& dir,
+                                                                  const std::vector<std::string>& settings) {
+  return [=](const std::string& name) {
+    config::Config config;
+    for (const std::string& setting : settings) config.set(setting);
+    config.set("run.output=" + (dir / (name + ".h5")).string());
+    config.set("run.checkpoint=" + (dir / (name + ".ckpt.h5")).string());
+    return config;
+  };
+}
+
 /// Runs the case straight, then stopped by SIGTERM at each stored phase (cycle, phase) of
 /// `stops` and continued from its checkpoint; each continuation must end in the straight run's
 /// final checkpoint, bit for bit, with the straight run's rows after its restart point.
