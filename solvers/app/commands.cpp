@@ -4,6 +4,8 @@
 #include <fmt/ranges.h>
 
 #include <cmath>
+#include <optional>
+#include <string>
 
 #include "analysis/analysis.hpp"
 #include "analysis/run_analysis.hpp"
@@ -11,6 +13,7 @@
 #include "common/errors.hpp"
 #include "common/describe.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/ranks.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
 #include "md/run_md.hpp"
@@ -20,6 +23,21 @@ namespace {
 
 config::Config load(const RunOptions& options) {
   return config::Config::load(options.config_file, options.overrides);
+}
+
+/// The configuration of a solver's run; under a launcher every rank must have the same (a
+/// rank that fails to load it takes part with its error, so none is left waiting).
+config::Config load_on_every_rank(const RunOptions& options) {
+  std::optional<config::Config> config;
+  std::string failure;
+  try {
+    config = load(options);
+  } catch (const InputError& error) {
+    failure = error.what();
+  }
+  if (launched_by_mpi()) Ranks::world().require_same_configuration(config ? config->to_toml() : "error: " + failure);
+  if (!config) throw InputError(failure);
+  return *config;
 }
 
 }  // namespace
@@ -68,13 +86,13 @@ CLI::App* add_solver_subcommand(CLI::App& app, const std::string& name, const st
 
 int command_md(const RunOptions& options) {
   options.progress.validate();
-  return md::run(load(options), {{"configuration file", options.config_file}}, options.progress);
+  return md::run(load_on_every_rank(options), {{"configuration file", options.config_file}}, options.progress);
 }
 int command_continuum(const RunOptions& options) {
   options.progress.validate();
   // Under mpirun a 3D box is decomposed over the ranks; a 1D column, or a box too narrow for
   // the ranks, is refused there with exit 2 before any work (continuum/run_continuum.cpp).
-  return continuum::run(load(options), {{"configuration file", options.config_file}}, options.progress);
+  return continuum::run(load_on_every_rank(options), {{"configuration file", options.config_file}}, options.progress);
 }
 
 int command_config(const RunOptions& options) {

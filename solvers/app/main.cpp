@@ -16,6 +16,10 @@
 
 int main(int argc, char** argv) {
   using namespace shaker;
+  // SIGTERM/SIGINT/SIGHUP: remove partial files, exit 128 + signal, with a message; inside a
+  // solver's run loop SIGTERM and SIGINT first write a checkpoint (StopRequested). First of
+  // all, so that a launcher's signal never meets the default action (a silent end).
+  install_signal_cleanup();
   CLI::App app{"granular-shaker: event-driven MD and continuum solvers for vertically "
                "oscillated granular layers (Bougie et al., PRE 66, 051301, 2002)"};
   app.set_version_flag("--version",
@@ -78,9 +82,6 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  // SIGTERM/SIGINT/SIGHUP: remove partial files, exit 128 + signal; inside a solver's run loop
-  // SIGTERM and SIGINT first write a checkpoint (StopRequested).
-  install_signal_cleanup();
   struct FinalizeRanks {
     ~FinalizeRanks() { Ranks::finalize(); }
   } finalize_ranks;

@@ -158,6 +158,18 @@ void CheckpointObserver::at_run_end(double t) {
   deferred_.reset();
 }
 
+bool CheckpointObserver::asked() {
+  signal_between_ = ranks_.agree(DeferredStop::requested());
+  return signal_between_ != 0;
+}
+
+void CheckpointObserver::stop_between(const SchedulePosition& next, double t) {
+  next_ = next;
+  ranks_.before_stop_between();
+  stop_if_asked(t, signal_between_);
+  throw std::logic_error("CheckpointObserver::stop_between without a stop signal");
+}
+
 void CheckpointObserver::save(const std::filesystem::path& path) const {
   if (!ranks_.writer) return;
   keep_as_previous(path);

@@ -78,9 +78,15 @@ using CheckpointWriter = std::function<void(const std::filesystem::path&, const 
 struct StopAcrossRanks {
   std::function<int(int)> agree = [](int signal) { return signal; };
   bool writer = true;
+  /// Called by every rank before the checkpoint of a stop between stored phases (a decomposed
+  /// run gathers its blocks there, as it does at every stored phase).
+  std::function<void()> before_stop_between = [] {};
 };
 
-class CheckpointObserver final : public RunObserver {
+/// Besides the stored phases, the observer is asked before each solver step whether to stop
+/// (StopBetweenPhases): a solver that can end between phases (the continuum, at a step) stops
+/// within a step of the signal, well inside a launcher's grace before it kills the ranks.
+class CheckpointObserver final : public RunObserver, public StopBetweenPhases {
  public:
   /// `label` starts the stop message ("shaker md"). While the observer lives, SIGTERM and SIGINT
   /// are deferred to the next stored phase (DeferredStop).
@@ -90,6 +96,8 @@ class CheckpointObserver final : public RunObserver {
   void at_phase(const PhaseInstant& instant) override;
   void at_cycle_end(const CycleEnd& end) override;
   void at_run_end(double t) override;
+  bool asked() override;
+  [[noreturn]] void stop_between(const SchedulePosition& next, double t) override;
   /// The stored phase the run reaches next: where a failure's last good state continues.
   const SchedulePosition& next() const { return next_; }
 
@@ -97,6 +105,7 @@ class CheckpointObserver final : public RunObserver {
   void save(const std::filesystem::path& path) const;
   /// Throws StopRequested after writing the checkpoint if `signal` (agreed) is not 0.
   void stop_if_asked(double t, int signal) const;
+  int signal_between_ = 0;  ///< agreed by asked()
 
   CheckpointSettings settings_;
   const PhaseSchedule& schedule_;

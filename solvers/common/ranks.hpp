@@ -24,6 +24,11 @@ class Ranks {
 
   Ranks(int rank, int size) : rank_(rank), size_(size) {}
 
+  /// Compares every rank's `text` (its effective configuration) with the root's; if any differs,
+  /// throws InputError on every rank alike, naming the lowest such rank and the first key (or
+  /// line) that differs, with both values. Without effect on a single rank.
+  void require_same_configuration(const std::string& text) const;
+
   /// Every rank's buffer, at the root in rank order; other ranks get an empty list.
   std::vector<std::vector<double>> gather(const std::vector<double>& mine) const;
 

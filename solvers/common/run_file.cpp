@@ -155,27 +155,35 @@ constexpr SampleSum sample_sums[] = {{"count", &BinSums::count, "1"},
                                      {"vz", &BinSums::vz, "sqrt(g sigma)"},
                                      {"v2", &BinSums::v2, "g sigma"}};
 
-void write_samples(hid_t file, const CycleSamples& samples) {
+}  // namespace
+
+void write_samples(hid_t file, const CycleSamples& samples, bool ragged) {
   if (samples.empty()) return;
-  const std::size_t phases = samples.phases(), m = samples.samples(), bins = samples.bins();
+  const std::size_t phases = samples.phases(), bins = samples.bins();
+  std::size_t m = 0;
+  for (std::size_t k = 0; k < phases; ++k) m = std::max(m, samples.samples(k));
   h5::Handle group = h5::create_group(file, "cycle_samples");
   h5::write_attribute(group.id(), "bin_volume", samples.bin_volume());
+  // A phase with fewer samples is padded with empty ones (0 cycles, zero sums).
   std::vector<double> cycles;
   for (std::size_t k = 0; k < phases; ++k) {
-    if (samples.samples(k) != m) throw std::logic_error("phases hold different sample counts");
+    if (!ragged && samples.samples(k) != m) throw std::logic_error("phases hold different sample counts");
     cycles.insert(cycles.end(), samples.cycles(k).begin(), samples.cycles(k).end());
+    cycles.resize((k + 1) * m, 0.0);
   }
   h5::write(group.id(), "cycles", cycles, {phases, m}, "1");
   for (const auto& [name, member, units] : sample_sums) {
     std::vector<double> matrix;
     matrix.reserve(phases * m * bins);
-    for (std::size_t k = 0; k < phases; ++k)
+    for (std::size_t k = 0; k < phases; ++k) {
       for (const BinSums& b : samples.sums(k)) matrix.push_back(b.*member);
+      matrix.resize((k + 1) * m * bins, 0.0);
+    }
     h5::write(group.id(), name, matrix, {phases * m, bins}, units);
   }
 }
 
-CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
+CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins, bool ragged) {
   if (!h5::exists(file, "cycle_samples") || bins == 0) return {};
   h5::Handle group = h5::open_group(file, "cycle_samples");
   const double bin_volume = h5::read_double_attribute(group.id(), "bin_volume");
@@ -199,14 +207,27 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
   for (std::size_t k = 0; k < phases; ++k) {
     cycles[k].assign(flat_cycles.begin() + static_cast<long>(k * m),
                      flat_cycles.begin() + static_cast<long>((k + 1) * m));
+    // Padding (0 cycles) only after a phase's samples, and only where phases may differ.
+    const auto padding = std::find(cycles[k].begin(), cycles[k].end(), 0.0);
+    if (ragged && std::all_of(padding, cycles[k].end(), [](double c) { return c == 0.0; }))
+      cycles[k].erase(padding, cycles[k].end());
     for (double c : cycles[k])
       if (!(c >= 1.0 && c == std::floor(c)))
-        throw InputError(fmt::format("cycle_samples/cycles holds {}, allowed: whole numbers >= 1", c));
+        throw InputError(fmt::format("cycle_samples/cycles holds {}, allowed: whole numbers >= 1{}", c,
+                                     ragged ? " (0 after a phase's last sample)" : ""));
   }
   for (const auto& [name, member, units] : sample_sums) {
     const auto values = h5::read_doubles(group.id(), name);
-    for (std::size_t k = 0; k < phases; ++k)
-      for (std::size_t i = 0; i < m * bins; ++i) sums[k][i].*member = values[k * m * bins + i];
+    for (std::size_t k = 0; k < phases; ++k) {
+      sums[k].resize(cycles[k].size() * bins);
+      for (std::size_t i = 0; i < sums[k].size(); ++i) {
+        const double x = values[k * m * bins + i];
+        if (!std::isfinite(x) || (member == &BinSums::count && x < 0.0))
+          throw InputError(fmt::format("cycle_samples/{} holds {}; allowed: finite{}", name, x,
+                                       member == &BinSums::count ? " counts >= 0" : " sums"));
+        sums[k][i].*member = x;
+      }
+    }
   }
   if (!(bin_volume > 0.0 && std::isfinite(bin_volume)))
     throw InputError(fmt::format("cycle_samples: bin_volume = {}, allowed: > 0", bin_volume));
@@ -216,6 +237,8 @@ CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins) {
     throw InputError(error.what());
   }
 }
+
+namespace {
 
 /// A time series as a group: one 1D dataset per column with its units, and the string
 /// attribute `columns` naming them in order (`/timeseries`, and each replica's in an ensemble).
@@ -305,7 +328,7 @@ void write_run_file(const std::filesystem::path& path, const RunRecord& record) 
   write_hdf5_atomically(path, [&](hid_t file) {
     write_run_attributes(file, record);
     write_profiles(file, record.profiles);
-    write_samples(file, record.samples);
+    write_samples(file, record.samples, false);
     write_series(file, "timeseries", record.series);
     write_replica_series(file, record.replica_series);
   });
@@ -341,7 +364,7 @@ RunRecord read_run_file(const std::filesystem::path& path) {
                                    record.e, restitution.describe()));
     record.profiles = read_profiles(file.id());
     record.samples = read_samples(file.id(), record.profiles.size(),
-                                  record.profiles.empty() ? 0 : record.profiles.front().size());
+                                  record.profiles.empty() ? 0 : record.profiles.front().size(), false);
     record.series = read_series(file.id(), "timeseries");
     record.replica_series = read_replica_series(file.id());
     return record;

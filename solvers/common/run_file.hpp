@@ -28,4 +28,12 @@ void write_run_file(const std::filesystem::path& path, const RunRecord& record);
 /// Reads a run file; throws InputError naming the file and what is missing or malformed.
 RunRecord read_run_file(const std::filesystem::path& path);
 
+/// The group /cycle_samples of a run file (docs/output-schema.md). `ragged`: the phases may
+/// hold different numbers of samples (a checkpoint written mid-cycle), the shorter ones padded
+/// with empty samples; a run file's phases hold the same number (std::logic_error otherwise).
+void write_samples(hid_t file, const CycleSamples& samples, bool ragged);
+/// Reads it back for `phases` phases of `bins` bins; InputError if it is malformed, or holds
+/// a sum that is not finite.
+CycleSamples read_samples(hid_t file, std::size_t phases, std::size_t bins, bool ragged);
+
 }  // namespace shaker

@@ -7,6 +7,7 @@
 // itself only moves the solver; observers only read it, so what is observed never changes
 // the trajectory.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +22,14 @@ class DrivenSolver {
   virtual double time() const = 0;
   /// Brings the solver to time t >= time().
   virtual void advance_to(double t) = 0;
+  /// Brings the solver towards time t >= time(), looking at `stop` before each of its steps:
+  /// false if it stopped short of t (at a step's end) because `stop` said so. A solver whose
+  /// steps cannot end between stored phases takes them all (the default).
+  virtual bool advance_to(double t, const std::function<bool()>& stop) {
+    (void)stop;
+    advance_to(t);
+    return true;
+  }
   /// The single shock's change of restitution, from now on.
   virtual void switch_restitution(const Restitution& after) = 0;
 
@@ -71,6 +80,19 @@ class RunObserver {
   virtual void at_run_end(double) {}
 };
 
+/// Stops a run between stored phases (PhaseSchedule::run): asked() is looked at before every
+/// step of the solver; once it is true the run stops there and stop_between() is called with
+/// the stored phase the run would have reached next and the solver's time.
+class StopBetweenPhases {
+ public:
+  virtual bool asked() = 0;
+  /// Never returns (it ends the run, e.g. with StopRequested after a checkpoint).
+  [[noreturn]] virtual void stop_between(const SchedulePosition& next, double t) = 0;
+
+ protected:
+  ~StopBetweenPhases() = default;
+};
+
 class PhaseSchedule {
  public:
   /// The MD's schedule: the run starts at the first whole cycle at or after t0 (so every run,
@@ -94,6 +116,11 @@ class PhaseSchedule {
   /// gave the checkpoint) if no stored phase of this schedule is left after the position,
   /// or if the position lies mid-cycle and run.phases_per_cycle differs from the checkpoint's.
   void resume_at(const SchedulePosition& position, double time, const std::string& source);
+  /// InputError (naming `source`) unless this run meets the single shock's switch as the run
+  /// that wrote the checkpoint at `time` (protocol `written_by`; its schedule started at the
+  /// same time) did: both switched before the checkpoint, at the same time to the same
+  /// restitution, or neither did. Otherwise the continued run would be neither run.
+  void check_switch(const RunProtocol& written_by, double time, const std::string& source) const;
   /// The position of stored phase k of cycle m; (cycles(), 0) is the end of the run.
   SchedulePosition position(std::int64_t m, std::int64_t k) const;
   /// Where run() starts: (0, 0), or where resume_at put it.
@@ -101,7 +128,9 @@ class PhaseSchedule {
 
   /// Takes the solver through every stored phase of every cycle and on to end(), calling each
   /// observer, in the order given, at each phase, at each cycle end and at the end.
-  void run(DrivenSolver& solver, const std::vector<RunObserver*>& observers) const;
+  /// With `stop`, the run may also end between stored phases, at a step of the solver.
+  void run(DrivenSolver& solver, const std::vector<RunObserver*>& observers,
+           StopBetweenPhases* stop = nullptr) const;
 
  private:
   // The two solvers turn cycle counts into times with different roundings (x / f against
@@ -110,6 +139,8 @@ class PhaseSchedule {
   PhaseSchedule(const RunProtocol& run, const ShakerKinematics& shaker, Clock clock, double start_time,
                 double origin);
   double time_of(double cycle_count) const;
+  /// The time of `run`'s switch on this schedule's clock (a single shock's).
+  double switch_time_of(const RunProtocol& run) const;
   /// A continued run past the single shock's switch.
   bool switched_before_start() const;
 
@@ -120,7 +151,7 @@ class PhaseSchedule {
   std::int64_t first_ = 0;  ///< m * phases + k of the first stored phase run() reaches
   std::int64_t transient_, sampled_, phases_;
   std::optional<double> switch_time_;  ///< single shock only
-  Restitution after_switch_;
+  RunProtocol protocol_;
 };
 
 }  // namespace shaker

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -229,6 +230,13 @@ class DrivenIntegrator final : public DrivenSolver {
   explicit DrivenIntegrator(TimeIntegrator& solver) : solver_(solver) {}
   double time() const override { return solver_.time(); }
   void advance_to(double t) override { solver_.advance_to(t); }
+  bool advance_to(double t, const std::function<bool()>& stop) override {
+    while (solver_.time() < t) {
+      if (stop()) return false;
+      solver_.step(t);
+    }
+    return true;
+  }
   void switch_restitution(const Restitution& after) override {
     solver_.op().settings().e = after.e;
     switched = true;
@@ -346,7 +354,8 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
   const RunProtocol& run = c.parameters.run;
   if (restart_from.empty()) return PhaseSchedule::from_start(run, c.parameters.shaker, solver.time());
   const std::string source = restart_source(restart_from);
-  config::require_same_keys(config, checkpoint_configuration(restart_from),
+  const std::string saved = checkpoint_configuration(restart_from);
+  config::require_same_keys(config, saved,
                             {"material.restitution", "material.e", "layer.particles", "md.box_width", "shaker.frequency"},
                             source);
   const Halo* halo = solver.op().halo();
@@ -354,6 +363,7 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
                                          : read_checkpoint(restart_from, solver);
   PhaseSchedule schedule = PhaseSchedule::from_start(run, c.parameters.shaker, position.start_time);
   schedule.resume_at(position, solver.time(), source);
+  schedule.check_switch(CaseParameters::from(config::Config::from_toml(saved, source)).run, solver.time(), source);
   return schedule;
 }
 
@@ -391,12 +401,13 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   };
   StopAcrossRanks stop_across_ranks{.writer = box.writer()};
   if (halo) stop_across_ranks.agree = [&](int signal) { return static_cast<int>(halo->max(signal)); };
+  stop_across_ranks.before_stop_between = [&] { box.gather(); };
   CheckpointObserver checkpointing(checkpoints, schedule, write, "shaker continuum", stop_across_ranks);
   std::vector<RunObserver*> observers{&box, &recorder, &profiles, &progress, &checkpointing};
   if (!c.field_phases.empty()) observers.insert(observers.end() - 1, &fields);
   DrivenIntegrator driven(solver);
   try {
-    schedule.run(driven, observers);
+    schedule.run(driven, observers, &checkpointing);
   } catch (const StepFailure& failure) {
     // Every rank fails alike (the step's decisions are agreed), so all take part in the gather.
     box.gather();

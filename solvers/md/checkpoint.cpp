@@ -9,6 +9,8 @@
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/run_file.hpp"
+#include "md/sampling.hpp"
 
 namespace shaker::md {
 namespace {
@@ -54,10 +56,28 @@ void read_tally(hid_t f, Tally& t) {
   t.virial = energy[3];
 }
 
+/// The sampled sums, if any (group cycle_samples, as in a run file, with the attribute
+/// first_cycle).
+SampledCycles read_sampled(hid_t f, const SchedulePosition& position) {
+  if (!h5::exists(f, "cycle_samples")) return {};
+  SampledCycles sampled;
+  const h5::Handle group = h5::open_group(f, "cycle_samples");
+  sampled.first_cycle = h5::read_integer_attribute(group.id(), "first_cycle");
+  if (sampled.first_cycle < 0 || sampled.first_cycle > position.cycle)
+    throw InputError(fmt::format("attribute 'cycle_samples/first_cycle' = {}; allowed: 0 <= value <= {} "
+                                 "(schedule_cycle)", sampled.first_cycle, position.cycle));
+  const auto dims = h5::shape(group.id(), "count");
+  if (dims.size() != 2 || dims[1] == 0) throw InputError("dataset 'cycle_samples/count' is not a [rows x bins] matrix");
+  const auto phases = static_cast<std::size_t>(position.phases);
+  sampled.sums = read_samples(f, phases, dims[1], true);
+  return sampled;
+}
+
 }  // namespace
 
 void write_checkpoint(const std::filesystem::path& path, const SimulationData& d, const Geometry& geometry,
-                      const SchedulePosition& position, const std::string& configuration) {
+                      const SchedulePosition& position, const std::string& configuration,
+                      const SampledCycles& sampled) {
   write_hdf5_atomically(path, [&](const hid_t f) {
     write_checkpoint_header(f, checkpoint_kind, position, configuration);
     h5::write_attribute(f, "time", d.time);
@@ -105,6 +125,9 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
                                                            t.guard_activations, t.grazes}));
     h5::write(f, "tally_energy", std::vector<double>{t.plate_work, t.pair_loss, t.wall_loss, t.virial},
               {4}, "m g sigma");
+    if (sampled.sums.empty() || sampled.sums.samples(0) == 0) return;  // phase 0 is sampled first
+    write_samples(f, sampled.sums, true);
+    h5::write_attribute(h5::open_group(f, "cycle_samples").id(), "first_cycle", sampled.first_cycle);
   });
 }
 
@@ -178,10 +201,52 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     require_length("cell_next", d.cell_next.size(), n);
     require_length("cell_prev", d.cell_prev.size(), n);
     require_length("cell_of", d.cell_of.size(), n);
+    c.sampled = read_sampled(f, c.position);
   } catch (const std::exception& error) {
     throw InputError(fmt::format("{} is not a valid checkpoint: {}", restart_source(path), error.what()));
   }
   return c;
+}
+
+void take_up_samples(PhaseSampler& sampler, const SampledCycles& sampled, const SchedulePosition& at,
+                     const PhaseSchedule& schedule, const std::string& source) {
+  const std::int64_t first = schedule.transient_cycles();
+  if (at.cycle < first || (at.cycle == first && at.phase == 0)) return;  // nothing sampled yet
+  const CycleSamples& saved = sampled.sums;
+  const std::string sample_anew = fmt::format("or run.transient_cycles >= {} to sample only after it", at.cycle);
+  if (saved.empty())
+    throw InputError(fmt::format(
+        "run.transient_cycles = {}, but {} (cycle {}, phase {} of {}) holds no profile sums of the "
+        "sampled cycles before it (it was written in its run's transient, or by an earlier version); "
+        "allowed: run.transient_cycles >= {}, sampling only after it", first, source, at.cycle, at.phase,
+        at.phases, at.cycle));
+  if (sampled.first_cycle != first)
+    throw InputError(fmt::format("run.transient_cycles = {}, but {} holds the profile sums of the cycles "
+                                 "from {}; allowed: run.transient_cycles = {}, {}", first, source,
+                                 sampled.first_cycle, sampled.first_cycle, sample_anew));
+  if (saved.phases() != static_cast<std::size_t>(schedule.phases()))
+    throw InputError(fmt::format("run.phases_per_cycle = {}, but {} holds profile sums at {} phases; "
+                                 "allowed: run.phases_per_cycle = {}, {}", schedule.phases(), source,
+                                 saved.phases(), saved.phases(), sample_anew));
+  const CycleSamples& mine = sampler.store();
+  if (saved.bins() != mine.bins() || saved.bin_volume() != mine.bin_volume())
+    throw InputError(fmt::format(
+        "md.bin_height, md.ceiling and md.box_width give {} sampling bins of volume {}, but {} holds "
+        "profile sums in {} bins of volume {}; allowed: the checkpoint's md.bin_height, md.ceiling "
+        "and md.box_width, {}", mine.bins(), mine.bin_volume(), source, saved.bins(), saved.bin_volume(),
+        sample_anew));
+  for (std::size_t k = 0; k < saved.phases(); ++k) {
+    double cycles = 0.0;
+    for (double c : saved.cycles(k)) cycles += c;
+    const std::int64_t expected = at.cycle - first + (static_cast<std::int64_t>(k) < at.phase ? 1 : 0);
+    if (cycles != static_cast<double>(expected))
+      throw InputError(fmt::format("{} is not a valid checkpoint: dataset 'cycle_samples/cycles' holds {} "
+                                   "sampled cycles at phase {}; allowed: {} (cycles {} to {}, phase {})", source,
+                                   cycles, k, expected, first, at.cycle, at.phase));
+  }
+  std::vector<double> first_times;
+  for (std::int64_t k = 0; k < schedule.phases(); ++k) first_times.push_back(schedule.target(first, k));
+  sampler.resume(saved, first_times);
 }
 
 void validate_state(const Geometry& g, const SimulationData& d, double tolerance) {

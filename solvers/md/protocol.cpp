@@ -133,11 +133,21 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters, const
                       parameters, settings, also);
 }
 
+PhaseSampler make_sampler(const Simulation& sim, const PhaseSchedule& schedule, const MdSettings& settings) {
+  return PhaseSampler(static_cast<int>(schedule.phases()), settings.bin_height, settings.ceiling,
+                      sim.geometry().width);
+}
+
 RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, const CaseParameters& parameters,
                         const MdSettings& settings, const std::vector<RunObserver*>& also) {
+  PhaseSampler sampler = make_sampler(sim, schedule, settings);
+  return run_protocol(sim, schedule, sampler, parameters, settings, also);
+}
+
+RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, PhaseSampler& sampler,
+                        const CaseParameters& parameters, const MdSettings& settings,
+                        const std::vector<RunObserver*>& also) {
   const BudgetOrigin origin{sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time()), sim.tally()};
-  PhaseSampler sampler(static_cast<int>(schedule.phases()), settings.bin_height, settings.ceiling,
-                       sim.geometry().width);
   PhaseSnapshot snapshot(sim);
   SeriesObserver series(sim, parameters.shaker, settings, origin, snapshot);
   SamplingObserver sampling(sampler, snapshot);

@@ -10,6 +10,7 @@
 #include "common/config.hpp"
 #include "common/profile.hpp"
 #include "common/run_loop.hpp"
+#include "md/sampling.hpp"
 #include "md/simulation.hpp"
 
 namespace shaker::md {
@@ -83,5 +84,12 @@ RunOutcome run_protocol(Simulation& simulation, const CaseParameters& parameters
 /// The same on a given schedule (a continued run's).
 RunOutcome run_protocol(Simulation& simulation, const PhaseSchedule& schedule, const CaseParameters& parameters,
                         const MdSettings& settings, const std::vector<RunObserver*>& also = {});
+/// The same, sampling into `sampler` (which a continued run takes up from its checkpoint, and
+/// whose sums the checkpoints keep).
+RunOutcome run_protocol(Simulation& simulation, const PhaseSchedule& schedule, PhaseSampler& sampler,
+                        const CaseParameters& parameters, const MdSettings& settings,
+                        const std::vector<RunObserver*>& also = {});
+/// The sampler of a run of `schedule` in the simulation's box.
+PhaseSampler make_sampler(const Simulation& simulation, const PhaseSchedule& schedule, const MdSettings& settings);
 
 }  // namespace shaker::md

@@ -48,11 +48,18 @@ std::string variant_name(const Restitution& r, const MdSettings& s) {
   return model + ", " + guard;
 }
 
+/// What a continued run takes from its checkpoint besides the simulation's state.
+struct Resumed {
+  SchedulePosition position;
+  SampledCycles sampled;
+  RunProtocol written_by;  ///< the protocol of the run that wrote the checkpoint
+};
+
 /// The simulation at the case's initial state, or at the checkpoint `restart_from` (whose
-/// schedule position goes to `position`).
+/// schedule position and sampled sums go to `resumed`).
 Simulation make_simulation(const config::Config& config, const CaseParameters& c, const MdSettings& s,
                            const Geometry& g, const CollisionRules& rules,
-                           const std::filesystem::path& restart_from, std::optional<SchedulePosition>& position) {
+                           const std::filesystem::path& restart_from, std::optional<Resumed>& resumed) {
   const auto n = static_cast<std::size_t>(c.particles);
   if (restart_from.empty()) {
     if (s.initial_state == "gas")
@@ -76,7 +83,8 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
   } catch (const InputError& error) {
     throw InputError(fmt::format("{} is not a valid checkpoint: {}", source, error.what()));
   }
-  position = saved.position;
+  resumed = Resumed{saved.position, std::move(saved.sampled),
+                    CaseParameters::from(config::Config::from_toml(saved.configuration, source)).run};
   if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
   State state{saved.data.time, std::move(saved.data.particles), std::move(saved.data.last_collision)};
@@ -85,10 +93,11 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
 
 /// The MD's schedule: a new one from the simulation's time, or the checkpoint's, continued.
 PhaseSchedule schedule_of(const CaseParameters& c, const Simulation& simulation,
-                          const std::optional<SchedulePosition>& resume, const std::filesystem::path& restart_from) {
+                          const std::optional<Resumed>& resume, const std::filesystem::path& restart_from) {
   if (!resume) return PhaseSchedule::whole_cycles(c.run, c.shaker, simulation.time());
-  PhaseSchedule schedule = PhaseSchedule::whole_cycles(c.run, c.shaker, resume->start_time);
-  schedule.resume_at(*resume, simulation.time(), restart_source(restart_from));
+  PhaseSchedule schedule = PhaseSchedule::whole_cycles(c.run, c.shaker, resume->position.start_time);
+  schedule.resume_at(resume->position, simulation.time(), restart_source(restart_from));
+  schedule.check_switch(resume->written_by, simulation.time(), restart_source(restart_from));
   return schedule;
 }
 
@@ -269,10 +278,13 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   for (std::int64_t r = ranks.rank(); r < replicas; r += ranks.size()) {
     const config::Config replica = replica_configuration(config, r);
     const CaseParameters replica_parameters = CaseParameters::from(replica);
-    std::optional<SchedulePosition> resume;
+    std::optional<Resumed> resume;
     Simulation simulation =
         make_simulation(replica, replica_parameters, settings, geometry, rules, checkpoints.restart_from, resume);
     const PhaseSchedule schedule = schedule_of(replica_parameters, simulation, resume, checkpoints.restart_from);
+    PhaseSampler sampler = make_sampler(simulation, schedule, settings);
+    if (resume)
+      take_up_samples(sampler, resume->sampled, resume->position, schedule, restart_source(checkpoints.restart_from));
     ProgressReport progress(replicas == 1 ? "shaker md" : fmt::format("shaker md replica {}", r),
                             "collisions/s",
                             [&] { return static_cast<double>(simulation.tally().collisions()); },
@@ -284,12 +296,13 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
       checkpointing.emplace(
           checkpoints, schedule,
           [&](const std::filesystem::path& path, const SchedulePosition& position) {
-            write_checkpoint(path, simulation.save(), geometry, position, configuration);
+            write_checkpoint(path, simulation.save(), geometry, position, configuration,
+                             SampledCycles{sampler.store(), schedule.transient_cycles()});
           },
           "shaker md");
       also.push_back(&*checkpointing);
     }
-    const RunOutcome outcome = run_protocol(simulation, schedule, replica_parameters, settings, also);
+    const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, settings, also);
     summary_of(simulation, outcome).pack(mine);
     if (r == 0) {
       record.profiles = outcome.profiles;

@@ -1,6 +1,7 @@
 #include "md/sampling.hpp"
 
 #include <cmath>
+#include <utility>
 
 namespace shaker::md {
 
@@ -57,6 +58,16 @@ CycleSamples PhaseSampler::samples() const {
       sums.push_back(samples_.sums(k));
     }
   return CycleSamples::from_arrays(bins_, samples_.bin_volume(), std::move(cycles), std::move(sums));
+}
+
+void PhaseSampler::resume(CycleSamples saved, const std::vector<double>& first_times) {
+  for (std::size_t k = 0; k < saved.phases(); ++k) {
+    double cycles = 0.0;
+    for (double c : saved.cycles(k)) cycles += c;
+    cycles_[k] = static_cast<int>(cycles);
+    first_time_[k] = first_times[k];
+  }
+  samples_ = std::move(saved);
 }
 
 void PhaseSnapshot::take(double t) {

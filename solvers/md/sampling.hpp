@@ -27,6 +27,11 @@ class PhaseSampler {
   std::vector<Profile> profiles(const ShakerKinematics& shaker) const;
   /// The per-cycle sums behind the profiles, restricted to the phases with a snapshot.
   CycleSamples samples() const;
+  /// Every phase's sums so far, also mid-cycle (what a checkpoint keeps).
+  const CycleSamples& store() const { return samples_; }
+  /// Takes up the sums of a run continued from a checkpoint (`saved`: a store() of the same
+  /// phases and bins), whose first snapshot at phase k was taken at first_times[k].
+  void resume(CycleSamples saved, const std::vector<double>& first_times);
 
  private:
   int phases_;

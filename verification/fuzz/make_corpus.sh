@@ -31,6 +31,15 @@ trap 'rm -rf "$work"' EXIT
     --set run.checkpoint="$work/md-checkpoint.h5" > "$work/md.log"
 "$shaker" continuum "$case_file" --set run.output="$work/continuum.h5" \
     --set run.checkpoint="$work/continuum-checkpoint.h5" > "$work/continuum.log"
+# Checkpoints whose schedule and sums the restart path checks: two sampled cycles (the sums of
+# both), and single shocks after their switch (check_switch against the stored protocol).
+"$shaker" md "$case_file" --set run.output="$work/md2.h5" --set run.sampled_cycles=2 \
+    --set run.checkpoint="$work/md-checkpoint-sampled.h5" > "$work/md2.log"
+for solver in md continuum; do
+  "$shaker" "$solver" "$case_file" --set run.output="$work/$solver-shock.h5" \
+      --set run.protocol=single_shock --set run.transient_cycles=1 \
+      --set run.checkpoint="$work/$solver-checkpoint-single-shock.h5" > "$work/$solver-shock.log"
+done
 
 rm -rf "$output"
 mkdir -p "$output"/{fuzz_config,fuzz_run_file,fuzz_md_checkpoint,fuzz_continuum_checkpoint}
@@ -39,6 +48,10 @@ recipe "$work/md.h5" "$output/fuzz_run_file/md-run"
 recipe "$work/continuum.h5" "$output/fuzz_run_file/continuum-run"
 recipe "$work/md-checkpoint.h5" "$output/fuzz_md_checkpoint/md-checkpoint"
 recipe "$work/continuum-checkpoint.h5" "$output/fuzz_continuum_checkpoint/continuum-checkpoint"
+recipe "$work/md-checkpoint-sampled.h5" "$output/fuzz_md_checkpoint/md-checkpoint-sampled"
+recipe "$work/md-checkpoint-single-shock.h5" "$output/fuzz_md_checkpoint/md-checkpoint-single-shock"
+recipe "$work/continuum-checkpoint-single-shock.h5" \
+    "$output/fuzz_continuum_checkpoint/continuum-checkpoint-single-shock"
 
 for file in validation/cases/*.toml "$case_file"; do
   cp "$file" "$output/fuzz_config/$(basename "$file" .toml)"

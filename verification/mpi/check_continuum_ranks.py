@@ -42,11 +42,21 @@
       the root writes the checkpoint and says so once, no run file is written, and the run
       continued from the checkpoint on 4 ranks ends in the straight run's final checkpoint, bit
       for bit but the budget.
+  check_continuum_ranks.py SHAKER signal_repeated N [--mpirun CMD]
+      The stop signal to the launcher N times, each once the 2 ranks are in their cycles (the
+      first progress line): each time one stop message and the checkpoint at the stored phase
+      it names, no run file, no rank killed. (A signal before mpirun has started the ranks ends
+      the job before the program runs: nothing to stop, docs/parallel.md.)
   check_continuum_ranks.py SHAKER root_failure [--mpirun CMD]
       A failure of the root alone during a run on 2 ranks (its checkpoint's folder removed
       after the first checkpoint, so that the next one cannot be written): the root says why
       and every rank ends, exit 1 within a minute (no rank left waiting for the others, nor
       the root for them), no run file written.
+  check_continuum_ranks.py SHAKER disagree [--mpirun CMD]
+      An MPMD launch (`mpirun -np 1 shaker ... : -np 1 shaker ...`) whose ranks get different
+      --set values (continuum.box_width 11 and 12; material.e of an MD ensemble; a value
+      refused on one rank alone): exit 2 on every rank, the message naming the rank and the key
+      that differ with both values, nothing written.
   check_continuum_ranks.py SHAKER refused [--mpirun CMD]
       A 1D column on 2 ranks, an 8 x 8 box on 3 ranks (fewer than 3 cells per rank in x), and a
       box too large for the machine's memory on 2 ranks (their blocks' needs added up, as both
@@ -402,6 +412,38 @@ def check_signal(shaker, work, launcher):
     return failures
 
 
+def check_signal_repeated(shaker, work, launcher, repeats):
+    """SIGTERM to the launcher `repeats` times, each once the ranks are in their cycles: every
+    time one stop message (the root's, exit 143), the checkpoint at the phase it names, no run
+    file, no rank killed (SIGKILL) and no other failure."""
+    failures = []
+    for attempt in range(repeats):
+        output = f"repeat{attempt}"
+        stderr, found = stopped_run(shaker, work, launcher, output, None)
+        stops = re.findall(r"stopped by signal 15 \(SIGTERM\).*stored phase (\d+) of \d+ in cycle "
+                           r"(\d+)", stderr)
+        checkpoint = os.path.join(work, f"{output}.checkpoint.h5")
+        if len(stops) != 1:
+            found.append(f"{output}: {len(stops)} stop messages, expected 1: {stderr[-600:]}")
+        elif not os.path.exists(checkpoint):
+            found.append(f"{output}: no checkpoint: {os.listdir(work)}")
+        else:
+            with h5py.File(checkpoint, "r") as f:
+                position = (int(f.attrs["schedule_phase"]), int(f.attrs["schedule_cycle"]))
+            if position != tuple(int(x) for x in stops[0]):
+                found.append(f"{output}: checkpoint at {position}, the message says {stops[0]}")
+        for needle in ("shaker: failed", "signal 9", "Killed", "shaker: error"):
+            if needle in stderr:
+                found.append(f"{output}: '{needle}' in the output: {stderr[-600:]}")
+        if os.path.exists(os.path.join(work, f"{output}.h5")):
+            found.append(f"{output}: a run file was written")
+        print(f"SIGTERM {attempt + 1} of {repeats} to the launcher: "
+              f"{'stopped at ' + str(stops[0]) if len(stops) == 1 else 'no single stop'}, "
+              f"{len(found)} problems")
+        failures += found
+    return failures
+
+
 def check_root_failure(shaker, work, launcher):
     folder = os.path.join(work, "checkpoints")
     os.mkdir(folder)
@@ -466,12 +508,45 @@ def check_refused(shaker, work, launcher):
         result = run(mpirun_prefix(launcher, ranks) + [shaker, "continuum", "case.toml", "--set",
                                                        "run.output=refused.h5", "--quiet"]
                      + [w for s in settings for w in ("--set", s)], work, expect=2)
-        for needle in needles:
-            if needle not in result.stderr:
-                failures.append(f"{label}: message lacks '{needle}': {result.stderr[-600:]}")
-        written = [n for n in os.listdir(work) if n.startswith("refused")]
-        if written:
-            failures.append(f"{label}: wrote {written}")
+        failures += refusal_problems(label, result.stderr, needles, work, "refused")
+        print(f"{label}: exit 2, {len(failures)} problems so far")
+    return failures
+
+
+def refusal_problems(label, stderr, needles, work, output):
+    """What a refusal lacks: fragments of its message, or an empty folder of outputs named
+    `output`*."""
+    problems = [f"{label}: message lacks '{needle}': {stderr[-600:]}"
+                for needle in needles if needle not in stderr]
+    written = [n for n in os.listdir(work) if n.startswith(output)]
+    return problems + ([f"{label}: wrote {written}"] if written else [])
+
+
+def check_disagreeing_ranks(shaker, work, launcher):
+    """An MPMD launch whose two ranks get different settings: exit 2 on every rank, naming the
+    rank and the key that differ (or the rank whose configuration did not load)."""
+    failures = []
+    words = shlex.split(launcher) + ["--oversubscribe", "--mca", "mpi_yield_when_idle", "1"]
+    if os.geteuid() == 0:
+        words.append("--allow-run-as-root")
+    for label, solver, ours, theirs, needles in (
+            ("continuum box widths 11 and 12", "continuum", "continuum.box_width=11",
+             "continuum.box_width=12",
+             ["rank 1 has continuum.box_width = 12.0 where rank 0 has continuum.box_width = 11.0"]),
+            ("MD ensemble with e 0.9 and 0.8", "md", "material.e=0.9", "material.e=0.8",
+             ["rank 1 has material.e = 0.8 where rank 0 has material.e = 0.9"]),
+            ("a setting refused on rank 1 alone", "continuum", "material.e=0.9", "material.e=1.5",
+             ["rank 1 has 'error: ", "material.e"])):
+        contexts = []
+        for setting in (ours, theirs):
+            contexts += ["-np", "1", shaker, solver, "case.toml", "--quiet", "--set",
+                         "run.output=disagree.h5", "--set", "md.replicas=2", "--set", setting, ":"]
+        result = run(words + contexts[:-1], work, expect=2)
+        failures += refusal_problems(
+            label, result.stderr,
+            needles + ["the 2 ranks of this launch disagree on the effective configuration",
+                       "allowed: the same case file and --set values on every rank"],
+            work, "disagree")
         print(f"{label}: exit 2, {len(failures)} problems so far")
     return failures
 
@@ -481,7 +556,8 @@ def main():
     parser.add_argument("shaker")
     parser.add_argument("check", choices=["explicit", "wall_stress", "hybrid", "implicit",
                                           "implicit_wall_stress", "restart", "column", "failure",
-                                          "signal", "root_failure", "refused"])
+                                          "signal", "signal_repeated", "root_failure", "refused",
+                                          "disagree"])
     parser.add_argument("ranks", nargs="*", type=int, default=[1, 2, 4])
     parser.add_argument("--mpirun", default="mpirun", help="the launcher (default: mpirun)")
     args = parser.parse_args()
@@ -508,8 +584,12 @@ def main():
         failures = check_failure(args.shaker, work, args.mpirun)
     elif args.check == "signal":
         failures = check_signal(args.shaker, work, args.mpirun)
+    elif args.check == "signal_repeated":
+        failures = check_signal_repeated(args.shaker, work, args.mpirun, args.ranks[0])
     elif args.check == "root_failure":
         failures = check_root_failure(args.shaker, work, args.mpirun)
+    elif args.check == "disagree":
+        failures = check_disagreeing_ranks(args.shaker, work, args.mpirun)
     else:
         failures = check_refused(args.shaker, work, args.mpirun)
     for failure in failures:

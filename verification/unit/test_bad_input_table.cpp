@@ -221,6 +221,7 @@ void replace_dataset(hid_t file, const std::string& name, const std::vector<doub
 ///            cut to their first `bins` columns
 ///   phases:  name = dataset, rows: a [phases x bins] matrix cut to its first rows
 ///   bytes:   a plain file of `bytes` zero bytes (to fill a small file system)
+///   delete:  name = a dataset or group, removed
 void apply_damage(const fs::path& dir, const toml::value& step) {
   const auto path = dir / toml::find<std::string>(step, "file");
   const auto op = toml::find<std::string>(step, "op");
@@ -231,7 +232,9 @@ void apply_damage(const fs::path& dir, const toml::value& step) {
   const auto name = toml::find<std::string>(step, "name");
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   ASSERT_GE(file, 0) << path;
-  if (op == "attr") {
+  if (op == "delete") {
+    EXPECT_GE(H5Ldelete(file, name.c_str(), H5P_DEFAULT), 0) << name;
+  } else if (op == "attr") {
     H5Adelete(file, name.c_str());
     if (step.contains("double")) shaker::h5::write_attribute(file, name, toml::find<double>(step, "double"));
     if (step.contains("integer"))

@@ -1,0 +1,60 @@
+// A run stopped by SIGTERM at any stored phase and continued from its checkpoint ends as the
+// uninterrupted run does: the same final checkpoint, the same profiles and per-cycle sums in
+// its run file, bit for bit, and the uninterrupted run's time-series rows after the restart
+// point. The stops are deterministic (support/continuation.hpp).
+#include <string>
+#include <vector>
+
+#include "common/config.hpp"
+#include "md/run_md.hpp"
+#include "md_test_support.hpp"
+#include "support/continuation.hpp"
+
+namespace shaker::md {
+namespace {
+
+constexpr int phases = 10, transient = 2, sampled = 3;
+
+/// Time-series columns counted from the start of each run (README, "Continuing").
+bool run_relative(const std::string& column) {
+  for (const char* name : {"plate_work", "collisional_loss", "energy_closure", "collisions"})
+    if (column == name) return true;
+  return column.rfind("crossings_z", 0) == 0 || column.rfind("particles_z", 0) == 0;
+}
+
+shaker::testing::Continuation small_case(const std::filesystem::path& dir, const std::vector<std::string>& settings,
+                                         std::int64_t cycles) {
+  shaker::testing::Continuation c;
+  c.run = [](const config::Config& config, const ProgressSettings& progress) { return run(config, {}, progress); };
+  std::vector<std::string> all{"layer.particles=200", "md.box_width=6.0", "md.ceiling=60.0",
+                               "md.crossing_heights=[12.5]", "run.phases_per_cycle=" + std::to_string(phases),
+                               "run.transient_cycles=" + std::to_string(transient),
+                               "run.sampled_cycles=" + std::to_string(sampled)};
+  all.insert(all.end(), settings.begin(), settings.end());
+  c.make_case = shaker::testing::case_in(dir, all);
+  c.phases = phases;
+  c.cycles = cycles;
+  c.run_relative = run_relative;
+  c.same_run_file = true;
+  return c;
+}
+
+TEST(MdContinuation, StoppedAtAnyStoredPhaseEndsAsTheStraightRun) {
+  const auto dir = testing::test_directory();
+  // In the transient, at the first sampled phase, mid-way through sampled cycles, and at the
+  // last two phases of the run (whose checkpoint continues to the run's end).
+  shaker::testing::expect_continuations_exact(dir, small_case(dir, {}, transient + sampled),
+                                              {{1, 4}, {2, 0}, {2, 7}, {3, 3}, {4, 8}, {4, 9}});
+}
+
+TEST(MdContinuation, SingleShockStoppedAfterItsSwitchEndsAsTheStraightRun) {
+  const auto dir = testing::test_directory();
+  // The switch at f t = -0.33 of the recorded cycle 2: stops before it, just after it, and in
+  // the recorded cycle.
+  shaker::testing::expect_continuations_exact(
+      dir, small_case(dir, {"run.protocol=single_shock", "run.switch_e=0.8"}, transient + 1),
+      {{1, 5}, {1, 7}, {2, 4}});
+}
+
+}  // namespace
+}  // namespace shaker::md
