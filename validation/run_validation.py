@@ -539,7 +539,8 @@ def evaluate_claims(claims, views, comparer, partial_cases_ok):
 
 CATEGORIES = {"a": "the continuum and MD really differ",
               "b": "MD does not reproduce the paper's statement",
-              "c": "a defect of the project still to find or fix"}
+              "c": "a defect of the project still to find or fix",
+              "d": "the continuum's equations give it, whatever the numerical choices"}
 
 
 def validate_diagnoses(diagnoses, claims, studies):

@@ -129,7 +129,7 @@ def broken_diagnoses(diagnoses):
         return d
     return [
         ("unknown claim", edit(lambda d: d[0].update(claim="C21"))),
-        ("unknown category", edit(lambda d: d[0].update(category="d"))),
+        ("unknown category", edit(lambda d: d[0].update(category="e"))),
         ("no reason", edit(lambda d: d[0].update(reason=" "))),
         ("unknown evidence quantity", edit(lambda d: d[0]["evidence"][0].update(quantity="x"))),
         ("evidence on a case nobody runs",
