@@ -16,6 +16,7 @@ import json
 import math
 import os
 import sys
+import textwrap
 
 import matplotlib
 
@@ -190,7 +191,7 @@ def figure(results, out_dir, link):
             ax.axvspan(reference[0] - 2 * err, reference[0] + 2 * err, color="C3", alpha=0.25,
                        label="MD ± 2 standard errors")
             ax.axvline(reference[0], color="C3", lw=1.0, label="MD")
-        ax.set_xlabel(label)
+        ax.set_xlabel(textwrap.fill(label, 32))  # four panels side by side: no overlap
         ax.grid(axis="x", lw=0.3)
         if not xs:
             ax.text(0.5, 0.5, "not measured", transform=ax.transAxes, ha="center")
