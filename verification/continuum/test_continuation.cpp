@@ -23,17 +23,9 @@ bool run_relative(const std::string& column) {
 
 shaker::testing::Continuation column(const std::filesystem::path& dir, const std::vector<std::string>& settings,
                                      std::int64_t cycles) {
-  shaker::testing::Continuation c;
-  c.run = [](const config::Config& config, const ProgressSettings& progress) { return run(config, {}, progress); };
-  std::vector<std::string> all{"continuum.cell_size=0.5", "run.phases_per_cycle=" + std::to_string(phases),
-                               "run.transient_cycles=" + std::to_string(transient),
-                               "run.sampled_cycles=" + std::to_string(sampled)};
-  all.insert(all.end(), settings.begin(), settings.end());
-  c.make_case = shaker::testing::case_in(dir, all);
-  c.phases = phases;
-  c.cycles = cycles;
-  c.run_relative = run_relative;
-  return c;
+  return shaker::testing::continuation_of(
+      [](const config::Config& config, const ProgressSettings& progress) { return run(config, {}, progress); }, dir,
+      {phases, transient, sampled}, {"continuum.cell_size=0.5"}, settings, cycles, run_relative);
 }
 
 TEST(Continuation, StoppedAtAnyStoredPhaseEndsAsTheStraightRun) {

@@ -16,6 +16,7 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/checkpoints.hpp"
@@ -147,6 +148,32 @@ inline std::function<config::Config(const std::string&)> case_in(const std::file
     config.set("run.checkpoint=" + (dir / (name + ".ckpt.h5")).string());
     return config;
   };
+}
+
+/// How often a case stores phases, and for how long it runs before and while it samples.
+struct Schedule {
+  int phases_per_cycle, transient_cycles, sampled_cycles;
+};
+
+/// The Continuation of the case `solver_settings` + `schedule` + `settings` (outputs in
+/// `dir`), running `cycles` cycles with `run`; series columns where run_relative holds are
+/// not compared.
+inline Continuation continuation_of(std::function<int(const config::Config&, const ProgressSettings&)> run,
+                                    const std::filesystem::path& dir, const Schedule& schedule,
+                                    std::vector<std::string> solver_settings,
+                                    const std::vector<std::string>& settings, std::int64_t cycles,
+                                    std::function<bool(const std::string&)> run_relative) {
+  solver_settings.push_back("run.phases_per_cycle=" + std::to_string(schedule.phases_per_cycle));
+  solver_settings.push_back("run.transient_cycles=" + std::to_string(schedule.transient_cycles));
+  solver_settings.push_back("run.sampled_cycles=" + std::to_string(schedule.sampled_cycles));
+  solver_settings.insert(solver_settings.end(), settings.begin(), settings.end());
+  Continuation c;
+  c.run = std::move(run);
+  c.make_case = case_in(dir, solver_settings);
+  c.phases = schedule.phases_per_cycle;
+  c.cycles = cycles;
+  c.run_relative = std::move(run_relative);
+  return c;
 }
 
 /// Runs the case straight, then stopped by SIGTERM at each stored phase (cycle, phase) of
