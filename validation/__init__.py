@@ -1,1 +1,1 @@
-"""The validation study of issue 6: run_validation (runner) and quantities (claims)."""
+"""The validation study: run_validation (runner) and quantities (claims)."""

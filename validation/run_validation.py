@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Runs the validation study of issue 6 and writes reports/validation.md.
+"""Runs the validation study (MD, continuum, the paper's claims) and writes reports/validation.md.
 
     validation/run_validation.py --shaker build/release/solvers/app/shaker [--quick]
         [--cases base,depth_h4p5] [--workdir DIR] [--report reports/validation.md]

@@ -1,5 +1,5 @@
 #pragma once
-// A shock width that does not depend on the bin (issue 15, item 3): a smooth front fitted
+// A shock width that does not depend on the bin: a smooth front fitted
 // across the shock. The paper's width (T maximum to T minimum, find_shock) is a whole number
 // of bins and cannot resolve a front about one mean free path wide; the fitted one can, and
 // comes with an error.

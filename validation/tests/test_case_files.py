@@ -16,7 +16,7 @@ from validation import run_validation
 
 VALIDATION = os.path.dirname(os.path.abspath(run_validation.__file__))
 
-# What each study of issue 6 must set (key path -> value) in the effective configuration.
+# What each study of the validation must set (key path -> value) in the effective configuration.
 EXPECTED = {
     "base": {"layer.particles": 3937, "material.e": 0.9, "continuum.ceiling": 80.0,
              "md.box_width": 20.0, "run.protocol": "periodic"},

@@ -88,7 +88,7 @@ void BM_Continuum1D_BaseCase_PaperImplicitDiffusion(benchmark::State& state) {
 }
 BENCHMARK(BM_Continuum1D_BaseCase_PaperImplicitDiffusion)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
-// The integrator that meets issue 4's 2 s per cycle: SSP-RK(s,2) (s right-hand sides per step,
+// The integrator that meets the 2 s per cycle asked of the 1D base case: SSP-RK(s,2) (s right-hand sides per step,
 // a step s - 1 times Heun's at the same Courant number per stage) with the diffusive half
 // steps backward Euler, Richardson-extrapolated to second order (3 solves each). Its base-case
 // quantities against the case's own configuration:

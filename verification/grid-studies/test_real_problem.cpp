@@ -242,7 +242,7 @@ TEST(NightlyRealProblem, BaseCase1DGridConvergence) {
   EXPECT_FALSE(conv::write_study(dir, "real-1d-base", table, {}, rows).empty());
 }
 
-// The faster time integrators of issue 4 against the most accurate one available for the
+// The faster time integrators against the most accurate one available for the
 // transport, at cell 0.1. The fast ones: the diffusive terms implicit (Strang split; backward
 // Euler, first order in time, or its Richardson extrapolation, second order) with SSP-RK(s,2),
 // s = 2, 4 or 10, whose steps are 1, 3 and 9 times Heun's at the same Courant number per

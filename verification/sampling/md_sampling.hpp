@@ -1,5 +1,5 @@
 #pragma once
-// MD sampling convergence (issue 5, "Convergence of the real problem"):
+// MD sampling convergence of the real problem:
 // how the standard error of the MD fields and quantities of interest falls with the number K
 // of sampled cycles, and whether the sampling bin size (sigma against sigma/2) changes the
 // fields by more than their standard error.

@@ -1,5 +1,5 @@
-// MD sampling convergence of the real problem (issue 5, "MD sampling
-// convergence"): the base case (validation/cases/base.toml: H = 9, e = 0.9, 3937 particles).
+// MD sampling convergence of the real problem: the base case (validation/cases/base.toml:
+// H = 9, e = 0.9, 3937 particles).
 //
 // 1. Standard error against the number K of sampled cycles. One trajectory (explicit seed,
 //    fixed transient, M sampled cycles at 100 phases so that f t = 0.22 and 0.25 are on the

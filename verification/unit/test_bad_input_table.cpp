@@ -1,4 +1,4 @@
-// Issue 18's contract for bad input and failures, as data: every row of bad_input_cases.toml
+// The README's contract for bad input and failures, as data: every row of bad_input_cases.toml
 // runs `shaker` in its own temporary directory (named after the case and the process id,
 // removed when the case passes) and checks the exit code, a fragment of the message, the files
 // that must not exist, must exist and must be left unchanged; no NAME.partial-PID file may be

@@ -1,6 +1,6 @@
 // The run-level estimators of run_analysis.hpp (shock life: formation, exit, speed; shock
 // location per phase) and their jackknife errors over samples, tested on synthetic MD runs of
-// known truth (issue 15, item 4). The generator builds per-cycle sums (CycleSamples) whose
+// known truth. The generator builds per-cycle sums (CycleSamples) whose
 // pooled fields are a base-case-like layer with a shock of known speed, formation and exit,
 // plus Gaussian noise at the per-bin level the project's MD shows; the analysis then runs as
 // `shaker analyze` runs it: central values from the pooled profiles, errors from the jackknife
