@@ -24,6 +24,7 @@ CaseParameters CaseParameters::from(const config::Config& c) {
                                    c.real("run.switch_e")};
   p.run.seed = static_cast<std::uint64_t>(c.integer("run.seed"));
   p.run.output = c.text("run.output");
+  p.run.log = c.boolean("run.log");
   // The switch lies run.switch_phase (in [-1, 0)) before the recorded cycle, i.e. inside the
   // transient: without a transient cycle it would lie before the start of the run.
   if (p.run.kind == RunProtocol::Kind::single_shock && static_cast<double>(p.run.transient_cycles) + p.run.switch_phase < 0.0)

@@ -19,6 +19,7 @@ struct RunProtocol {
   Restitution after_switch;      ///< single_shock: restitution after the switch
   std::uint64_t seed = 1;
   std::string output = "run.h5";
+  bool log = true;  ///< keep OUTPUT.log (common/terminal_log.hpp)
 };
 
 struct CaseParameters {

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "common/errors.hpp"
+#include "common/terminal_log.hpp"
 
 namespace shaker::h5 {
 namespace {
@@ -318,9 +319,13 @@ void unregister_for_cleanup(int slot) {
   cleanup_registry[slot].used.store(false);
 }
 
+/// To the terminal and the run's log (async-signal safe).
 void write_stderr(const char* text) {
-  const ssize_t ignored = ::write(2, text, std::strlen(text));
-  (void)ignored;
+  for (const int fd : {2, terminal_log::descriptor()})
+    if (fd >= 0) {
+      const ssize_t ignored = ::write(fd, text, std::strlen(text));
+      (void)ignored;
+    }
 }
 
 extern "C" void remove_partial_files_and_exit(int signal) {

@@ -32,6 +32,10 @@ std::vector<ParameterSpec> common_parameters() {
       real("run.switch_e", 0.9, closed(0.0, 1.0), "single_shock: e after the switch").in("1"),
       integer("run.seed", 1, closed(0, 9.0e15), "seed of every random choice of the run").in("-"),
       text("run.output", "run.h5", {}, "HDF5 output file (written atomically)").in("-"),
+      boolean("run.log", true,
+              "keep what the terminal shows (configuration, progress, summary, warnings, the "
+              "message of a stop or failure) in OUTPUT.log beside run.output, written as the run "
+              "goes").in("-"),
       text("run.restart_from", "", {},
            "checkpoint to continue from (empty: the solver's initial state): the run continues the "
            "checkpoint's schedule, its cycles counted from that run's start, up to "

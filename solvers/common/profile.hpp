@@ -48,6 +48,9 @@ struct RunRecord {
   /// MD ensembles (md.replicas = K > 1): the time series of replicas 1 .. K-1, in replica
   /// order, with the columns of `series`; empty for a single run.
   std::vector<TimeSeries> replica_series;
+  /// What the run found doubtful about its own result (docs/output-schema.md, `warnings`);
+  /// empty when nothing was.
+  std::vector<std::string> warnings;
   // Filled when read back from a file:
   int schema_version = 0;
   std::string program_version, git_commit, created;

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "common/errors.hpp"
+#include "common/terminal_log.hpp"
 
 namespace shaker {
 namespace {
@@ -53,7 +54,7 @@ void ProgressReport::at_run_end(double t) {
   if (settings_.quiet || cycles_ == 0) return;
   const double cycles = static_cast<double>(cycles_);
   if (live_ || since_line_.seconds() >= settings_.interval_seconds) write(cycles, cycles_, cycles_, t);
-  if (live_) fmt::print(stream_, "\n");
+  if (live_) fmt::print(stream_, "\n");  // ends the live line; the log has it already
 }
 
 void ProgressReport::write(double cycles_done, std::int64_t cycle, std::int64_t cycles, double t) {
@@ -65,9 +66,16 @@ void ProgressReport::write(double cycles_done, std::int64_t cycle, std::int64_t 
   const std::string line = fmt::format("{}: cycle {} of {}, t = {:.6g}, {:.3g} {}, {} left", label_,
                                        cycle, cycles, t, rate, rate_unit_, duration_text(left));
   // The spaces clear what a longer previous live line left behind.
-  if (live_) fmt::print(stream_, "\r{}   ", line);
-  else fmt::print(stream_, "{}\n", line);
-  std::fflush(stream_);
+  if (live_) {
+    fmt::print(stream_, "\r{}   ", line);
+    std::fflush(stream_);
+    if (since_logged_.seconds() >= settings_.interval_seconds || cycles_done >= static_cast<double>(cycles)) {
+      since_logged_ = Stopwatch();
+      terminal_log::to_log(line + "\n");
+    }
+  } else {
+    terminal_log::print(stream_, line + "\n");
+  }
 }
 
 }  // namespace shaker

@@ -57,6 +57,7 @@ class ProgressReport final : public RunObserver {
   std::FILE* stream_;
   bool live_;
   Stopwatch run_, since_line_;
+  Stopwatch since_logged_;  ///< the run's log takes a live terminal's lines at the interval only
   double work_at_start_;
   std::int64_t cycles_ = 0;  ///< of the run, from the first instant
   double resumed_at_ = 0.0;  ///< PhaseInstant::resumed_at

@@ -77,10 +77,6 @@ std::string series_units(const std::string& column) {
                                      "series_units (run_file.cpp) and docs/output-schema.md", column));
 }
 
-std::string utc_now() {
-  return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::now()));
-}
-
 void write_profiles(hid_t file, const std::vector<Profile>& profiles) {
   h5::Handle group = h5::create_group(file, "profiles");
   const std::size_t phases = profiles.size();
@@ -302,6 +298,10 @@ std::vector<TimeSeries> read_replica_series(hid_t file) {
 
 }  // namespace
 
+std::string utc_now() {
+  return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::now()));
+}
+
 void write_run_attributes(hid_t file, const RunRecord& record) {
   h5::write_attribute(file, "schema_version", std::int64_t{output_schema_version});
   h5::write_attribute(file, "program_version", std::string(program_version()));
@@ -311,6 +311,7 @@ void write_run_attributes(hid_t file, const RunRecord& record) {
   h5::write_attribute(file, "model_variant", record.model_variant);
   h5::write_attribute(file, "configuration", record.configuration);
   h5::write_attribute(file, "restitution_for_analysis", record.e);
+  h5::write_attribute(file, "warnings", fmt::format("{}", fmt::join(record.warnings, "\n")));
 }
 
 void write_run_file(const std::filesystem::path& path, const RunRecord& record) {
@@ -358,6 +359,11 @@ RunRecord read_run_file(const std::filesystem::path& path) {
     record.model_variant = h5::read_string_attribute(file.id(), "model_variant");
     record.configuration = h5::read_string_attribute(file.id(), "configuration");
     record.e = h5::read_double_attribute(file.id(), "restitution_for_analysis");
+    // Files written before runs judged themselves have no warnings attribute.
+    if (h5::has_attribute(file.id(), "warnings")) {
+      std::istringstream lines(h5::read_string_attribute(file.id(), "warnings"));
+      for (std::string line; std::getline(lines, line);) record.warnings.push_back(line);
+    }
     const config::Range restitution = config::find_spec("material.e").range;
     if (!std::isfinite(record.e) || !restitution.contains(record.e))
       throw InputError(fmt::format("attribute 'restitution_for_analysis' = {}; allowed: {} (material.e)",

@@ -20,6 +20,8 @@ inline constexpr const char* file_kind_attribute = "kind";
 /// The root attributes of a run file (docs/output-schema.md): schema version, program
 /// version, commit, date, and the record's solver, model variant, configuration and e.
 /// Every file a run writes for analysis carries them, so that each says what made it.
+/// The current UTC time, ISO 8601 (the `created` attribute of every output).
+std::string utc_now();
 void write_run_attributes(hid_t file, const RunRecord& record);
 /// Writes the record atomically; provenance (schema, version, commit, date) is added here.
 /// Throws std::invalid_argument, writing nothing, if the series lacks a required column or a

@@ -78,9 +78,10 @@ Diagnostics diagnostics(const BoxView& box, const ShakerKinematics& shaker) {
   return d;
 }
 
-FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker) {
+FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker, std::int64_t cycle) {
   const Grid& g = box.grid;
   FieldSnapshot f;
+  f.cycle = cycle;
   f.time = box.scalars.time;
   f.phase = shaker.phase(f.time);
   f.plate_z = shaker.position(f.time);
@@ -90,6 +91,7 @@ FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker) {
       for (int i = 0; i < g.nx; ++i) {
         const Primitive w = to_primitive(box.state, g.index(i, j, k));
         f.n.push_back(w.n);
+        f.nu.push_back(volume_fraction(w.n));
         f.ux.push_back(w.ux);
         f.uy.push_back(w.uy);
         f.uz.push_back(w.uz + f.plate_v);
@@ -151,10 +153,20 @@ struct FieldColumn {
   const char* units;
 };
 constexpr FieldColumn field_columns[] = {{"n", &FieldSnapshot::n, "1/sigma^3"},
+                                         {"nu", &FieldSnapshot::nu, "1"},
                                          {"ux", &FieldSnapshot::ux, "sqrt(g sigma)"},
                                          {"uy", &FieldSnapshot::uy, "sqrt(g sigma)"},
                                          {"uz", &FieldSnapshot::uz, "sqrt(g sigma)"},
                                          {"T", &FieldSnapshot::T, "g sigma"}};
+
+/// (ux, uy, uz) of each cell, for readers that take a vector field (ParaView's glyphs and
+/// stream lines); the components stay beside it for those that take scalars.
+std::vector<double> velocity_vectors(const FieldSnapshot& f) {
+  std::vector<double> v;
+  v.reserve(3 * f.n.size());
+  for (std::size_t c = 0; c < f.n.size(); ++c) v.insert(v.end(), {f.ux[c], f.uy[c], f.uz[c]});
+  return v;
+}
 
 std::string snapshot_group(std::size_t s) { return fmt::format("snapshot_{:03d}", s); }
 
@@ -182,7 +194,9 @@ std::string xdmf_text(const std::string& file, const Grid& g,
               hdf_item(fmt::format("{} {} {}", g.nz, g.ny, g.nx), "Float", file,
                        group + "/" + column.name) +
               "</Attribute>\n";
-    xdmf += "</Grid>\n";
+    xdmf += "<Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Cell\">\n" +
+            hdf_item(fmt::format("{} {} {} 3", g.nz, g.ny, g.nx), "Float", file, group + "/velocity") +
+            "</Attribute>\n</Grid>\n";
   }
   return xdmf + "</Grid>\n</Domain>\n</Xdmf>\n";
 }
@@ -210,9 +224,11 @@ void write_fields(const std::filesystem::path& h5_path, const Grid& g,
       h5::write_attribute(group.id(), "phase", f.phase);
       h5::write_attribute(group.id(), "plate_z", f.plate_z);
       h5::write_attribute(group.id(), "plate_v", f.plate_v);
+      h5::write_attribute(group.id(), "cycle", f.cycle);
       h5::write(group.id(), "points", corners(g, f.plate_z), {points, 3}, "sigma");
       for (const auto& column : field_columns)
         h5::write(group.id(), column.name, f.*column.values, shape, column.units);
+      h5::write(group.id(), "velocity", velocity_vectors(f), {shape[0], shape[1], shape[2], 3}, "sqrt(g sigma)");
     }
   });
   write_text_atomically(derived_name(h5_path, ".xdmf"), xdmf_text(h5_path.filename().string(), g, snapshots));

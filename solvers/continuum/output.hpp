@@ -47,9 +47,10 @@ inline Diagnostics diagnostics(const TimeIntegrator& solver, const ShakerKinemat
 /// container-frame centres + plate_z, and u_z includes plate_v.
 struct FieldSnapshot {
   double time = 0, phase = 0, plate_z = 0, plate_v = 0;
-  std::vector<double> n, ux, uy, uz, T;  ///< interior cells, x fastest, lab-frame u_z
+  std::int64_t cycle = 0;  ///< of the run's schedule, from 0
+  std::vector<double> n, nu, ux, uy, uz, T;  ///< interior cells, x fastest, lab-frame u_z
 };
-FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker);
+FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker, std::int64_t cycle);
 /// Root attribute `kind` of the fields file: a reader of run files refuses it by this.
 inline constexpr const char* fields_file_kind = "shaker continuum fields";
 /// Writes the fields file (h5_path) and its .xdmf sidecar atomically; the file's root carries

@@ -70,6 +70,10 @@ std::vector<ParameterSpec> continuum_parameters() {
                 "3D only: phases f t of the last sampled cycle whose full fields are written "
                 "(RUN.fields.h5 + RUN.fields.xdmf), each a stored phase k / run.phases_per_cycle, "
                 "at most once").in("1 (f t)"),
+      real_list("continuum.field_cycles", {}, closed(0.0, 2e6),
+                "3D only: the cycles (of the run's schedule, from 0, transient included) in which "
+                "continuum.field_phases are written, each at most once, so that ParaView can "
+                "animate the run; empty: the last cycle").in("cycles"),
   };
 }
 

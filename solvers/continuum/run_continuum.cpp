@@ -29,6 +29,7 @@
 #include "common/ranks.hpp"
 #include "common/run_file.hpp"
 #include "common/run_loop.hpp"
+#include "common/terminal_log.hpp"
 #include "continuum/checkpoint.hpp"
 #include "continuum/halo.hpp"
 #include "continuum/output.hpp"
@@ -210,18 +211,20 @@ class ProfileAverage final : public RunObserver {
 /// 3D fields at the stored phases of continuum.field_phases, in the last cycle.
 class FieldSnapshots final : public RunObserver {
  public:
-  FieldSnapshots(const Box& box, const ShakerKinematics& shaker, std::vector<std::int64_t> phases)
-      : box_(box), shaker_(shaker), phases_(std::move(phases)) {}
+  FieldSnapshots(const Box& box, const ShakerKinematics& shaker, const ContinuumCase& c)
+      : box_(box), shaker_(shaker), phases_(c.field_phases), cycles_(c.field_cycles) {}
   void at_phase(const PhaseInstant& instant) override {
-    if (box_.writer() && instant.last_cycle() && std::binary_search(phases_.begin(), phases_.end(), instant.phase))
-      snapshots.push_back(snapshot(box_.view(), shaker_));
+    const bool in_cycle = cycles_.empty() ? instant.last_cycle()
+                                          : std::binary_search(cycles_.begin(), cycles_.end(), instant.cycle);
+    if (box_.writer() && in_cycle && std::binary_search(phases_.begin(), phases_.end(), instant.phase))
+      snapshots.push_back(snapshot(box_.view(), shaker_, instant.cycle));
   }
   std::vector<FieldSnapshot> snapshots;
 
  private:
   const Box& box_;
   const ShakerKinematics& shaker_;
-  std::vector<std::int64_t> phases_;  ///< increasing
+  std::vector<std::int64_t> phases_, cycles_;  ///< increasing
 };
 
 /// The solver as the run loop drives it.
@@ -247,6 +250,32 @@ class DrivenIntegrator final : public DrivenSolver {
   TimeIntegrator& solver_;
 };
 
+/// A periodic run whose centre of mass still moves from one cycle to the next by more than this
+/// fraction of its height (periodicity_last_two_cycles) has not settled into its periodic state.
+constexpr double settled_periodicity = 0.01;
+/// A run that raised more than this share of its cell updates to the temperature floor is
+/// decided by the floor, not by its equations, where the layer thins.
+constexpr double floor_share_limit = 1e-3;
+
+/// What the run finds doubtful about its own result, one sentence each (docs/output-schema.md).
+std::vector<std::string> doubts_about(const RunProtocol& run, double periodicity, const Counters& counters,
+                                      double cells) {
+  std::vector<std::string> doubts;
+  if (run.kind == RunProtocol::Kind::periodic && periodicity > settled_periodicity)
+    doubts.push_back(fmt::format(
+        "far from periodic: the centre of mass changed by {:.3g} of its height (RMS) over the last "
+        "cycle, above {:g}; run more transient cycles (run.transient_cycles)", periodicity,
+        settled_periodicity));
+  const double updates = cells * static_cast<double>(counters.steps);
+  const double floor_share = updates > 0.0 ? static_cast<double>(counters.temperature_floor_uses) / updates : 0.0;
+  if (floor_share > floor_share_limit)
+    doubts.push_back(fmt::format(
+        "leans on the temperature floor: {} of {:.4g} cell updates ({:.3g}) were raised to "
+        "continuum.temperature_floor, above {:g}; the dilute region is decided by the floor",
+        counters.temperature_floor_uses, updates, floor_share, floor_share_limit));
+  return doubts;
+}
+
 /// Where a step failure leaves the last good state: OUTPUT.last_good.h5.
 std::filesystem::path last_good_path(const std::filesystem::path& output) {
   return derived_name(output, ".last_good.h5");
@@ -256,6 +285,7 @@ std::filesystem::path last_good_path(const std::filesystem::path& output) {
 void check_outputs(const ContinuumCase& c, const CheckpointSettings& checkpoints, const std::vector<NamedPath>& inputs) {
   const std::filesystem::path output = c.parameters.run.output;
   std::vector<NamedPath> outputs{{"run.output", output}};
+  terminal_log::add_output(outputs, c.parameters.run);
   if (!output.empty()) outputs.push_back({"run.output's last-good checkpoint", last_good_path(output)});
   if (!c.field_phases.empty() && !output.empty()) {
     const std::filesystem::path fields = derived_name(output, ".fields.h5");
@@ -288,7 +318,7 @@ void check_memory_of_run(const ContinuumCase& c, const Halo* halo) {
   const double box_cells = static_cast<double>(g.nx) * g.ny * g.nz;
   const double own_cells = halo ? static_cast<double>(halo->block().nx) * halo->block().ny * g.nz : box_cells;
   constexpr double stored_bytes_per_cell = variable_count * sizeof(double);
-  const double copies = (halo ? 1.0 : 0.0) + static_cast<double>(c.field_phases.size());
+  const double copies = (halo ? 1.0 : 0.0) + static_cast<double>(c.field_snapshots());
   const bool writer = !halo || halo->root();
   const double mine = own_cells * solver_bytes_per_cell + (halo ? halo->shared_bytes() : 0.0) +
                       (writer ? copies * box_cells * stored_bytes_per_cell : 0.0);
@@ -386,7 +416,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   Box box(solver, c.grid);
   Recorder recorder(box, shaker, K);
   ProfileAverage profiles(box, shaker, K);
-  FieldSnapshots fields(box, shaker, c.field_phases);
+  FieldSnapshots fields(box, shaker, c);
   const double cells = static_cast<double>(c.grid.interior_cells());
   ProgressSettings progress_of_rank = progress_settings;
   progress_of_rank.quiet = progress_settings.quiet || !box.writer();
@@ -406,6 +436,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   std::vector<RunObserver*> observers{&box, &recorder, &profiles, &progress, &checkpointing};
   if (!c.field_phases.empty()) observers.insert(observers.end() - 1, &fields);
   DrivenIntegrator driven(solver);
+  if (box.writer()) terminal_log::start(run, configuration);  // the inputs are accepted
   try {
     schedule.run(driven, observers, &checkpointing);
   } catch (const StepFailure& failure) {
@@ -414,8 +445,8 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
     if (!box.writer()) return 1;
     const std::filesystem::path last_good = last_good_path(output);
     write(last_good, checkpointing.next());
-    fmt::print(stderr, "shaker continuum: {}\nThe last good state is in {}\n", failure.what(),
-               last_good.string());
+    terminal_log::print(stderr, fmt::format("shaker continuum: {}\nThe last good state is in {}\n",
+                                            failure.what(), last_good.string()));
     return 1;
   }
   if (!box.writer()) return 0;
@@ -428,12 +459,13 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
   record.e = driven.switched ? run.after_switch.e : c.parameters.restitution.e;  // e of the recorded cycle
   record.profiles = profiles.averages();
   record.series = recorder.series();
+  const Counters counters = box.view().scalars.counters;
+  record.warnings = doubts_about(run, recorder.periodicity(), counters, cells);
   if (!fields.snapshots.empty()) {
     write_fields(derived_name(output, ".fields.h5"), c.grid, fields.snapshots, record);
   }
   write_run_file(output, record);
-  const Counters counters = box.view().scalars.counters;
-  fmt::print("shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
+  terminal_log::print(stdout, fmt::format("shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
              "temperature floor used {} times; mass drift {:.3e}; periodicity (centre of mass, last "
              "two cycles) {:.3e} (series column periodicity_last_two_cycles); energy budget residual "
              "{:.3e} of the accumulated loss {:.6g}\nwrote {}\n",
@@ -441,7 +473,10 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
              counters.rejected_steps, counters.temperature_floor_uses,
              (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
              recorder.periodicity(), recorder.budget_residual.back(),
-             recorder.collisional_loss.back() - recorder.initial_loss, output.string());
+             recorder.collisional_loss.back() - recorder.initial_loss, output.string()));
+  for (const std::string& doubt : record.warnings)
+    terminal_log::print(stderr, fmt::format("shaker continuum: warning: {} (kept in the run file's "
+                                            "attribute warnings)\n", doubt));
   return 0;
 }
 

@@ -54,6 +54,34 @@ std::vector<std::int64_t> field_phase_indices(const config::Config& config, int 
   return indices;
 }
 
+/// continuum.field_cycles: whole cycles of the run, each at most once, with field phases to
+/// write in them.
+std::vector<std::int64_t> field_cycle_indices(const config::Config& config, const ContinuumCase& c) {
+  constexpr const char* key = "continuum.field_cycles";
+  const std::vector<double>& listed = config.real_list(key);
+  if (listed.empty()) return {};
+  const std::string given = fmt::format("{} = {}", key, config.value_text(key));
+  if (c.field_phases.empty())
+    throw InputError(fmt::format("{} without continuum.field_phases writes nothing; allowed: [] (the "
+                                 "default), or continuum.field_phases set", given));
+  const RunProtocol& run = c.parameters.run;
+  const std::int64_t cycles = run.transient_cycles + (run.kind == RunProtocol::Kind::single_shock ? 1 : run.sampled_cycles);
+  const std::string allowed = fmt::format(
+      "allowed: whole cycles 0 to {} of the run (run.transient_cycles + {}), each at most once", cycles - 1,
+      run.kind == RunProtocol::Kind::single_shock ? "1 for a single shock" : "run.sampled_cycles");
+  std::vector<std::int64_t> indices;
+  for (const double cycle : listed) {
+    if (cycle != std::floor(cycle) || cycle < 0.0 || cycle >= static_cast<double>(cycles))
+      throw InputError(fmt::format("{}: {} is not a cycle of the run; {}", given, cycle, allowed));
+    const auto index = static_cast<std::int64_t>(cycle);
+    if (std::find(indices.begin(), indices.end(), index) != indices.end())
+      throw InputError(fmt::format("{}: cycle {} is listed twice; {}", given, index, allowed));
+    indices.push_back(index);
+  }
+  std::sort(indices.begin(), indices.end());
+  return indices;
+}
+
 /// A 3D layer's cells are drawn up to (1 + p) times the layer's density and then all scaled
 /// by the mass correction, at most 1 / (1 - p): both keys together must keep every cell below
 /// the clamp at 0.999 nu_max, where the constitutive functions end.
@@ -120,6 +148,7 @@ ContinuumCase continuum_case(const config::Config& config) {
   check_perturbation(l, c.grid.dimension);
   l.seed = c.parameters.run.seed;
   c.field_phases = field_phase_indices(config, c.grid.dimension, c.parameters.run.phases_per_cycle);
+  c.field_cycles = field_cycle_indices(config, c);
   // The layer must fit under the ceiling: checked now, before anything runs or is written, on
   // one column of the grid (the check depends on the height alone; a whole 3D box would cost
   // every rank of a decomposed run the memory of the box's state).

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <algorithm>
 #include <vector>
 
 #include "common/case_parameters.hpp"
@@ -22,6 +23,11 @@ struct ContinuumCase {
   /// Stored phases k of run.phases_per_cycle = K (f t = k / K) whose 3D fields are written in
   /// the last cycle: continuum.field_phases, checked, in increasing order.
   std::vector<std::int64_t> field_phases;
+  /// Cycles (of the run's schedule, from 0) in which they are written: continuum.field_cycles,
+  /// checked, in increasing order; empty: the last cycle.
+  std::vector<std::int64_t> field_cycles;
+  /// Field snapshots the run writes.
+  std::size_t field_snapshots() const { return field_phases.size() * std::max<std::size_t>(1, field_cycles.size()); }
 };
 
 ContinuumCase continuum_case(const config::Config& config);

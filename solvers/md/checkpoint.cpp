@@ -73,6 +73,29 @@ SampledCycles read_sampled(hid_t f, const SchedulePosition& position) {
   return sampled;
 }
 
+/// Kinetic plus potential energy (lab frame) of positions r and velocities v.
+double system_energy(const Geometry& g, const std::vector<Vec3>& r, const std::vector<Vec3>& v) {
+  double energy = 0.0;
+  for (std::size_t i = 0; i < r.size(); ++i) energy += 0.5 * dot(v[i], v[i]) + g.gravity * r[i].z;
+  return energy;
+}
+
+/// The energy budget is closed to 1e-9 relative from differences of the running energy totals.
+/// A total beyond tally_energy_bound times the system's energy leaves fewer than 1e-9 of its
+/// resolution for those differences, so the continued run could not check its budget.
+inline constexpr double tally_energy_bound = 1e6;
+
+void check_tally_scale(const Tally& t, double energy) {
+  const double scale = std::max(std::fabs(energy), 1.0);
+  const double values[] = {t.plate_work, t.pair_loss, t.wall_loss};
+  for (std::size_t k = 0; k < 3; ++k)
+    if (std::fabs(values[k]) > tally_energy_bound * scale)
+      throw InputError(fmt::format(
+          "dataset 'tally_energy' holds {} at entry {} (plate work, pair loss, wall loss); allowed: "
+          "|value| <= {:g} x the particles' energy ({:.6g} m g sigma), beyond which the energy budget "
+          "can no longer be closed to 1e-9", values[k], k, tally_energy_bound, scale));
+}
+
 }  // namespace
 
 void write_checkpoint(const std::filesystem::path& path, const SimulationData& d, const Geometry& geometry,
@@ -269,6 +292,7 @@ void validate_state(const Geometry& g, const SimulationData& d, double tolerance
           "and {} <= z <= {} at t = {}", i, x, y, z, g.width, z_lo + tolerance, z_hi - tolerance,
           d.time));
   }
+  check_tally_scale(d.tally, system_energy(g, r, v));
   Geometry cells_geometry = g;
   CellList cells;
   cells.build(cells_geometry, n);

@@ -18,6 +18,7 @@
 #include "common/progress.hpp"
 #include "common/ranks.hpp"
 #include "common/run_file.hpp"
+#include "common/terminal_log.hpp"
 #include "md/checkpoint.hpp"
 #include "md/initial_states.hpp"
 #include "md/protocol.hpp"
@@ -258,7 +259,9 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   const MdSettings settings = MdSettings::from(config);
   const Geometry geometry = geometry_of(parameters, settings);
   const CheckpointSettings checkpoints = CheckpointSettings::from(config);
-  checkpoints.check_paths({{"run.output", parameters.run.output}}, inputs);
+  std::vector<NamedPath> outputs{{"run.output", parameters.run.output}};
+  terminal_log::add_output(outputs, parameters.run);
+  checkpoints.check_paths(outputs, inputs);
   check_replicas(config, checkpoints);
   check_md_memory(parameters, settings, geometry);
   CollisionRules rules;
@@ -302,6 +305,7 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
           "shaker md");
       also.push_back(&*checkpointing);
     }
+    if (r == 0) terminal_log::start(parameters.run, configuration);  // the inputs are accepted
     const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, settings, also);
     summary_of(simulation, outcome).pack(mine);
     if (r == 0) {

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """The 3D fields file as a visualisation tool reads it (docs/output-schema.md, "3D continuum
-fields"): a small 3D run of `shaker continuum` (a 2 x 2 x 10 box at cell 0.5, one cycle, the
-fields at all four stored phases), then its XDMF sidecar read by an XDMF reader and every
-field of every snapshot compared with the HDF5 file read by h5py, value for value.
+fields"): a small 3D run of `shaker continuum` (a 2 x 2 x 10 box at cell 0.5, two cycles,
+the fields at all four stored phases of both, continuum.field_cycles), then its XDMF sidecar
+read by an XDMF reader and every field of every snapshot compared with the HDF5 file read by
+h5py, value for value.
 
     check_fields_xdmf.py --shaker SHAKER --reader meshio      (ctest default set)
     pvbatch check_fields_xdmf.py --shaker SHAKER --reader paraview      (nightly)
@@ -30,10 +31,12 @@ import h5py
 import keep_on_failure
 import numpy as np
 
-FIELDS = ("n", "ux", "uy", "uz", "T")
-UNITS = {"n": "1/sigma^3", "ux": "sqrt(g sigma)", "uy": "sqrt(g sigma)", "uz": "sqrt(g sigma)",
-         "T": "g sigma", "points": "sigma", "hexahedra": "1"}
+FIELDS = ("n", "nu", "ux", "uy", "uz", "T", "velocity")
+UNITS = {"n": "1/sigma^3", "nu": "1", "ux": "sqrt(g sigma)", "uy": "sqrt(g sigma)",
+         "uz": "sqrt(g sigma)", "T": "g sigma", "velocity": "sqrt(g sigma)", "points": "sigma",
+         "hexahedra": "1"}
 PHASES = 4
+CYCLES = 2  # a transient cycle and the sampled one, both written (a movie of the run)
 # The phases listed out of order: the snapshots come in time order, each once.
 CASE = f"""[continuum]
 dimension = 3
@@ -41,10 +44,11 @@ cell_size = 0.5
 box_width = 2.0
 ceiling = 10.0
 field_phases = [0.75, 0.0, 0.5, 0.25]
+field_cycles = [1, 0]
 [layer]
 particles = 1000
 [run]
-transient_cycles = 0
+transient_cycles = 1
 sampled_cycles = 1
 phases_per_cycle = {PHASES}
 """
@@ -74,7 +78,8 @@ def h5_snapshots(path):
         snapshots = []
         for name in names:
             g = f[name]
-            s = {key: float(g.attrs[key]) for key in ("time", "phase", "plate_z", "plate_v")}
+            s = {key: float(g.attrs[key])
+                 for key in ("time", "phase", "plate_z", "plate_v", "cycle")}
             s["name"] = name
             s["points"] = g["points"][()]
             for field in FIELDS:
@@ -95,7 +100,8 @@ def check_file(fields_path, run_path, shaker):
         datasets = []
         f.visititems(lambda name, obj: datasets.append((name, obj))
                      if isinstance(obj, h5py.Dataset) else None)
-        expect(len(datasets) == 1 + PHASES * 6, f"{len(datasets)} datasets")
+        expect(len(datasets) == 1 + CYCLES * PHASES * (1 + len(FIELDS)),
+               f"{len(datasets)} datasets")
         for name, data in datasets:
             expect(data.attrs.get("units") == UNITS[name.split("/")[-1]],
                    f"{name} units {data.attrs.get('units')!r}")
@@ -108,9 +114,11 @@ def check_file(fields_path, run_path, shaker):
         profiles = run["profiles"]
         hexahedra, snapshots = h5_snapshots(fields_path)
         # f t at the snapshot's time: the stored phase k / K to round-off.
-        expect(np.allclose([s["phase"] for s in snapshots], np.arange(PHASES) / PHASES,
-                           rtol=0, atol=1e-12),
-               f"phases in time order, each once: {[s['phase'] for s in snapshots]}")
+        expect(np.allclose([s["phase"] for s in snapshots],
+                           np.tile(np.arange(PHASES) / PHASES, CYCLES), rtol=0, atol=1e-12),
+               f"phases in time order, each once a cycle: {[s['phase'] for s in snapshots]}")
+        expect([s["cycle"] for s in snapshots] == [c for c in range(CYCLES) for _ in range(PHASES)],
+               f"cycles {[s['cycle'] for s in snapshots]}")
         expect(all(a["time"] < b["time"] for a, b in zip(snapshots, snapshots[1:])),
                "snapshots in time order")
         # The corners of cell 0 and of the last cell, independently of the writer's loops.
@@ -121,6 +129,11 @@ def check_file(fields_path, run_path, shaker):
         k, j, i = np.meshgrid(np.arange(nz + 1), np.arange(ny + 1), np.arange(nx + 1),
                               indexing="ij")
         for s in snapshots:
+            # nu and the velocity vector are n and (ux, uy, uz) as other readers want them.
+            expect(np.array_equal(s["nu"], math.pi / 6 * s["n"]), f"{s['name']}: nu = pi/6 n")
+            expect(np.array_equal(s["velocity"].reshape(-1, 3),
+                                  np.stack([s["ux"], s["uy"], s["uz"]], axis=1)),
+                   f"{s['name']}: velocity = (ux, uy, uz)")
             t = s["time"]
             plate_z = amplitude * (1 - math.cos(2 * math.pi * frequency * t))
             expect(abs(s["plate_z"] - plate_z) <= 1e-12 * amplitude,
@@ -128,6 +141,8 @@ def check_file(fields_path, run_path, shaker):
             expected = np.stack([i.ravel() * h, j.ravel() * h, k.ravel() * h + s["plate_z"]],
                                 axis=1)
             expect(np.array_equal(s["points"], expected), f"{s['name']}: lab-frame corners")
+            if s["cycle"] != CYCLES - 1:
+                continue  # the profiles are of the sampled cycle
             row = profiles["phase"][()].tolist().index(s["phase"])
             expect(profiles["time"][row] == t and profiles["plate_v"][row] == s["plate_v"],
                    f"{s['name']}: the time and plate velocity of profile row {row}")

@@ -1,7 +1,13 @@
 // Whole-run checks: mass conservation (1D and 3D), a horizontally uniform 3D run equals the
 // 1D run, restart continues identically, and the base-case smoke test (H = 9, e = 0.9, 1D).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <fstream>
+#include <iterator>
 #include <utility>
 
 #include "analysis/analysis.hpp"
@@ -251,6 +257,74 @@ TEST(BaseCase, PeriodicStateAndShock) {
   EXPECT_GE(shocks, 3);
   const auto& mass = r.series.column("total_mass");
   EXPECT_LT(std::abs(mass.back() - mass.front()) / mass.front(), 1e-12);
+  // Settled, and above the floor: nothing doubtful.
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+}
+
+std::string text_of(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// A short coarse column: 2 cycles from the initial state, far from its periodic state.
+config::Config unsettled(const std::filesystem::path& dir) {
+  config::Config c = base_config(dir);
+  c.set("continuum.cell_size=0.5");
+  c.set("run.transient_cycles=0");
+  c.set("run.sampled_cycles=2");
+  c.set("run.phases_per_cycle=10");
+  return c;
+}
+
+TEST(RunLog, KeepsTheConfigurationTheSummaryAndTheWarnings) {
+  const auto dir = test_directory();
+  ASSERT_EQ(run(unsettled(dir)), 0);
+  const RunRecord r = read_run_file(dir / "run.h5");
+  const double periodicity = r.series.column("periodicity_last_two_cycles").back();
+  std::printf("periodicity after 2 cycles from the initial state: %.3g\n", periodicity);
+  ASSERT_GT(periodicity, 0.01);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_EQ(r.warnings[0].rfind("far from periodic", 0), 0u) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find(fmt::format("{:.3g}", periodicity)), std::string::npos) << r.warnings[0];
+  const std::string log = text_of(dir / "run.log");
+  EXPECT_NE(log.find(std::string("# shaker ") + program_version()), std::string::npos);
+  EXPECT_NE(log.find("cell_size = 0.5"), std::string::npos);  // the effective configuration
+  EXPECT_NE(log.find("shaker continuum: 2 cycles to t ="), std::string::npos);  // the summary
+  EXPECT_NE(log.find("warning: " + r.warnings[0]), std::string::npos);
+}
+
+TEST(RunLog, ALogIsNotKeptWhenAskedNotTo) {
+  const auto dir = test_directory();
+  config::Config c = unsettled(dir);
+  c.set("run.log=false");
+  ASSERT_EQ(run(c), 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "run.h5"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "run.log"));
+}
+
+TEST(RunWarnings, AFloorAboveTheLayersTemperatureIsAWarningWithItsShare) {
+  const auto dir = test_directory();
+  config::Config c = unsettled(dir);
+  c.set("continuum.temperature_floor=1.0");
+  ASSERT_EQ(run(c), 0);
+  const RunRecord r = read_run_file(dir / "run.h5");
+  const double uses = r.series.column("temperature_floor_uses").back();
+  const double cells = static_cast<double>(continuum_case(c).grid.interior_cells());
+  const double updates = cells * r.series.column("steps").back();
+  std::printf("at the last stored phase: floor uses %.0f of %.0f cell updates\n", uses, updates);
+  ASSERT_GT(uses / updates, 1e-3);
+  // The warning counts to the end of the run, a little past the last stored phase.
+  const auto warning = std::find_if(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.rfind("leans on the temperature floor: ", 0) == 0;
+  });
+  ASSERT_NE(warning, r.warnings.end()) << fmt::format("{}", fmt::join(r.warnings, " | "));
+  double warned_uses = 0, warned_updates = 0, warned_share = 0;
+  ASSERT_EQ(std::sscanf(warning->c_str(), "leans on the temperature floor: %lf of %lf cell updates (%lf)",
+                        &warned_uses, &warned_updates, &warned_share), 3) << *warning;
+  EXPECT_GE(warned_uses, uses);
+  EXPECT_GE(warned_updates, updates);
+  EXPECT_NEAR(warned_share, warned_uses / warned_updates, 1e-3 * warned_share);
+  EXPECT_NEAR(warned_share, uses / updates, 0.05 * warned_share);
 }
 
 }  // namespace
