@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "common/errors.hpp"
 
 namespace shaker {
@@ -32,6 +35,37 @@ CaseParameters CaseParameters::from(const config::Config& c) {
         "run.switch_phase = {} cycles, before the start of the run; allowed: run.transient_cycles "
         ">= 1 for a single shock", p.run.transient_cycles, p.run.switch_phase));
   return p;
+}
+
+std::vector<std::int64_t> stored_phase_indices(const config::Config& config, const std::string& key,
+                                               std::int64_t phases) {
+  const std::vector<double>& listed = config.real_list(key);
+  const std::string given = fmt::format("{} = {}", key, config.value_text(key));
+  const auto K = static_cast<double>(phases);
+  std::string grid;
+  for (std::int64_t k = 0; k < phases; ++k) {
+    if (phases > 12 && k == 3) {
+      grid += ", ...";
+      k = phases - 1;
+    }
+    grid += fmt::format("{}{}", k == 0 ? "" : ", ", static_cast<double>(k) / K);
+  }
+  const std::string allowed = fmt::format(
+      "allowed: the stored phases k / {} (run.phases_per_cycle = {}), each at most once: {}",
+      phases, phases, grid);
+  std::vector<std::int64_t> indices;
+  for (const double phase : listed) {
+    const double k = std::round(phase * K);
+    if (std::abs(phase * K - k) > 1e-9 || k >= K)
+      throw InputError(fmt::format("{}: {} is not a stored phase; {}", given, phase, allowed));
+    const auto index = static_cast<std::int64_t>(k);
+    if (std::find(indices.begin(), indices.end(), index) != indices.end())
+      throw InputError(fmt::format("{}: the stored phase {} is listed twice; {}", given,
+                                   static_cast<double>(index) / K, allowed));
+    indices.push_back(index);
+  }
+  std::sort(indices.begin(), indices.end());
+  return indices;
 }
 
 }  // namespace shaker
