@@ -364,7 +364,13 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
           "shaker md");
       also.push_back(&*checkpointing);
     }
-    const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, settings, also);
+    // Replica 0 alone takes particle snapshots (the files hold one run's frames).
+    MdSettings replica_settings = settings;
+    if (r != 0) {
+      replica_settings.snapshot_phases.clear();
+      replica_settings.snapshot_cycles.clear();
+    }
+    const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, replica_settings, also);
     summary_of(simulation, outcome).pack(mine);
     if (r == 0) {
       record.profiles = outcome.profiles;

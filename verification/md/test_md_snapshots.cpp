@@ -2,7 +2,8 @@
 // files"): every particle of a frame at the frame's time (a free flight from the checkpoint
 // written at that phase, and the run file's centre of mass and kinetic energy there), the
 // frames in time order, a run with snapshots the same trajectory as one without, no particle
-// file by default, and a run started from a frame (md.initial_state = "file").
+// file by default, an ensemble's frames those of replica 0, and a run started from a frame
+// (md.initial_state = "file").
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -174,6 +175,21 @@ TEST(MdSnapshots, SnapshotsLeaveTheRunUnchangedAndTheDefaultWritesNoParticleFile
     EXPECT_EQ(plain.profiles[k].n, with.profiles[k].n);
     EXPECT_EQ(plain.profiles[k].T, with.profiles[k].T);
   }
+}
+
+TEST(MdSnapshots, AnEnsembleWritesTheFramesOfReplicaZero) {
+  const auto dir = testing::test_directory();
+  ASSERT_EQ(run(small_case(dir / "single.h5", two_by_two)), 0);
+  ASSERT_EQ(run(small_case(dir / "ensemble.h5", [] {
+              auto settings = two_by_two;
+              settings.push_back("md.replicas=2");
+              return settings;
+            }())),
+            0);
+  const Frames single = read_frames(dir / "single.particles.h5"), ensemble = read_frames(dir / "ensemble.particles.h5");
+  EXPECT_EQ(ensemble.time, single.time);
+  EXPECT_EQ(ensemble.r, single.r);
+  EXPECT_EQ(ensemble.v, single.v);
 }
 
 TEST(MdSnapshots, ARunStartsFromAFrameAtItsTime) {
