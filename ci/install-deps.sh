@@ -16,7 +16,7 @@ packages=(
   libtoml11-dev libcli11-dev libfmt-dev
   libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-matplotlib python3-h5py python3-meshio
-  python3-pytest python3-flake8
+  python3-pytest python3-flake8 python3-ase python3-gsd
 )
 case ${1:-} in
   "") ;;

@@ -2,6 +2,7 @@
 // The typed, validated view of the keys both solvers share.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "common/config.hpp"
 #include "common/restitution.hpp"
@@ -20,6 +21,8 @@ struct RunProtocol {
   std::uint64_t seed = 1;
   std::string output = "run.h5";
   bool log = true;  ///< keep OUTPUT.log (common/terminal_log.hpp)
+  /// Cycles of the run: the transient ones, then the sampled ones or the single shock's one.
+  std::int64_t cycles() const { return transient_cycles + (kind == Kind::single_shock ? 1 : sampled_cycles); }
 };
 
 struct CaseParameters {
@@ -33,5 +36,16 @@ struct CaseParameters {
   double mass_per_area() const { return static_cast<double>(particles) / (md_box_width * md_box_width); }
   static CaseParameters from(const config::Config& config);
 };
+
+/// The list `key` of phases f t as stored phases k of `phases` (run.phases_per_cycle), in
+/// increasing order. A phase between stored phases, or one listed twice, is refused
+/// (InputError naming the key and the allowed values).
+std::vector<std::int64_t> stored_phase_indices(const config::Config& config, const std::string& key,
+                                               std::int64_t phases);
+
+/// The list `key` of cycles of `run` (from 0; negative from the end, -1 the last) as cycles
+/// from 0, in increasing order. A cycle the run does not have, a fraction, or one listed twice
+/// is refused (InputError naming the key and the allowed values).
+std::vector<std::int64_t> cycle_indices(const config::Config& config, const std::string& key, const RunProtocol& run);
 
 }  // namespace shaker

@@ -2,13 +2,16 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 
 #include "common/errors.hpp"
@@ -44,13 +47,30 @@ Handle string_type() {
   return type;
 }
 
+/// The creation properties of a dataset of `dims` whose first dimension is unlimited: chunks
+/// of one row (one frame of an H5MD element; a whole 1D dataset).
+Handle extendable_layout(const std::vector<hsize_t>& dims) {
+  Handle properties(checked(H5Pcreate(H5P_DATASET_CREATE), "dataset creation properties"));
+  std::vector<hsize_t> chunk = dims;
+  if (chunk.size() == 1) chunk[0] = std::max<hsize_t>(chunk[0], 1);
+  else chunk[0] = 1;
+  for (hsize_t& c : chunk) c = std::max<hsize_t>(c, 1);
+  checked_status(H5Pset_chunk(properties.id(), static_cast<int>(chunk.size()), chunk.data()),
+                 "chunked layout");
+  return properties;
+}
+
 template <class T>
 Handle write_array(hid_t parent, const std::string& name, const T* data,
-                   const std::vector<hsize_t>& dims, hid_t memory_type, hid_t file_type) {
-  Handle space(checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
+                   const std::vector<hsize_t>& dims, hid_t memory_type, hid_t file_type,
+                   bool extendable = false) {
+  std::vector<hsize_t> limits = dims;
+  if (extendable && !limits.empty()) limits[0] = H5S_UNLIMITED;
+  Handle space(checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), limits.data()),
                        "dataspace for " + name));
+  const Handle layout = extendable ? extendable_layout(dims) : Handle();
   Handle set(checked(H5Dcreate2(parent, name.c_str(), file_type, space.id(), H5P_DEFAULT,
-                                H5P_DEFAULT, H5P_DEFAULT),
+                                extendable ? layout.id() : H5P_DEFAULT, H5P_DEFAULT),
                      "create dataset " + name));
   checked_status(H5Dwrite(set.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
                  "write dataset " + name);
@@ -60,14 +80,14 @@ Handle write_array(hid_t parent, const std::string& name, const T* data,
 template <class T>
 void write_with_units(hid_t parent, const std::string& name, const std::vector<T>& data,
                       const std::vector<std::size_t>& dims, const std::string& units,
-                      hid_t memory_type, hid_t file_type) {
+                      hid_t memory_type, hid_t file_type, bool extendable = false) {
   std::size_t count = 1;
   for (const std::size_t d : dims) count *= d;
   if (count != data.size())
     throw std::logic_error(fmt::format("dataset {}: {} values for a shape of {} values", name,
                                        data.size(), count));
-  const Handle set = write_array(parent, name, data.data(),
-                                 std::vector<hsize_t>(dims.begin(), dims.end()), memory_type, file_type);
+  const Handle set = write_array(parent, name, data.data(), std::vector<hsize_t>(dims.begin(), dims.end()),
+                                 memory_type, file_type, extendable);
   write_attribute(set.id(), "units", units);
 }
 
@@ -88,9 +108,12 @@ Handle open_attribute(hid_t object, const std::string& name) {
   return Handle(checked(H5Aopen(object, name.c_str(), H5P_DEFAULT), "open attribute " + name));
 }
 
+/// A scalar attribute, or (`count` given) a one-dimensional array attribute of `count` values.
 template <class T>
-void write_scalar_attribute(hid_t object, const std::string& name, const T* value, hid_t type) {
-  Handle space(checked(H5Screate(H5S_SCALAR), "scalar dataspace"));
+void write_scalar_attribute(hid_t object, const std::string& name, const T* value, hid_t type,
+                            std::optional<hsize_t> count = std::nullopt) {
+  Handle space(checked(count ? H5Screate_simple(1, &*count, nullptr) : H5Screate(H5S_SCALAR),
+                       "attribute dataspace"));
   if (has_attribute(object, name)) H5Adelete(object, name.c_str());
   Handle attribute(checked(
       H5Acreate2(object, name.c_str(), type, space.id(), H5P_DEFAULT, H5P_DEFAULT),
@@ -202,11 +225,41 @@ void write(hid_t parent, const std::string& name, const std::vector<std::int64_t
            const std::vector<std::size_t>& dims, const std::string& units) {
   write_with_units(parent, name, data, dims, units, H5T_NATIVE_INT64, H5T_STD_I64LE);
 }
+void write_extendable(hid_t parent, const std::string& name, const std::vector<double>& data,
+                      const std::vector<std::size_t>& dims, const std::string& units) {
+  write_with_units(parent, name, data, dims, units, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, true);
+}
+void write_extendable(hid_t parent, const std::string& name, const std::vector<std::int64_t>& data,
+                      const std::vector<std::size_t>& dims, const std::string& units) {
+  write_with_units(parent, name, data, dims, units, H5T_NATIVE_INT64, H5T_STD_I64LE, true);
+}
 std::vector<double> read_doubles(hid_t parent, const std::string& name) {
   return read_array<double>(parent, name, H5T_NATIVE_DOUBLE);
 }
 std::vector<std::int64_t> read_integers(hid_t parent, const std::string& name) {
   return read_array<std::int64_t>(parent, name, H5T_NATIVE_INT64);
+}
+
+std::vector<double> read_row(hid_t parent, const std::string& name, std::size_t row) {
+  std::vector<std::size_t> dims = shape(parent, name);
+  if (dims.empty() || row >= dims[0])
+    throw InputError(fmt::format("dataset '{}' has no row {} (shape [{}])", name, row, fmt::join(dims, ", ")));
+  Handle set(checked(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), "open dataset " + name));
+  Handle space(checked(H5Dget_space(set.id()), "dataspace of " + name));
+  std::vector<hsize_t> start(dims.size(), 0), count(dims.begin(), dims.end());
+  start[0] = row;
+  count[0] = 1;
+  checked_status(H5Sselect_hyperslab(space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+                 "select row of " + name);
+  std::size_t values = 1;
+  for (std::size_t k = 1; k < dims.size(); ++k) values *= dims[k];
+  std::vector<double> data(values);
+  const hsize_t memory_size = values;
+  Handle memory(checked(H5Screate_simple(1, &memory_size, nullptr), "memory dataspace"));
+  if (values > 0)
+    checked_status(H5Dread(set.id(), H5T_NATIVE_DOUBLE, memory.id(), space.id(), H5P_DEFAULT, data.data()),
+                   "read row of " + name);
+  return data;
 }
 
 std::vector<std::size_t> shape(hid_t parent, const std::string& name) {
@@ -229,6 +282,16 @@ void write_attribute(hid_t object, const std::string& name, double value) {
 }
 void write_attribute(hid_t object, const std::string& name, std::int64_t value) {
   write_scalar_attribute(object, name, &value, H5T_NATIVE_INT64);
+}
+
+void write_attribute(hid_t object, const std::string& name, const std::vector<std::int64_t>& values) {
+  write_scalar_attribute(object, name, values.data(), H5T_NATIVE_INT64, values.size());
+}
+void write_attribute(hid_t object, const std::string& name, const std::vector<std::string>& values) {
+  const Handle type = string_type();
+  std::vector<const char*> texts;
+  for (const std::string& value : values) texts.push_back(value.c_str());
+  write_scalar_attribute(object, name, texts.data(), type.id(), texts.size());
 }
 
 std::string read_string_attribute(hid_t object, const std::string& name) {

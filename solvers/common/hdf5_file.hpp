@@ -51,14 +51,25 @@ void write(hid_t parent, const std::string& name, const std::vector<double>& dat
            const std::vector<std::size_t>& dims, const std::string& units);
 void write(hid_t parent, const std::string& name, const std::vector<std::int64_t>& data,
            const std::vector<std::size_t>& dims, const std::string& units);
+/// The same, chunked with an unlimited first dimension, as H5MD's time-dependent datasets are
+/// (a reader may append rows).
+void write_extendable(hid_t parent, const std::string& name, const std::vector<double>& data,
+                      const std::vector<std::size_t>& dims, const std::string& units);
+void write_extendable(hid_t parent, const std::string& name, const std::vector<std::int64_t>& data,
+                      const std::vector<std::size_t>& dims, const std::string& units);
 std::vector<double> read_doubles(hid_t parent, const std::string& name);
 std::vector<std::int64_t> read_integers(hid_t parent, const std::string& name);
+/// Row `row` of a dataset (the values at that index of its first dimension), as doubles.
+std::vector<double> read_row(hid_t parent, const std::string& name, std::size_t row);
 /// Dimensions of a dataset.
 std::vector<std::size_t> shape(hid_t parent, const std::string& name);
 
 void write_attribute(hid_t object, const std::string& name, const std::string& value);
 void write_attribute(hid_t object, const std::string& name, double value);
 void write_attribute(hid_t object, const std::string& name, std::int64_t value);
+/// One-dimensional array attributes.
+void write_attribute(hid_t object, const std::string& name, const std::vector<std::int64_t>& values);
+void write_attribute(hid_t object, const std::string& name, const std::vector<std::string>& values);
 std::string read_string_attribute(hid_t object, const std::string& name);
 double read_double_attribute(hid_t object, const std::string& name);
 std::int64_t read_integer_attribute(hid_t object, const std::string& name);

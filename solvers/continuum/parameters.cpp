@@ -67,12 +67,12 @@ std::vector<ParameterSpec> continuum_parameters() {
       text("continuum.ceiling_energy", "adiabatic", {"adiabatic", "inelastic"},
            "the same for the ceiling").in("-"),
       real_list("continuum.field_phases", {}, Range{0.0, 1.0, false, true},
-                "3D only: phases f t of the last sampled cycle whose full fields are written "
+                "3D only: phases f t of the last cycle (or of continuum.field_cycles) whose full fields are written "
                 "(RUN.fields.h5 + RUN.fields.xdmf), each a stored phase k / run.phases_per_cycle, "
                 "at most once").in("1 (f t)"),
-      real_list("continuum.field_cycles", {}, closed(0.0, 2e6),
-                "3D only: the cycles (of the run's schedule, from 0, transient included) in which "
-                "continuum.field_phases are written, each at most once, so that ParaView can "
+      real_list("continuum.field_cycles", {}, Range{-1e9, 1e9, false, false},
+                "3D only: the cycles of the run (from 0, transient included; negative from the end, "
+                "-1 the last) in which continuum.field_phases are written, each at most once, so that ParaView can "
                 "animate the run; empty: the last cycle").in("cycles"),
   };
 }

@@ -14,72 +14,25 @@ namespace shaker::continuum {
 
 namespace {
 
-/// continuum.field_phases as stored phases k of K. A phase between stored phases, or one listed
-/// twice, once gave a snapshot at the nearest stored phase, twice over; in 1D the key was
-/// ignored. Each is refused instead, naming the allowed values.
+/// continuum.field_phases as stored phases k of K; only a 3D run writes full fields.
 std::vector<std::int64_t> field_phase_indices(const config::Config& config, int dimension,
                                               std::int64_t phases) {
   constexpr const char* key = "continuum.field_phases";
-  const std::vector<double>& listed = config.real_list(key);
-  const std::string given = fmt::format("{} = {}", key, config.value_text(key));
-  if (listed.empty()) return {};
+  if (config.real_list(key).empty()) return {};
   if (dimension != 3)
-    throw InputError(fmt::format("{}: full fields are written only by a 3D run, and "
+    throw InputError(fmt::format("{} = {}: full fields are written only by a 3D run, and "
                                  "continuum.dimension = {}; allowed with it: [] (the default)",
-                                 given, dimension));
-  const auto K = static_cast<double>(phases);
-  std::string grid;
-  for (std::int64_t k = 0; k < phases; ++k) {
-    if (phases > 12 && k == 3) {
-      grid += ", ...";
-      k = phases - 1;
-    }
-    grid += fmt::format("{}{}", k == 0 ? "" : ", ", static_cast<double>(k) / K);
-  }
-  const std::string allowed = fmt::format(
-      "allowed: the stored phases k / {} (run.phases_per_cycle = {}), each at most once: {}",
-      phases, phases, grid);
-  std::vector<std::int64_t> indices;
-  for (const double phase : listed) {
-    const double k = std::round(phase * K);
-    if (std::abs(phase * K - k) > 1e-9 || k >= K)
-      throw InputError(fmt::format("{}: {} is not a stored phase; {}", given, phase, allowed));
-    const auto index = static_cast<std::int64_t>(k);
-    if (std::find(indices.begin(), indices.end(), index) != indices.end())
-      throw InputError(fmt::format("{}: the stored phase {} is listed twice; {}", given,
-                                   static_cast<double>(index) / K, allowed));
-    indices.push_back(index);
-  }
-  std::sort(indices.begin(), indices.end());
-  return indices;
+                                 key, config.value_text(key), dimension));
+  return stored_phase_indices(config, key, phases);
 }
 
-/// continuum.field_cycles: whole cycles of the run, each at most once, with field phases to
-/// write in them.
+/// continuum.field_cycles, each a cycle of the run with field phases to write in it.
 std::vector<std::int64_t> field_cycle_indices(const config::Config& config, const ContinuumCase& c) {
   constexpr const char* key = "continuum.field_cycles";
-  const std::vector<double>& listed = config.real_list(key);
-  if (listed.empty()) return {};
-  const std::string given = fmt::format("{} = {}", key, config.value_text(key));
-  if (c.field_phases.empty())
-    throw InputError(fmt::format("{} without continuum.field_phases writes nothing; allowed: [] (the "
-                                 "default), or continuum.field_phases set", given));
-  const RunProtocol& run = c.parameters.run;
-  const std::int64_t cycles = run.transient_cycles + (run.kind == RunProtocol::Kind::single_shock ? 1 : run.sampled_cycles);
-  const std::string allowed = fmt::format(
-      "allowed: whole cycles 0 to {} of the run (run.transient_cycles + {}), each at most once", cycles - 1,
-      run.kind == RunProtocol::Kind::single_shock ? "1 for a single shock" : "run.sampled_cycles");
-  std::vector<std::int64_t> indices;
-  for (const double cycle : listed) {
-    if (cycle != std::floor(cycle) || cycle < 0.0 || cycle >= static_cast<double>(cycles))
-      throw InputError(fmt::format("{}: {} is not a cycle of the run; {}", given, cycle, allowed));
-    const auto index = static_cast<std::int64_t>(cycle);
-    if (std::find(indices.begin(), indices.end(), index) != indices.end())
-      throw InputError(fmt::format("{}: cycle {} is listed twice; {}", given, index, allowed));
-    indices.push_back(index);
-  }
-  std::sort(indices.begin(), indices.end());
-  return indices;
+  if (!config.real_list(key).empty() && c.field_phases.empty())
+    throw InputError(fmt::format("{} = {} without continuum.field_phases writes nothing; allowed: [] (the "
+                                 "default), or continuum.field_phases set", key, config.value_text(key)));
+  return cycle_indices(config, key, c.parameters.run);
 }
 
 /// A 3D layer's cells are drawn up to (1 + p) times the layer's density and then all scaled

@@ -288,7 +288,7 @@ void validate_state(const Geometry& g, const SimulationData& d, double tolerance
     const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
     if (!finite || !inside_xy || z < z_lo || z > z_hi || !std::isfinite(dot(v[i], v[i])))
       throw InputError(fmt::format(
-          "checkpoint particle {} at ({}, {}, {}) is outside the box: allowed 0 <= x, y <= {} "
+          "particle {} at ({}, {}, {}) is outside the box: allowed 0 <= x, y <= {} "
           "and {} <= z <= {} at t = {}", i, x, y, z, g.width, z_lo + tolerance, z_hi - tolerance,
           d.time));
   }
@@ -304,7 +304,7 @@ void validate_state(const Geometry& g, const SimulationData& d, double tolerance
       const Vec3 dr = r[i] - r[static_cast<std::size_t>(j)] - shift;
       if (dot(dr, dr) < limit)
         throw InputError(fmt::format(
-            "checkpoint particles {} and {} overlap: centre distance {:.12g}, allowed at least "
+            "particles {} and {} overlap: centre distance {:.12g}, allowed at least "
             "1 - {:g} (one diameter)", i, j, std::sqrt(dot(dr, dr)), tolerance));
     });
   }

@@ -49,7 +49,7 @@ void take_up_samples(PhaseSampler& sampler, const SampledCycles& sampled, const 
 
 /// Throws InputError naming the particle(s) if a particle lies outside the box (below the
 /// plate, above the ceiling, outside [0, width) horizontally) or two particles overlap by more
-/// than `tolerance` at time data.time.
+/// than `tolerance` at time data.time (of a checkpoint, or of a run's initial particles).
 void validate_state(const Geometry& geometry, const SimulationData& data, double tolerance = 1e-9);
 
 }  // namespace shaker::md

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "common/errors.hpp"
 #include "md/sampling.hpp"
@@ -25,6 +26,19 @@ MdSettings MdSettings::from(const config::Config& c) {
   s.tc_guard = c.text("md.collapse_guard") == "tc";
   s.tc = c.real("md.tc");
   s.queue = c.text("md.event_queue") == "calendar" ? QueueKind::calendar : QueueKind::heap;
+  s.initial_file = c.text("md.initial_file");
+  s.initial_frame = c.integer("md.initial_frame");
+  if (s.initial_state == "file" && s.initial_file.empty())
+    throw InputError("md.initial_state = \"file\" but md.initial_file = \"\"; allowed: the path of an H5MD "
+                     "particle file (RUN.particles.h5 of an earlier run)");
+  const RunProtocol run = CaseParameters::from(c).run;
+  s.snapshot_phases = stored_phase_indices(c, "md.snapshot_phases", run.phases_per_cycle);
+  s.snapshot_cycles = cycle_indices(c, "md.snapshot_cycles", run);
+  if (s.snapshot_phases.empty() != s.snapshot_cycles.empty())
+    throw InputError(fmt::format("md.snapshot_phases = [{}] and md.snapshot_cycles = [{}]: a snapshot needs a "
+                                 "phase and a cycle; allowed: both lists empty (no snapshots) or both set",
+                                 fmt::join(c.real_list("md.snapshot_phases"), ", "),
+                                 fmt::join(c.real_list("md.snapshot_cycles"), ", ")));
   s.crossing_heights = c.real_list("md.crossing_heights");
   for (std::size_t k = 0; k < s.crossing_heights.size(); ++k)
     for (std::size_t m = 0; m < k; ++m)
@@ -125,6 +139,29 @@ class SeriesObserver final : public RunObserver {
   SeriesRows rows_;
 };
 
+/// Every particle at the stored phases and cycles of MdSettings::snapshot_*, read from the
+/// snapshot the other observers share: all at the phase's time.
+class ParticleSnapshots final : public RunObserver {
+ public:
+  ParticleSnapshots(const ShakerKinematics& shaker, const MdSettings& settings, PhaseSnapshot& snapshot)
+      : shaker_(shaker), settings_(settings), snapshot_(snapshot) {}
+  void at_phase(const PhaseInstant& at) override {
+    if (!std::binary_search(settings_.snapshot_cycles.begin(), settings_.snapshot_cycles.end(), at.cycle) ||
+        !std::binary_search(settings_.snapshot_phases.begin(), settings_.snapshot_phases.end(), at.phase))
+      return;
+    snapshot_.take(at.t);
+    frames.push_back(ParticleFrame{at.cycle * at.phases + at.phase, at.cycle, at.t,
+                                   static_cast<double>(at.phase) / static_cast<double>(at.phases),
+                                   shaker_.position(at.t), shaker_.velocity(at.t), snapshot_.r(), snapshot_.v()});
+  }
+  std::vector<ParticleFrame> frames;
+
+ private:
+  const ShakerKinematics& shaker_;
+  const MdSettings& settings_;
+  PhaseSnapshot& snapshot_;
+};
+
 }  // namespace
 
 RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters, const MdSettings& settings,
@@ -151,7 +188,9 @@ RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, PhaseSam
   PhaseSnapshot snapshot(sim);
   SeriesObserver series(sim, parameters.shaker, settings, origin, snapshot);
   SamplingObserver sampling(sampler, snapshot);
+  ParticleSnapshots particles(parameters.shaker, settings, snapshot);
   std::vector<RunObserver*> observers{&series, &sampling};
+  if (!settings.snapshot_phases.empty()) observers.push_back(&particles);
   observers.insert(observers.end(), also.begin(), also.end());
 
   const auto start = std::chrono::steady_clock::now();
@@ -164,6 +203,7 @@ RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, PhaseSam
   out.profiles = sampler.profiles(parameters.shaker);
   out.samples = sampler.samples();
   out.series = series.finish();
+  out.frames = std::move(particles.frames);
   out.budget = origin.at(sim.tally(), sim.kinetic_energy(end) + sim.potential_energy(end));
   out.overlaps = sim.count_overlaps(end, 1e-9);
   out.queue_consistent = sim.queue_consistent();

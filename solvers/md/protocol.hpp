@@ -10,6 +10,7 @@
 #include "common/config.hpp"
 #include "common/profile.hpp"
 #include "common/run_loop.hpp"
+#include "md/particle_file.hpp"
 #include "md/sampling.hpp"
 #include "md/simulation.hpp"
 
@@ -25,6 +26,13 @@ struct MdSettings {
   double tc = 1e-5;
   QueueKind queue = QueueKind::calendar;
   std::vector<double> crossing_heights{80.0};
+  std::string initial_file;         ///< md.initial_state = "file": the H5MD particle file
+  std::int64_t initial_frame = -1;  ///< and its frame (negative: from the end)
+  /// md.snapshot_phases as stored phases k and md.snapshot_cycles as cycles from 0, both
+  /// increasing; both empty (the default): no particle snapshots.
+  std::vector<std::int64_t> snapshot_phases, snapshot_cycles;
+  /// InputError for a snapshot phase that is not a stored phase, a cycle the run does not have,
+  /// or only one of the two lists given.
   static MdSettings from(const config::Config& config);
 };
 
@@ -61,6 +69,9 @@ struct RunOutcome {
   EnergyBudget budget;
   std::size_t overlaps = 0;  ///< at the end of the run
   bool queue_consistent = false;
+  /// Every particle at the stored phases MdSettings::snapshot_phases of its snapshot_cycles,
+  /// in time order (empty without snapshots).
+  std::vector<ParticleFrame> frames;
   double seconds = 0.0;      ///< wall-clock time of the event loop
   std::uint64_t collisions = 0, events = 0;
 };

@@ -21,6 +21,7 @@
 #include "common/terminal_log.hpp"
 #include "md/checkpoint.hpp"
 #include "md/initial_states.hpp"
+#include "md/particle_file.hpp"
 #include "md/protocol.hpp"
 
 namespace shaker::md {
@@ -56,6 +57,41 @@ struct Resumed {
   RunProtocol written_by;  ///< the protocol of the run that wrote the checkpoint
 };
 
+/// How messages name the particle file a run starts from.
+std::string initial_file_source(const MdSettings& s) { return fmt::format("md.initial_file = \"{}\"", s.initial_file); }
+
+/// Frame md.initial_frame of md.initial_file: its particles, at its time. InputError unless the
+/// file holds layer.particles particles in a box of md.box_width, all inside this run's box
+/// (above its plate at that time) and none overlapping.
+State state_from_file(const CaseParameters& c, const MdSettings& s, const Geometry& g) {
+  const std::string source = initial_file_source(s);
+  StoredFrame stored = read_particle_frame(s.initial_file, s.initial_frame, source);
+  const ParticleFrame& frame = stored.frame;
+  const std::string which = fmt::format("{} (frame {} of {}, t = {})", source, stored.index, stored.frames, frame.time);
+  if (frame.r.size() != static_cast<std::size_t>(c.particles))
+    throw InputError(fmt::format("layer.particles = {} but {} holds {} particles; allowed: layer.particles = {}",
+                                 c.particles, which, frame.r.size(), frame.r.size()));
+  const auto same_width = [&](double edge) { return std::fabs(edge - g.width) <= 1e-12 * g.width; };
+  if (!same_width(stored.edges[0]) || !same_width(stored.edges[1]))
+    throw InputError(fmt::format("md.box_width = {} but {} was written in a box of {} x {} "
+                                 "(particles/all/box/edges); allowed: md.box_width = {}, the periodic box "
+                                 "of the file's particles", g.width, which, stored.edges[0], stored.edges[1],
+                                 stored.edges[0]));
+  State state;
+  state.time = frame.time;
+  state.particles.resize(frame.r.size());
+  for (std::size_t i = 0; i < frame.r.size(); ++i) state.particles[i] = Particle{frame.r[i], frame.v[i], frame.time};
+  SimulationData data;
+  data.time = state.time;
+  data.particles = state.particles;
+  try {
+    validate_state(g, data);
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("{} cannot start this run: {}", which, error.what()));
+  }
+  return state;
+}
+
 /// The simulation at the case's initial state, or at the checkpoint `restart_from` (whose
 /// schedule position and sampled sums go to `resumed`).
 Simulation make_simulation(const config::Config& config, const CaseParameters& c, const MdSettings& s,
@@ -63,6 +99,7 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
                            const std::filesystem::path& restart_from, std::optional<Resumed>& resumed) {
   const auto n = static_cast<std::size_t>(c.particles);
   if (restart_from.empty()) {
+    if (s.initial_state == "file") return Simulation(g, rules, state_from_file(c, s, g), s.queue);
     if (s.initial_state == "gas")
       return Simulation(g, rules, homogeneous_gas(g, n, s.gas_volume_fraction, s.gas_temperature, c.run.seed),
                         s.queue);
@@ -115,11 +152,31 @@ void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometr
   const double cells = std::floor(g.width) * std::floor(g.width) * std::max(rows, 3.0);
   const double bins = std::ceil(s.ceiling / s.bin_height);
   const double phases = static_cast<double>(c.run.phases_per_cycle);
-  check_memory(n * per_particle + 4.0 * cells + bins * phases * (13.0 + 18.0) * 8.0,
-               fmt::format("the MD run ({} particles, {:.3g} cells, {:.3g} sampling bins x {} phases)",
-                           c.particles, cells, bins, c.run.phases_per_cycle),
-               "allowed: fewer layer.particles, a larger md.bin_height, a lower md.ceiling or fewer "
-               "run.phases_per_cycle");
+  // Each particle snapshot: r and v kept until the end, and its lines of the XYZ text.
+  const double frames = static_cast<double>(s.snapshot_phases.size() * s.snapshot_cycles.size());
+  check_memory(n * per_particle + 4.0 * cells + bins * phases * (13.0 + 18.0) * 8.0 + frames * n * (48.0 + 160.0),
+               fmt::format("the MD run ({} particles, {:.3g} cells, {:.3g} sampling bins x {} phases, {} "
+                           "particle snapshots)", c.particles, cells, bins, c.run.phases_per_cycle, frames),
+               "allowed: fewer layer.particles, a larger md.bin_height, a lower md.ceiling, fewer "
+               "run.phases_per_cycle or fewer particle snapshots (md.snapshot_phases x md.snapshot_cycles)");
+}
+
+/// Every file the run may write, none equal to an input (md.initial_file among them) or to
+/// another (checked before work).
+void check_paths(const CaseParameters& c, const MdSettings& s, const CheckpointSettings& checkpoints,
+                 std::vector<NamedPath> inputs) {
+  const std::filesystem::path output = c.run.output;
+  std::vector<NamedPath> outputs{{"run.output", output}};
+  terminal_log::add_output(outputs, c.run);
+  if (!s.snapshot_phases.empty() && !output.empty()) {
+    outputs.push_back({"run.output's particle file", particle_h5_path(output)});
+    outputs.push_back({"run.output's particle XYZ file", particle_xyz_path(output)});
+  }
+  if (s.initial_state == "file" && checkpoints.restart_from.empty()) {
+    inputs.push_back({"md.initial_file", s.initial_file});
+    check_input_file(inputs.back());
+  }
+  checkpoints.check_paths(outputs, inputs);
 }
 
 /// Replica r of the case (md.replicas): the periodic protocol takes seed run.seed + r, the
@@ -143,6 +200,11 @@ void check_replicas(const config::Config& config, const CheckpointSettings& chec
                                  "run.checkpoint = \"{}\"): a checkpoint holds one replica; "
                                  "allowed: md.replicas = 1 with run.restart_from or run.checkpoint",
                                  replicas, checkpoints.restart_from.string(), checkpoints.file.string()));
+  if (config.text("md.initial_state") == "file" && config.text("run.protocol") == "periodic")
+    throw InputError(fmt::format("md.replicas = {} with md.initial_state = \"file\" and run.protocol = "
+                                 "\"periodic\": every replica would start from the same particles and run "
+                                 "the same trajectory; allowed: md.replicas = 1 with md.initial_state = \"file\" "
+                                 "(or the single shock, whose replicas differ in their transient)", replicas));
   const auto& spec = config::find_spec(replica_key(config));
   const double last = static_cast<double>(config.integer(spec.key) + replicas - 1);
   if (!spec.range.contains(last))
@@ -259,9 +321,7 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   const MdSettings settings = MdSettings::from(config);
   const Geometry geometry = geometry_of(parameters, settings);
   const CheckpointSettings checkpoints = CheckpointSettings::from(config);
-  std::vector<NamedPath> outputs{{"run.output", parameters.run.output}};
-  terminal_log::add_output(outputs, parameters.run);
-  checkpoints.check_paths(outputs, inputs);
+  check_paths(parameters, settings, checkpoints, inputs);
   check_replicas(config, checkpoints);
   check_md_memory(parameters, settings, geometry);
   CollisionRules rules;
@@ -277,6 +337,7 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   progress_of_rank.quiet = progress_settings.quiet || !ranks.root();
   std::vector<double> mine;
   RunRecord record;
+  std::vector<ParticleFrame> frames;  // replica 0's
   const std::string configuration = config.to_toml();
   for (std::int64_t r = ranks.rank(); r < replicas; r += ranks.size()) {
     const config::Config replica = replica_configuration(config, r);
@@ -306,11 +367,18 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
       also.push_back(&*checkpointing);
     }
     if (r == 0) terminal_log::start(parameters.run, configuration);  // the inputs are accepted
-    const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, settings, also);
+    // Replica 0 alone takes particle snapshots (the files hold one run's frames).
+    MdSettings replica_settings = settings;
+    if (r != 0) {
+      replica_settings.snapshot_phases.clear();
+      replica_settings.snapshot_cycles.clear();
+    }
+    const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, replica_settings, also);
     summary_of(simulation, outcome).pack(mine);
     if (r == 0) {
       record.profiles = outcome.profiles;
       record.series = outcome.series;
+      frames = outcome.frames;
     }
   }
   const std::vector<std::vector<double>> gathered = ranks.gather(mine);
@@ -340,6 +408,8 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   if (replicas > 1) record.model_variant += fmt::format(" (pooled over {} replicas)", replicas);
   record.configuration = configuration;
   record.e = final_restitution.e;
+  if (!frames.empty())
+    write_particle_files(parameters.run.output, frames, ParticleBox{geometry.width, geometry.height}, record);
   write_run_file(parameters.run.output, record);
 
   fmt::print("shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", parameters.particles,
@@ -358,6 +428,9 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   fmt::print("  collapse guard activations: {}; overlaps at end: {}; event queue consistent: {}\n",
              count(all.guard_activations), count(all.overlaps), all.queue_consistent ? "yes" : "NO");
   fmt::print("  output: {}\n", parameters.run.output);
+  if (!frames.empty())
+    fmt::print("  particle snapshots: {} frames in {} and {}\n", frames.size(),
+               particle_h5_path(parameters.run.output).string(), particle_xyz_path(parameters.run.output).string());
   const bool ok = all.overlaps == 0 && all.queue_consistent && all.budget.relative_closure <= 1e-9;
   if (!ok) fmt::print(stderr, "shaker md: end-of-run invariant check FAILED (see summary)\n");
   return ok ? 0 : 1;

@@ -192,10 +192,16 @@ class Fixtures : public ::testing::Environment {
     const Outcome continuum =
         run_shaker(dir, {"continuum", "case.toml", "--set", "run.output=continuum.h5", "--set",
                          "run.checkpoint=continuum.ckpt.h5"});
+    // One frame of particles (the last cycle's phase 0) for the runs that start from a file.
+    const Outcome snapshot = run_shaker(dir, {"md", "case.toml", "--set", "run.output=snap.h5", "--set",
+                                              "md.snapshot_phases=[0]", "--set", "md.snapshot_cycles=[-1]"});
     ASSERT_EQ(md.exit_code, 0) << md.output;
     ASSERT_EQ(continuum.exit_code, 0) << continuum.output;
+    ASSERT_EQ(snapshot.exit_code, 0) << snapshot.output;
     fs::copy_file(dir / "run.h5", dir / "ref.h5");
     fs::remove(dir / "continuum.h5");
+    fs::remove(dir / "snap.h5");
+    fs::remove(dir / "snap.particles.xyz");
   }
   void TearDown() override { fs::remove_all(directory()); }
 };
@@ -208,6 +214,8 @@ void replace_dataset(hid_t file, const std::string& name, const std::vector<doub
   H5Ldelete(file, name.c_str(), H5P_DEFAULT);
   if (dims.size() == 2)
     shaker::h5::write(file, name, data, dims[0], dims[1]);
+  else if (dims.size() > 2)
+    shaker::h5::write(file, name, data, dims, "1");
   else
     shaker::h5::write(file, name, data);
 }
