@@ -32,7 +32,7 @@ def plot_profiles(run, quantities=("n", "T"), phases=(0.0, 0.25, 0.5, 0.75), zma
     """Profiles against height, one axis per quantity, a line per phase (the stored phases
     nearest `phases`) and the plate's height at that phase; for MD a band of one standard
     error."""
-    figure = figure or Figure(figsize=(7, 3 * len(quantities)), layout="constrained")
+    figure = figure or Figure(figsize=(7, 0.5 + 3.5 * len(quantities)), layout="constrained")
     axes = figure.subplots(len(quantities), 1, squeeze=False)[:, 0]
     rows = [_row_of(run, phase) for phase in phases]
     for ax, quantity in zip(axes, quantities):
