@@ -50,7 +50,7 @@ def read_run(path, frame="lab"):
         check_schema_version(f.attrs, path)
         if "kind" in f.attrs:
             raise SchemaError(f"{path}: a '{text(f.attrs['kind'])}' file, not a run file "
-                              "(read fields files with read_fields)")
+                              "(read_fields reads fields files, read_snapshots particle files)")
         for group in ("profiles", "timeseries"):
             if group not in f:
                 raise SchemaError(f"{path}: no group /{group}; not a complete run file")

@@ -4,7 +4,8 @@ Layout: root group `h5md`; `/particles/all/box` (attributes dimension, boundary;
 `edges` = [W, W, ceiling]); `/particles/all/position` and `/velocity`, each with `step`, `time`
 and `value` (F x N x 3, lab frame); `/observables/plate_position`, `plate_velocity`, `phase`
 and `cycle`, each with `step`, `time` and `value`; a `units` attribute on every `value`; the
-run file's provenance as root attributes.
+run file's provenance as root attributes, and `kind` = "shaker md particles". `shaker md`
+writes it as RUN.particles.h5 when `md.snapshot_phases` is set.
 """
 from collections import namedtuple
 from dataclasses import dataclass
@@ -14,6 +15,7 @@ import numpy as np
 
 from ._common import (SchemaError, Table, check_frame, check_schema_version, provenance, text)
 
+KIND = "shaker md particles"
 OBSERVABLES = ("plate_position", "plate_velocity", "phase", "cycle")
 _TIME_UNITS = "sqrt(sigma/g)"
 _Element = namedtuple("_Element", "step time time_units value units")
@@ -49,6 +51,9 @@ def read_snapshots(path, frame="lab"):
             raise SchemaError(f"{path}: H5MD version {list(np.asarray(version))}; this reader "
                               "knows H5MD 1.x")
         check_schema_version(f.attrs, path)
+        kind = text(f.attrs.get("kind", KIND))
+        if kind != KIND:
+            raise SchemaError(f"{path}: root attribute kind is '{kind}', not '{KIND}'")
         attributes, configuration = provenance(f.attrs)
         particles = _required(f, "particles/all", path)
         box = _required(particles, "box", path)

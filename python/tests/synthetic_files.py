@@ -198,6 +198,7 @@ def write_h5md(path, seed=3, schema_version=1, observable_steps=OBSERVABLE_STEPS
     velocity = rng.normal(0, 1, size=(frames, PARTICLES, 3))
     with h5py.File(path, "w") as f:
         write_attributes(f, "md", schema_version)
+        f.attrs["kind"] = "shaker md particles"
         h5md = f.create_group("h5md")
         h5md.attrs["version"] = np.array([1, 1], dtype=np.int32)
         h5md.create_group("author").attrs["name"] = "granular-shaker"

@@ -176,6 +176,12 @@ def test_snapshot_refusals(work_dir):
     synthetic.write_md_run(path)
     with pytest.raises(gs.SchemaError, match="no group /h5md"):
         gs.read_snapshots(path)
+    synthetic.write_h5md(path)
+    with h5py.File(path, "a") as f:
+        f.attrs["kind"] = "shaker md checkpoint"
+    with pytest.raises(gs.SchemaError,
+                       match="kind is 'shaker md checkpoint', not 'shaker md particles'"):
+        gs.read_snapshots(path)
 
 
 def test_analysis_json_from_text_and_path_in_both_frames(work_dir):
