@@ -50,16 +50,18 @@ def check_schema_version(attrs, path):
 
 def provenance(attrs):
     """Root attributes as Python values, and the configuration parsed (TOML)."""
-    attributes = {}
-    for key, value in attrs.items():
-        value = np.asarray(value) if not isinstance(value, (str, bytes)) else value
-        if isinstance(value, (str, bytes)) or value.dtype.kind in "OSU":
-            attributes[key] = text(value) if np.ndim(value) == 0 else [text(v) for v in value]
-        else:
-            attributes[key] = value.item() if value.ndim == 0 else value
-    configuration = tomllib.loads(attributes["configuration"]) if "configuration" in attributes \
-        else {}
+    attributes = {key: _attribute_value(value) for key, value in attrs.items()}
+    configuration = tomllib.loads(attributes.get("configuration", ""))
     return attributes, configuration
+
+
+def _attribute_value(value):
+    if isinstance(value, (str, bytes)):
+        return text(value)
+    array = np.asarray(value)
+    if array.dtype.kind in "OSU":
+        return [text(v) for v in array.ravel()]
+    return array.item() if array.ndim == 0 else array
 
 
 def units_of(dataset, path):
