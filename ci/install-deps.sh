@@ -16,7 +16,9 @@ packages=(
   libtoml11-dev libcli11-dev libfmt-dev
   libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-matplotlib python3-h5py python3-meshio
-  python3-pytest python3-flake8 python3-ase python3-gsd
+  python3-pytest python3-flake8 python3-ase
+  python3-pip python3-setuptools python3-wheel python3-gsd
+  python3-nbclient python3-nbformat python3-ipykernel
 )
 case ${1:-} in
   "") ;;
