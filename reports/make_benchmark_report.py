@@ -270,19 +270,20 @@ def figure_history(runs, series):
         panels["median real time per iteration [ns]"] = {
             n: [float(np.median(r["benchmarks"][n]["real_time"])) if n in r["benchmarks"]
                 else float("nan") for r in runs] for n in names}
-    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 3.2 * len(panels)), squeeze=False)
+    fig, axes = plt.subplots(len(panels), 1, figsize=(13, 3.4 * len(panels)), squeeze=False)
     x = np.arange(len(runs))
     labels = [short(r["commit"])[:7] for r in runs]
     for ax, (quantity, data) in zip(axes[:, 0], panels.items()):
-        for bench, values in data.items():
-            ax.plot(x, values, "o-", ms=4, label=bench)
+        for k, (bench, values) in enumerate(data.items()):
+            # Ten colours, then the next marker: every series is told apart.
+            ax.plot(x, values, "-", marker="os^Dv"[k // 10 % 5], ms=4, label=bench)
         ax.set_ylabel(quantity)
         ax.set_xticks(x)
         ax.set_xticklabels(labels, rotation=45, fontsize=7)
         ax.set_xlabel("run (commit)")
         ax.grid(True, alpha=0.3)
-        if data:
-            ax.legend(fontsize=6)
+        if data:  # beside the panel, never over its data
+            ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     return fig
 

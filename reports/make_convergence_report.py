@@ -505,7 +505,8 @@ def gci_panel(ax, r, h_label):
     if math.isfinite(band):
         ax.axhspan(r["phi1"] - band, r["phi1"] + band, color="C1", alpha=0.25,
                    label="uncertainty")
-    ax.set_title(textwrap.fill(f"{r['quantity']}: {gci_order_text(r)}", 36), fontsize=8)
+    title = f"{r['quantity']}: {gci_order_text(r)}"
+    ax.set_title(title if len(title) <= 36 else title.replace(": ", ":\n"), fontsize=8)
     ax.set_xlabel(h_label, fontsize=8)
     ax.set_ylabel(rc.with_units("phi", units_of(r["quantity"])), fontsize=8)
     ax.tick_params(labelsize=7)
