@@ -195,12 +195,11 @@ def figure_variants(results):
         ax.grid(axis="x", lw=0.3)
         if not xs:
             ax.text(0.5, 0.5, "not measured", transform=ax.transAxes, ha="center")
-        ax.legend(fontsize=7, loc="lower right")
     axes[0].set_yticks(y)
     axes[0].set_yticklabels(names, fontsize=8)
     axes[0].set_ylabel("variant")
     axes[0].invert_yaxis()
-    fig.tight_layout()
+    rc.legend_above(fig)  # one legend, over none of the points
     return fig
 
 
