@@ -13,8 +13,8 @@ breaks these rules (empty when the figure is fine).
 - Every colour-mapped artist has a colorbar in the figure (its own, or one of the same colour
   map and limits), whose label gives the units.
 - No title or axis label overlaps the title, axis label or tick labels of another axes (or
-  the figure's title), and none is cut off at the figure's edge; measured on the text as
-  drawn (Agg).
+  the figure's title or legend), and none (nor a figure legend) is cut off at the figure's
+  edge; measured on the text as drawn (Agg).
 
 The report tests (reports/tests/test_figures.py) hold every figure function of reports/ to
 these rules.
@@ -189,33 +189,33 @@ def shown(text):
 
 
 def overlap_problems(fig):
+    """Texts (and figure legends) of different owners that overlap, or that the figure's edge
+    cuts off; an owner is an axes, or the figure for its title and legends."""
     renderer = fig.canvas.get_renderer()
-    figure_texts = [t for t in [getattr(fig, "_suptitle", None)] + list(fig.texts)
-                    if t is not None and shown(t)]
-    owners = [(None, figure_texts)] + [(ax, own_texts(ax)) for ax in fig.axes]
-    boxes = {id(t): t.get_window_extent(renderer) for _, texts in owners for t in texts}
+    figure_texts = [t for t in dict.fromkeys([getattr(fig, "_suptitle", None)] + fig.texts)
+                    if t is not None and shown(t)]  # the title is one of fig.texts too
+    owners = [(None, [(f"'{t.get_text()}'", t.get_window_extent(renderer))
+                      for t in figure_texts]
+               + [("the figure's legend", legend.get_window_extent(renderer))
+                  for legend in fig.legends])]
+    owners += [(ax, [(f"'{t.get_text()}'", t.get_window_extent(renderer))
+                     for t in own_texts(ax)]) for ax in fig.axes]
     ticks = {ax: [t.get_window_extent(renderer) for t in tick_texts(ax)] for ax in fig.axes}
-    problems = []
     edge = fig.bbox
-    for owner, texts in owners:
-        for text in texts:
-            box = boxes[id(text)]
-            if box.x0 < edge.x0 - 1 or box.y0 < edge.y0 - 1 or box.x1 > edge.x1 + 1 \
-                    or box.y1 > edge.y1 + 1:
-                problems.append(f"'{text.get_text()}' is cut off at the figure's edge")
-    for i, (owner, texts) in enumerate(owners):
-        for other_owner, other_texts in owners[i + 1:]:
-            for text in texts:
-                for other in other_texts:
-                    if overlap(boxes[id(text)], boxes[id(other)]):
-                        problems.append(f"'{text.get_text()}' overlaps '{other.get_text()}'")
-        for other_owner in fig.axes:
-            if other_owner is owner:
-                continue
-            for text in texts:
-                if any(overlap(boxes[id(text)], tick) for tick in ticks[other_owner]):
-                    problems.append(f"'{text.get_text()}' overlaps the tick labels of another "
-                                    "axes")
+    problems = [f"{name} is cut off at the figure's edge" for _, boxes in owners
+                for name, box in boxes if box.x0 < edge.x0 - 1 or box.y0 < edge.y0 - 1
+                or box.x1 > edge.x1 + 1 or box.y1 > edge.y1 + 1]
+    figure_boxes = owners[0][1]
+    problems += [f"{name} overlaps {other}" for i, (name, box) in enumerate(figure_boxes)
+                 for other, other_box in figure_boxes[i + 1:] if overlap(box, other_box)]
+    for i, (owner, boxes) in enumerate(owners):
+        for _, other_boxes in owners[i + 1:]:
+            problems += [f"{name} overlaps {other}" for name, box in boxes
+                         for other, other_box in other_boxes if overlap(box, other_box)]
+        problems += [f"{name} overlaps the tick labels of another axes"
+                     for other_owner in fig.axes if other_owner is not owner
+                     for name, box in boxes
+                     if any(overlap(box, tick) for tick in ticks[other_owner])]
     return problems
 
 

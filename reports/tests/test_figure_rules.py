@@ -118,6 +118,16 @@ def overlapping_titles():
     return fig
 
 
+def legend_on_the_title():
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(X, X, label="data")
+    labelled(ax)
+    fig.suptitle("A figure title")
+    fig.tight_layout()
+    fig.legend(loc="upper center")
+    return fig
+
+
 def cut_off_label():
     fig, ax = plt.subplots(figsize=(3, 3))
     ax.plot(X, X)
@@ -142,6 +152,7 @@ def test_a_figure_that_keeps_the_rules_passes():
     (mesh_without_colorbar, "colour-mapped QuadMesh without a colorbar"),
     (colorbar_without_units, "colorbar label 'nu' gives no units"),
     (overlapping_titles, "overlaps"),
+    (legend_on_the_title, "'A figure title' overlaps the figure's legend"),
     (cut_off_label, "is cut off at the figure's edge"),
 ])
 def test_each_broken_rule_is_found(make, problem):
