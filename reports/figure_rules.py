@@ -7,7 +7,8 @@ breaks these rules (empty when the figure is fine).
   labels) needs a label but no units.
 - An axes drawing more than one thing names every one of them in a legend, its own or one of
   the figure's; a colour-mapped image, mesh, filled contour or scatter is named by a colorbar
-  instead.
+  instead. A legend inside the axes hides none of its data points (markers and the vertices
+  of lines).
 - MD data (a legend label starting with "MD") is drawn with its standard errors: as error
   bars, or as a band whose label says "standard error".
 - Every colour-mapped artist has a colorbar in the figure (its own, or one of the same colour
@@ -129,7 +130,29 @@ def legend_problems(ax, fig):
     missing = sorted({a.get_label() for a in named if not a.get_label().startswith("_")} - shown)
     if missing:
         problems.append("no legend names " + ", ".join(f"'{m}'" for m in missing))
+    hidden = covered_points(ax)
+    if hidden:
+        problems.append(f"its legend hides {hidden} data points")
     return problems
+
+
+def covered_points(ax):
+    """How many data points (markers and line vertices, in view) the axes' own legend
+    hides."""
+    legend = ax.get_legend()
+    if legend is None:
+        return 0
+    box = legend.get_window_extent(ax.figure.canvas.get_renderer())
+    view = ax.bbox
+    hidden = 0
+    for line in ax.lines:
+        if not line.get_visible() or len(line.get_xydata()) == 0:
+            continue
+        points = ax.transData.transform(line.get_xydata())
+        inside = ((points[:, 0] > view.x0) & (points[:, 0] < view.x1)
+                  & (points[:, 1] > view.y0) & (points[:, 1] < view.y1))
+        hidden += int(sum(box.contains(x, y) for x, y in points[inside]))
+    return hidden
 
 
 def md_error_problems(ax):

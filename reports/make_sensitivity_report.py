@@ -236,7 +236,8 @@ def figure_knudsen_maps(profiles):
         ax.set_title(SOLVER_NAMES[solver])
         ax.set_xlabel("phase f t [1]")
     axes[0][0].set_ylabel("height z, lab frame [sigma]")
-    colorbar = fig.colorbar(image, ax=axes[0].tolist())
+    fig.tight_layout(rect=(0, 0, 0.9, 1))  # the colorbar and its label take the last tenth
+    colorbar = fig.colorbar(image, ax=axes[0].tolist(), fraction=0.04, pad=0.02)
     colorbar.set_label("log10 of the local Knudsen number max(Kn_n, Kn_T) [1]")
     return fig
 

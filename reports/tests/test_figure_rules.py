@@ -87,6 +87,15 @@ def unlabelled_plate():
     return fig
 
 
+def legend_on_the_data():
+    fig, ax = plt.subplots()
+    ax.plot(X, X, "o", label="rising")
+    ax.plot(X, 0.5 * X, "s", label="slower")
+    ax.legend(loc="upper right", fontsize=20)
+    labelled(ax)
+    return fig
+
+
 def md_without_errors():
     fig, ax = plt.subplots()
     ax.plot(X, X, "o", label="MD")
@@ -148,6 +157,7 @@ def test_a_figure_that_keeps_the_rules_passes():
     (no_units, "y label 'height' gives no units"),
     (two_lines_no_legend, "no legend names 'one', 'other'"),
     (unlabelled_plate, "1 drawn artists without a label"),
+    (legend_on_the_data, "its legend hides"),
     (md_without_errors, "MD data ('MD') without its standard errors"),
     (mesh_without_colorbar, "colour-mapped QuadMesh without a colorbar"),
     (colorbar_without_units, "colorbar label 'nu' gives no units"),
