@@ -59,43 +59,45 @@ def nearest(phases, target):
     return int(np.argmin(np.abs(((phases - target + 0.5) % 1.0) - 0.5)))
 
 
-def plot_profiles(runs, out_dir):
-    fig, axes = plt.subplots(2, len(FIGURE_PHASES), figsize=(14, 7), sharey=True)
-    styles = {"md": dict(marker="o", ms=3, ls="none"), "continuum": dict(ls="-")}
+def figure_profiles(runs):
+    """nu and T against height above the plate at the phases of the paper's Fig. 1."""
+    fig, axes = plt.subplots(2, len(FIGURE_PHASES), figsize=(14, 7.5), sharey=True)
     for col, phase in enumerate(FIGURE_PHASES):
         for solver, (attrs, prof) in runs.items():
             k = nearest(prof["phase"], phase)
             z = prof["z"][k] - prof["plate_z"][k]
-            axes[0, col].plot(prof["nu"][k], z, label=solver, **styles[solver])
-            axes[1, col].plot(prof["T"][k], z, label=solver, **styles[solver])
+            errors = rc.profile_errors(prof, k)
+            rc.draw_profile(axes[0, col], solver, prof["nu"][k], z, errors["nu"])
+            rc.draw_profile(axes[1, col], solver, prof["T"][k], z, errors["T"])
         axes[0, col].set_title(f"f t = {phase:.2f}")
-        axes[0, col].set_xlabel("nu")
-        axes[1, col].set_xlabel("T")
+        axes[0, col].set_xlabel("volume fraction nu [1]")
+        axes[1, col].set_xlabel("temperature T [g sigma]")
     for row in range(2):
-        axes[row, 0].set_ylabel("height above plate")
+        axes[row, 0].set_ylabel("height above the plate [sigma]")
         axes[row, 0].set_ylim(0, 40)
-    axes[0, 0].legend()
-    fig.tight_layout()
-    path = os.path.join(out_dir, "base-case-profiles.png")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return os.path.basename(path)
+    rc.legend_above(fig)
+    return fig
 
 
-def plot_trajectories(analyses, out_dir):
+def figure_trajectories(analyses):
+    """Centre of mass, shock location and plate over a cycle (lab frame), MD with the
+    analysis' standard errors where its table has them (`shaker analyze --csv`: _error
+    columns)."""
     fig, ax = plt.subplots(figsize=(7, 5))
     for solver, a in analyses.items():
-        ax.plot(a["phase"], a["center_of_mass"], label=f"{solver} centre of mass")
-        ax.plot(a["phase"], a["shock_location"], "o", ms=3, label=f"{solver} shock")
-        ax.plot(a["phase"], a["plate_z"], "k:", lw=1)
-    ax.set_xlabel("f t")
-    ax.set_ylabel("height (lab frame)")
-    ax.legend()
+        name = "MD" if solver == "md" else solver
+        for column, what, style in (("center_of_mass", "centre of mass", {}),
+                                    ("shock_location", "shock", dict(marker="^", ls="none"))):
+            error = a[column + "_error"] if column + "_error" in a.dtype.names else None
+            rc.draw_series(ax, solver, a["phase"], a[column], error,
+                           label=f"{name} {what}", **style)
+    plate = next(iter(analyses.values()))
+    ax.plot(plate["phase"], plate["plate_z"], "k:", lw=1, label="plate")
+    ax.set_xlabel("phase f t [1]")
+    ax.set_ylabel("height z, lab frame [sigma]")
+    ax.legend(fontsize=8)
     fig.tight_layout()
-    path = os.path.join(out_dir, "base-case-trajectories.png")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return os.path.basename(path)
+    return fig
 
 
 def fmt(x, digits=3):
@@ -138,10 +140,13 @@ def main():
         if solver in runs and os.path.exists(log):
             lines += [f"## {solver} run summary", "", "```", open(log).read().strip(), "```", ""]
     if runs:
+        profiles = rc.write_figure(figure_profiles(runs), out_dir, "base-case-profiles.png")
+        trajectories = rc.write_figure(figure_trajectories(analyses), out_dir,
+                                       "base-case-trajectories.png")
         lines += ["## Profiles at the phases of the paper's Fig. 1", "",
-                  f"![nu and T]({plot_profiles(runs, out_dir)})", "",
+                  f"![nu and T]({profiles})", "",
                   "## Centre of mass and shock location over a cycle", "",
-                  f"![trajectories]({plot_trajectories(analyses, out_dir)})", ""]
+                  f"![trajectories]({trajectories})", ""]
         for solver, a in analyses.items():
             lines += [f"## {solver}: analysis per phase (every fifth stored phase)", ""]
             lines += rc.table_head([rc.analysis_header(label, column)

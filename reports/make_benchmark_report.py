@@ -256,29 +256,36 @@ def compare(previous, latest, threshold, alpha, metric):
     return rows, slowdowns
 
 
-def plot_history(runs, series, path):
-    panels = list(series.items()) or [("median real time per iteration (ns)", None)]
-    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 3.2 * len(panels)), squeeze=False)
+def figure_history(runs, series):
+    """One panel per counter (one quantity, its units on the axis), every benchmark that
+    reports it against the runs; the median real time per iteration when no run has a
+    throughput counter."""
+    panels = {}
+    for data in series.values():
+        for (bench, counter), values in data.items():
+            panels.setdefault(rc.with_units(counter.replace("_", " "),
+                                            THROUGHPUT_UNITS[counter]), {})[bench] = values
+    if not panels:
+        names = sorted({n for r in runs for n in r["benchmarks"]})
+        panels["median real time per iteration [ns]"] = {
+            n: [float(np.median(r["benchmarks"][n]["real_time"])) if n in r["benchmarks"]
+                else float("nan") for r in runs] for n in names}
+    fig, axes = plt.subplots(len(panels), 1, figsize=(13, 3.4 * len(panels)), squeeze=False)
     x = np.arange(len(runs))
     labels = [short(r["commit"])[:7] for r in runs]
-    for ax, (kind, data) in zip(axes[:, 0], panels):
-        if data is None:
-            names = sorted({n for r in runs for n in r["benchmarks"]})
-            data = {(n, "time"): [float(np.median(r["benchmarks"][n]["real_time"]))
-                                  if n in r["benchmarks"] else float("nan") for r in runs]
-                    for n in names}
-        for (bench, counter), values in data.items():
-            ax.plot(x, values, "o-", ms=4, label=f"{bench} ({counter})")
-        ax.set_ylabel(kind)
+    for ax, (quantity, data) in zip(axes[:, 0], panels.items()):
+        for k, (bench, values) in enumerate(data.items()):
+            # Ten colours, then the next marker: every series is told apart.
+            ax.plot(x, values, "-", marker="os^Dv"[k // 10 % 5], ms=4, label=bench)
+        ax.set_ylabel(quantity)
         ax.set_xticks(x)
         ax.set_xticklabels(labels, rotation=45, fontsize=7)
+        ax.set_xlabel("run (commit)")
         ax.grid(True, alpha=0.3)
-        if data:
-            ax.legend(fontsize=6)
-    axes[-1, 0].set_xlabel("run (commit)")
+        if data:  # beside the panel, never over its data
+            ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
-    rc.save_figure_atomically(fig, path)
-    plt.close(fig)
+    return fig
 
 
 HAND_MEASURED = "(measured by hand)"
@@ -351,7 +358,7 @@ def main(argv=None):
                              " | ".join(rc.fmt(data[key][k], 4) for key in keys) + " |")
             lines.append("")
         plot_name = "benchmark-history.png"
-        plot_history(runs, series, os.path.join(out_dir, plot_name))
+        rc.write_figure(figure_history(runs, series), out_dir, plot_name)
         lines += [f"![benchmark history]({plot_name})", ""]
         if len(runs) >= 2:
             previous = runs[-2]

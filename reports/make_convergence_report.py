@@ -92,6 +92,7 @@ import re
 import shutil
 import sys
 import tempfile
+import textwrap
 
 import matplotlib
 
@@ -405,35 +406,75 @@ def safe_name(study):
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", study)
 
 
-def plot_study(study, series, design_orders, out_dir):
-    norms = sorted({norm for _, norm in series}, key=lambda n: NORM_ORDER.get(n, 9))
-    fig, axes = plt.subplots(1, len(norms), figsize=(4.2 * len(norms), 3.8), squeeze=False)
-    for ax, norm in zip(axes[0], norms):
+def step_axis(study):
+    """The x axis of a study's plots: what its h is, with units. A temporal manufactured-solution
+    study refines the time step, a real-problem time-step study scales the production step."""
+    if "MmsTime" in study:
+        return rc.with_units("time step dt", "sqrt(sigma/g)")
+    if is_time_step_triple(study):
+        return rc.with_units("time-step scale", rc.DIMENSIONLESS)
+    return rc.with_units("cell size h", "sigma")
+
+
+ERROR_PANEL_COLUMNS = 4
+
+
+def panel_grid(fig, panels, width=3.6, height=3.1):
+    """`panels` axes in `fig`, at most ERROR_PANEL_COLUMNS to a line, the figure sized to
+    them; the spare ones hidden."""
+    columns = min(ERROR_PANEL_COLUMNS, panels)
+    lines = -(-panels // columns)
+    fig.set_size_inches(width * columns, height * lines + 0.6)
+    axes = fig.subplots(lines, columns, squeeze=False)
+    for ax in axes.flat[panels:]:
+        ax.set_visible(False)
+    return axes.flat[:panels]
+
+
+def suptitle(fig, text):
+    """A figure title wrapped to the figure's width."""
+    fig.suptitle(textwrap.fill(text, int(11 * fig.get_figwidth())), fontsize=10)
+
+
+def figure_errors(study, series, design_orders):
+    """One panel per quantity (its units on the error axis), its norms (and the phases at
+    which it is taken) against h, with the design order's slopes."""
+    quantities = {}
+    for (field, norm), rows in sorted(series.items()):
+        quantities.setdefault(PHASE_SUFFIX.sub("", field), []).append((field, norm, rows))
+    fig = plt.figure()
+    axes = panel_grid(fig, len(quantities))
+    for ax, (quantity, members) in zip(axes, quantities.items()):
         finest = []
-        for (field, series_norm), rows in sorted(series.items()):
-            if series_norm != norm:
-                continue
+        for field, norm, rows in sorted(members, key=lambda m: (m[0], NORM_ORDER.get(m[1], 9))):
             h = np.array([r["h"] for r in rows])
             e = np.array([r["error"] for r in rows])
             keep = (h > 0) & (e > 0)
-            ax.loglog(h[keep], e[keep], "o-", ms=4, label=field)
-            if keep.any():
-                finest.append((h[keep].min(), e[keep][np.argmin(h[keep])], h[keep].max()))
-        for p in sorted(design_orders):
-            if not finest:
-                break
-            h_min = min(f[0] for f in finest)
-            h_max = max(f[2] for f in finest)
-            e_anchor = float(np.exp(np.mean([np.log(f[1]) for f in finest])))
-            hs = np.array([h_min, h_max])
-            ax.loglog(hs, e_anchor * (hs / h_min) ** p, "k--", lw=1, label=f"slope {p:g}")
+            if not keep.any():
+                continue
+            label = norm if field == quantity else f"f t {field[len(quantity) + 3:]}, {norm}"
+            ax.loglog(h[keep], e[keep], "o-", ms=4, label=label)
+            finest.append((h[keep].min(), e[keep][np.argmin(h[keep])], h[keep].max()))
+        hs = np.array([min(f[0] for f in finest), max(f[2] for f in finest)]) if finest \
+            else np.zeros(2)
+        for p in sorted(design_orders) if hs[1] > hs[0] else []:
+            anchor = float(np.exp(np.mean([np.log(f[1]) for f in finest])))
+            ax.loglog(hs, anchor * (hs / hs[0]) ** p, "k--", lw=1, label=f"slope {p:g}")
+        if not finest:
+            ax.text(0.5, 0.5, "zero on every level", transform=ax.transAxes, ha="center")
+            ax.set_xticks([])
+            ax.set_yticks([])
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-        ax.set_title(f"{study}: {norm}")
-        ax.set_xlabel("h")
-        ax.set_ylabel("error")
+        ax.set_title(quantity, fontsize=9)
+        ax.set_xlabel(step_axis(study), fontsize=8)
+        ax.set_ylabel(rc.with_units("error", units_of(quantity)), fontsize=8)
+        ax.tick_params(labelsize=7)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    return finished_plot(fig, out_dir, f"convergence-{safe_name(study)}.png")
+        if finest:
+            ax.legend(fontsize=6)
+    suptitle(fig, f"{study}: error norms against the {step_axis(study)}")
+    fig.tight_layout()
+    return fig
 
 
 def label_log_ticks(ax, values):
@@ -442,9 +483,6 @@ def label_log_ticks(ax, values):
     ax.set_xticks(ticks)
     ax.set_xticklabels([f"{v:g}" for v in ticks])
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-
-
-GCI_PANEL_COLUMNS = 4
 
 
 def gci_order_text(r):
@@ -467,7 +505,8 @@ def gci_panel(ax, r, h_label):
     if math.isfinite(band):
         ax.axhspan(r["phi1"] - band, r["phi1"] + band, color="C1", alpha=0.25,
                    label="uncertainty")
-    ax.set_title(f"{r['quantity']}: {gci_order_text(r)}", fontsize=8)
+    title = f"{r['quantity']}: {gci_order_text(r)}"
+    ax.set_title(title if len(title) <= 36 else title.replace(": ", ":\n"), fontsize=8)
     ax.set_xlabel(h_label, fontsize=8)
     ax.set_ylabel(rc.with_units("phi", units_of(r["quantity"])), fontsize=8)
     ax.tick_params(labelsize=7)
@@ -475,30 +514,22 @@ def gci_panel(ax, r, h_label):
     ax.grid(True, which="both", alpha=0.3)
 
 
-def plot_gci_study(study, rows, out_dir):
-    """One panel per GCI row of `study`, at most GCI_PANEL_COLUMNS to a line."""
-    columns = min(GCI_PANEL_COLUMNS, len(rows))
-    lines = -(-len(rows) // columns)
-    fig, axes = plt.subplots(lines, columns, figsize=(3.3 * columns, 2.9 * lines),
-                             squeeze=False)
-    # A time-step study refines the step; its "-grid" triple, the grid it is compared with.
-    time_steps = study.startswith("real-time-") and not study.endswith("-grid")
-    h_label = "step scale" if time_steps else "cell size h"
-    for ax, r in zip(axes.flat, rows):
-        gci_panel(ax, r, h_label)
-    for ax in axes.flat[len(rows):]:
-        ax.set_visible(False)
-    axes.flat[0].legend(fontsize=6)
-    fig.suptitle(f"{study}: quantities of interest against the {h_label}", fontsize=10)
-    # "-gci": a study may also have an error table, whose plot takes the plain name.
-    return finished_plot(fig, out_dir, f"convergence-{safe_name(study)}-gci.png")
+def figure_gci(study, rows):
+    """One panel per GCI row of `study`, at most ERROR_PANEL_COLUMNS to a line."""
+    fig = plt.figure()
+    axes = panel_grid(fig, len(rows), 3.3, 2.9)
+    for ax, r in zip(axes, rows):
+        gci_panel(ax, r, step_axis(study))
+    suptitle(fig, f"{study}: quantities of interest against the {step_axis(study)}")
+    rc.legend_above(fig, where="bottom")
+    return fig
 
 
 def phase_text(phase):
     return "all" if math.isnan(phase) else rc.fmt(phase, 3)
 
 
-def plot_sampling(study, rows, out_dir):
+def figure_sampling(study, rows):
     """se / se(smallest K) against K for every quantity of one study, with K^-1/2."""
     series = {}
     for r in rows:
@@ -520,12 +551,13 @@ def plot_sampling(study, rows, out_dir):
         ks = np.array([min(k_all), max(k_all)], dtype=float)  # reference line over the K range
         ax.loglog(ks, (ks / ks[0]) ** -0.5, "k--", lw=1.5, label="K^-1/2")
         label_log_ticks(ax, k_all)
-    ax.set_xlabel("sampled cycles K (effective)")
-    ax.set_ylabel("se / se(smallest K)")
-    ax.set_title(f"{study}: standard error against K")
+    ax.set_xlabel("sampled cycles K (effective) [1]")
+    ax.set_ylabel("standard error / its value at the smallest K [1]")
+    ax.set_title(textwrap.fill(f"{study}: standard error against K", 60))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=6)
-    return finished_plot(fig, out_dir, f"sampling-{safe_name(study)}.png")
+    fig.tight_layout()
+    return fig
 
 
 def sampling_fit_line(r, mark):
@@ -544,14 +576,6 @@ def sampling_fit_failure(r):
 
 def relation_of(criterion):
     return {"at_least": ">=", "at_most": "<="}.get(criterion, criterion)
-
-
-def finished_plot(fig, out_dir, name):
-    """Lays out, writes (atomically) and closes a figure; returns its file name."""
-    fig.tight_layout()
-    rc.save_figure_atomically(fig, os.path.join(out_dir, name))
-    plt.close(fig)
-    return name
 
 
 def bin_size_line(r, mark):
@@ -770,7 +794,9 @@ def gci_section(data, out_dir, failures, orders):
         rows, gci_line, gci_failure, failures, "no GCI studies found")
     plots = []
     for study in dict.fromkeys(r["study"] for r in rows):
-        name = plot_gci_study(study, [r for r in rows if r["study"] == study], out_dir)
+        # "-gci": a study may also have an error table, whose plot takes the plain name.
+        name = rc.write_figure(figure_gci(study, [r for r in rows if r["study"] == study]),
+                               out_dir, f"convergence-{safe_name(study)}-gci.png")
         plots += [f"![{study}]({name})", ""]
     return ["## Grid convergence index of the quantities of interest", "",
             "Each row is judged against its quantity's theoretical order (column "
@@ -826,7 +852,8 @@ def sampling_section(data, out_dir, failures):
             lines.append(f"| {quantity}{note} | {units_of(quantity)} | "
                          f"{phase_text(phase if phase >= 0 else math.nan)} | "
                          + " | ".join(rc.fmt(cells.get(k, float("nan"))) for k in ks) + " |")
-        name = plot_sampling(study, rows, out_dir)
+        name = rc.write_figure(figure_sampling(study, rows), out_dir,
+                               f"sampling-{safe_name(study)}.png")
         lines += ["", f"![{study}: se against K]({name})", ""]
 
     bins = sorted(data["bin-size"], key=lambda r: (r["study"], r["quantity"]))
@@ -924,7 +951,8 @@ def main(argv=None):
     plot_lines = ["## Plots", ""]
     for study in sorted(series):
         designs = {r["design_order"] for r in data["orders"] if r["study"] == study}
-        name = plot_study(study, series[study], designs, out_dir)
+        name = rc.write_figure(figure_errors(study, series[study], designs), out_dir,
+                               f"convergence-{safe_name(study)}.png")
         plot_lines += [f"![{study}]({name})", ""]
 
     checks = order_checks + gci_checks + bound_checks + sampling_checks

@@ -160,7 +160,7 @@ def band_text(claim):
         ", ".join(f"{b:g}" for b in band)
 
 
-def figure(results, out_dir, link):
+def figure_variants(results):
     """Four panels, one quantity each, variants on the vertical axis; MD's value and error as a
     band, the paper's band hatched where a claim has one."""
     variants = results["variants"]
@@ -195,16 +195,12 @@ def figure(results, out_dir, link):
         ax.grid(axis="x", lw=0.3)
         if not xs:
             ax.text(0.5, 0.5, "not measured", transform=ax.transAxes, ha="center")
-        ax.legend(fontsize=7, loc="lower right")
     axes[0].set_yticks(y)
     axes[0].set_yticklabels(names, fontsize=8)
     axes[0].set_ylabel("variant")
     axes[0].invert_yaxis()
-    fig.tight_layout()
-    path = os.path.join(out_dir, "variants.png")
-    rc.save_figure_atomically(fig, path)
-    plt.close(fig)
-    return [f"![The variants against MD]({link}/variants.png)", ""]
+    rc.legend_above(fig)  # one legend, over none of the points
+    return fig
 
 
 KNUDSEN_BINS = (0.0, 0.01, 0.03, 0.1, 0.3, math.inf)
@@ -223,7 +219,7 @@ def read_profiles(path):
     return phases
 
 
-def knudsen_maps(profiles, out_dir, link):
+def figure_knudsen_maps(profiles):
     fig, axes = plt.subplots(1, len(profiles), figsize=(6 * len(profiles), 4.5), sharey=True,
                              squeeze=False)
     image = None
@@ -240,14 +236,13 @@ def knudsen_maps(profiles, out_dir, link):
         ax.set_title(SOLVER_NAMES[solver])
         ax.set_xlabel("phase f t [1]")
     axes[0][0].set_ylabel("height z, lab frame [sigma]")
-    colorbar = fig.colorbar(image, ax=axes[0].tolist())
+    fig.tight_layout(rect=(0, 0, 0.9, 1))  # the colorbar and its label take the last tenth
+    colorbar = fig.colorbar(image, ax=axes[0].tolist(), fraction=0.04, pad=0.02)
     colorbar.set_label("log10 of the local Knudsen number max(Kn_n, Kn_T) [1]")
-    rc.save_figure_atomically(fig, os.path.join(out_dir, "knudsen-maps.png"))
-    plt.close(fig)
-    return [f"![Local Knudsen number, base case]({link}/knudsen-maps.png)", ""]
+    return fig
 
 
-def knudsen_fraction_figure(knudsen, out_dir, link):
+def figure_knudsen_fraction(knudsen):
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
     for solver, data in knudsen.items():
         phase, fraction = np.array(data["phase"]), np.array(data["fraction"], dtype=float)
@@ -262,9 +257,7 @@ def knudsen_fraction_figure(knudsen, out_dir, link):
     ax.legend(fontsize=8)
     ax.grid(lw=0.3)
     fig.tight_layout()
-    rc.save_figure_atomically(fig, os.path.join(out_dir, "knudsen-fraction.png"))
-    plt.close(fig)
-    return [f"![Material above Kn = 0.1]({link}/knudsen-fraction.png)", ""]
+    return fig
 
 
 def difference_by_knudsen(md, continuum):
@@ -297,8 +290,10 @@ def knudsen_section(results, out_dir, link):
               "(docs/analysis.md), base case; MD and the continuum at the validation settings. "
               "Navier-Stokes order assumes Kn << 1.", ""]
     profiles = {solver: read_profiles(d["profiles_csv"]) for solver, d in knudsen.items()}
-    lines += knudsen_maps(profiles, out_dir, link)
-    lines += knudsen_fraction_figure(knudsen, out_dir, link)
+    maps = rc.write_figure(figure_knudsen_maps(profiles), out_dir, "knudsen-maps.png")
+    fraction = rc.write_figure(figure_knudsen_fraction(knudsen), out_dir, "knudsen-fraction.png")
+    lines += [f"![Local Knudsen number, base case]({link}/{maps})", "",
+              f"![Material above Kn = 0.1]({link}/{fraction})", ""]
     if "md" in profiles and "continuum" in profiles:
         rows = difference_by_knudsen(profiles["md"], profiles["continuum"])
         total = sum(r[5] for r in rows if np.isfinite(r[5])) or math.nan
@@ -336,7 +331,9 @@ def main():
              f"it started: {simulated:.0f} s", ""]
     lines += md_section(results)
     lines += decision_section(results)
-    lines += ["## The variants against MD", ""] + figure(results, out_dir, link)
+    variants = rc.write_figure(figure_variants(results), out_dir, "variants.png")
+    lines += ["## The variants against MD", "", f"![The variants against MD]({link}/{variants})",
+              ""]
     lines += knudsen_section(results, out_dir, link)
     lines += variants_table(results)
     rc.write_text_atomically(args.output, "\n".join(lines) + "\n")

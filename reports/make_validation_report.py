@@ -19,6 +19,7 @@ import json
 import math
 import os
 import sys
+import textwrap
 
 import h5py
 import matplotlib
@@ -36,7 +37,6 @@ else:  # run as a script: its folder, reports/, is first on sys.path
     from make_convergence_report import GCI_HEADER, read_csv
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-STYLE = {"md": dict(marker="o", ms=3, ls="none"), "continuum": dict(ls="-", lw=1.2)}
 FIG1_PHASES = (0.0, 0.15, 0.22, 0.40)
 FIG2_CASES = (("single_shock_e0p99", "e = 0.99"), ("single_shock_e0p90", "e = 0.90"),
               ("single_shock_e0p85", "e = 0.85"))
@@ -122,15 +122,16 @@ def missing_text(results, needs):
     return "runs not available: " + ", ".join(absent) if absent else ""
 
 
-def save(fig, out_dir, name):
+def write(fig, out_dir, name):
     os.makedirs(out_dir, exist_ok=True)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out_dir, name), dpi=90)
-    plt.close(fig)
-    return name
+    return rc.write_figure(fig, out_dir, name)
 
 
-# ---- figures (each returns markdown) ---------------------------------------------------------
+# ---- figures: each fig<N>_section returns markdown, its figure_* draws the figure ------------
+
+HEIGHT_LAB = "height z, lab frame [sigma]"
+PHASE = "phase f t [1]"
+
 
 def shock_region(row):
     """(low, high) of the shock region: the analysis' compressed-region top and undisturbed
@@ -141,14 +142,52 @@ def shock_region(row):
         row["shock_location"] + row["shock_width"] / 2, False
 
 
-def figure1(results, out_dir, link):
+def draw_plate(ax, phase, plate_z, horizontal=False):
+    if horizontal:
+        return ax.axhline(plate_z, color="k", lw=2, label="plate")
+    return ax.plot(phase, plate_z, "k-", lw=2.5, label="plate")
+
+
+def error_of(errors, name):
+    return None if errors is None or name not in errors else np.nan_to_num(errors[name])
+
+
+def figure_profiles(runs):
+    """Fig. 1: nu and T against height at FIG1_PHASES; runs: {solver: (profiles, analysis)}.
+    The continuum's shock region shaded."""
+    fig, axes = plt.subplots(2, len(FIG1_PHASES), figsize=(14, 7.5), sharey="col")
+    for col, phase in enumerate(FIG1_PHASES):
+        top, plate = 0.0, None
+        for solver, (prof, table) in runs.items():
+            k = nearest(prof["phase"], phase)
+            errors = rc.profile_errors(prof, k)
+            rc.draw_profile(axes[0, col], solver, prof["nu"][k], prof["z"][k], errors["nu"])
+            rc.draw_profile(axes[1, col], solver, prof["T"][k], prof["z"][k], errors["T"])
+            row = {name: table[name][k] for name in table}
+            top = max(top, np.nan_to_num(row["layer_top"]) + 12)
+            plate = prof["plate_z"][k] if plate is None else min(plate, prof["plate_z"][k])
+            if solver == "continuum" and not math.isnan(row["shock_location"]):
+                lo, hi, _ = shock_region(row)
+                for ax in axes[:, col]:
+                    ax.axhspan(lo, hi, color="0.8", zorder=0, label="continuum shock region")
+        for ax in axes[:, col]:
+            draw_plate(ax, None, plate, horizontal=True)
+            ax.set_ylim(plate - 1, max(top, plate + 20))
+            ax.set_ylabel(HEIGHT_LAB)
+        axes[0, col].set_title(f"f t = {phase:.2f}")
+        axes[0, col].set_xlabel("volume fraction nu [1]")
+        axes[1, col].set_xlabel("temperature T [g sigma]")
+    rc.legend_above(fig)
+    return fig
+
+
+def fig1_section(results, out_dir, link):
     needs = [("base", "md"), ("base", "continuum")]
     runs = {s: (results.profiles("base", s), results.analysis("base", s)) for _, s in needs}
     runs = {s: r for s, r in runs.items() if r[0] is not None}
     text = ["## Fig. 1: volume fraction and temperature against height (base case)", ""]
     if not runs:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
-    fig, axes = plt.subplots(2, len(FIG1_PHASES), figsize=(14, 7), sharey="col")
     rows = rc.table_head([rc.analysis_header("f t", "phase"), "solver",
                           rc.analysis_header("plate z", "plate_z"),
                           rc.analysis_header("layer bottom", "layer_bottom"),
@@ -156,86 +195,95 @@ def figure1(results, out_dir, link):
                           rc.analysis_header("shock location", "shock_location"),
                           rc.analysis_header("width d", "shock_width")])
     exact = True
-    for col, phase in enumerate(FIG1_PHASES):
-        top = 0.0
+    for phase in FIG1_PHASES:
         for solver, (prof, table) in runs.items():
             k = nearest(prof["phase"], phase)
-            axes[0, col].plot(prof["nu"][k], prof["z"][k], label=solver, **STYLE[solver])
-            axes[1, col].plot(prof["T"][k], prof["z"][k], label=solver, **STYLE[solver])
             row = {name: table[name][k] for name in table}
-            top = max(top, np.nan_to_num(row["layer_top"]) + 12)
             rows.append(f"| {prof['phase'][k]:.2f} | {solver} | {fmt(row['plate_z'])} | "
                         f"{fmt(row['layer_bottom'])} | {fmt(row['layer_top'])} | "
                         f"{fmt(row['shock_location'])} | {fmt(row['shock_width'])} |")
             if solver == "continuum" and not math.isnan(row["shock_location"]):
-                lo, hi, exact_region = shock_region(row)
-                exact = exact and exact_region
-                for ax in axes[:, col]:
-                    ax.axhspan(lo, hi, color="0.8", zorder=0)
-            for ax in axes[:, col]:
-                ax.axhline(prof["plate_z"][k], color="k", lw=2)
-        plate = min(p[0]["plate_z"][nearest(p[0]["phase"], phase)] for p in runs.values())
-        for ax in axes[:, col]:
-            ax.set_ylim(plate - 1, max(top, plate + 20))
-        axes[0, col].set_title(f"f t = {phase:.2f}")
-        axes[0, col].set_xlabel("nu")
-        axes[1, col].set_xlabel("T / (g sigma)")
-    for r in range(2):
-        axes[r, 0].set_ylabel("z / sigma (lab frame)")
-    axes[0, 0].legend()
-    name = save(fig, out_dir, "fig1-profiles.png")
+                exact = exact and shock_region(row)[2]
+    name = write(figure_profiles(runs), out_dir, "fig1-profiles.png")
     region = ("the continuum's shock region (compressed-region top to undisturbed bottom)"
               if exact else "location -/+ d/2 of the continuum shock (approximate: `shaker "
               "analyze` does not print the region's ends)")
-    return text + [f"MD points, continuum lines; the plate is the black line; grey: {region}.",
-                   "", f"![Fig. 1]({link}/{name})", ""] + rows + [""]
+    return text + [f"MD points with their standard errors, continuum lines; the plate is the "
+                   f"black line; grey: {region}.", "", f"![Fig. 1]({link}/{name})", ""] \
+        + rows + [""]
 
 
-def figure2(results, out_dir, link):
-    needs = [(c, s) for c, _ in FIG2_CASES for s in ("md", "continuum")]
-    text = ["## Fig. 2: shock location and centre of mass, e = 0.99, 0.90, 0.85 (single shock)",
-            ""]
-    available = [(c, label) for c, label in FIG2_CASES
-                 if results.view(c, "md") or results.view(c, "continuum")]
-    if not available:
-        return text + [f"No plot: {missing_text(results, needs)}.", ""]
-    fig, axes = plt.subplots(1, len(available), figsize=(5 * len(available), 5), squeeze=False)
-    rows = rc.table_head(["case", "solver", rc.analysis_header("formation f t", "phase"),
-                          rc.analysis_header("shock speed", "shock_speed"),
-                          rc.analysis_header("centre-of-mass apex", "center_of_mass_apex")])
-    for ax, (case, label) in zip(axes[0], available):
-        prof = results.profiles(case, "continuum")
+FIG2_MAX_NU = 0.65  # the shading's scale: random close packing
+
+
+def figure_single_shock(cases):
+    """Fig. 2: per case (label, continuum profiles or None, {solver: (analysis, errors)}),
+    shock location, centre of mass and layer edges over the cycle on the continuum's nu."""
+    # The colorbar in a column of its own, so that the layout makes room for its label.
+    fig, axes = plt.subplots(1, len(cases) + 1, figsize=(5 * len(cases) + 1, 5.6),
+                             gridspec_kw=dict(width_ratios=[1] * len(cases) + [0.05]))
+    panels, bar = axes[:-1], axes[-1]
+    mesh = None
+    for ax, (label, prof, tables) in zip(panels, cases):
+        if ax is not panels[0]:
+            ax.sharey(panels[0])
         if prof is not None:
             phase = np.repeat(prof["phase"][:, None], prof["z"].shape[1], axis=1)
-            ax.pcolormesh(phase, prof["z"], prof["nu"], cmap="Greys", shading="gouraud",
-                          vmin=0, vmax=0.65)
-        for solver in ("continuum", "md"):
-            t = results.analysis(case, solver)
-            if t is None:
-                continue
+            mesh = ax.pcolormesh(phase, prof["z"], prof["nu"], cmap="Greys", shading="gouraud",
+                                 vmin=0, vmax=FIG2_MAX_NU)
+        for solver, (t, errors) in tables.items():
             if solver == "continuum":
                 ax.plot(t["phase"], t["shock_location"], "r-", label="continuum shock")
                 ax.plot(t["phase"], t["center_of_mass"], "b--", label="continuum centre of mass")
-            else:
-                ax.plot(t["phase"], t["shock_location"], "r^", ms=4, label="MD shock")
-                ax.plot(t["phase"], t["center_of_mass"], "bo", ms=3, label="MD centre of mass")
-                ax.plot(t["phase"], t["layer_top"], "g+", ms=5, label="MD layer top")
-                ax.plot(t["phase"], t["layer_bottom"], "gx", ms=4, label="MD layer bottom")
-            ax.plot(t["phase"], t["plate_z"], "k-", lw=2.5)
+                continue
+            for column, what, style in (("shock_location", "shock", dict(marker="^", color="r")),
+                                        ("center_of_mass", "centre of mass",
+                                         dict(marker="o", color="b")),
+                                        ("layer_top", "layer top", dict(marker="+", color="g")),
+                                        ("layer_bottom", "layer bottom",
+                                         dict(marker="x", color="g"))):
+                rc.draw_series(ax, "md", t["phase"], t[column], error_of(errors, column),
+                               label=f"MD {what}", **style)
+        t = next(iter(tables.values()))[0]
+        draw_plate(ax, t["phase"], t["plate_z"])
+        ax.set_title(label)
+        ax.set_xlabel(PHASE)
+        ax.set_ylim(0, 60)
+    panels[0].set_ylabel(HEIGHT_LAB)
+    if mesh is not None:
+        fig.colorbar(mesh, cax=bar).set_label("continuum volume fraction nu [1]")
+    else:
+        bar.set_visible(False)
+    rc.legend_above(fig)
+    return fig
+
+
+def fig2_section(results, out_dir, link):
+    needs = [(c, s) for c, _ in FIG2_CASES for s in ("md", "continuum")]
+    text = ["## Fig. 2: shock location and centre of mass, e = 0.99, 0.90, 0.85 (single shock)",
+            ""]
+    cases = []
+    rows = rc.table_head(["case", "solver", rc.analysis_header("formation f t", "phase"),
+                          rc.analysis_header("shock speed", "shock_speed"),
+                          rc.analysis_header("centre-of-mass apex", "center_of_mass_apex")])
+    for case, label in FIG2_CASES:
+        tables = {s: results.analysis_with_errors(case, s) for s in ("continuum", "md")}
+        tables = {s: t for s, t in tables.items() if t is not None}
+        if not tables:
+            continue
+        cases.append((label, results.profiles(case, "continuum"), tables))
+        for solver, (t, _) in tables.items():
             v = results.views[f"{case}/{solver}"]
             rows.append(f"| {case} | {solver} | {fmt(first_shock(t))} | "
                         f"{fmt(v['shock_speed'])}{pm(v.get('shock_speed_error'))} | "
                         f"{fmt(float(np.max(t['center_of_mass'])))} |")
-        ax.set_title(label)
-        ax.set_xlabel("f t")
-        ax.set_ylim(0, 60)
-    axes[0, 0].set_ylabel("z / sigma (lab frame)")
-    axes[0, 0].legend(fontsize=7)
-    name = save(fig, out_dir, "fig2-single-shock.png")
+    if not cases:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    name = write(figure_single_shock(cases), out_dir, "fig2-single-shock.png")
     note = missing_text(results, needs)
     return text + ["Shading: continuum volume fraction (dark = dense). Lines continuum, "
-                   "markers MD (pooled single-shock runs)." + (f" Missing: {note}." if note
-                                                               else ""), "",
+                   "markers MD (pooled single-shock runs, with their standard errors)."
+                   + (f" Missing: {note}." if note else ""), "",
                    f"![Fig. 2]({link}/{name})", ""] + rows + [""]
 
 
@@ -249,86 +297,137 @@ def pm(error):
 
 
 MACH_PLOT_MIN_NU = 1e-3  # Fig. 3 draws Ma(z) only where nu exceeds this
+FIG3_PHASE = 0.22
 
 
-def figure3(results, out_dir, link):
-    needs = [("base", "md"), ("base", "continuum")]
-    text = ["## Fig. 3: Mach number and 10 nu against height at f t = 0.22 (base case)", ""]
-    runs = {s: (results.profiles("base", s), results.analysis("base", s)) for _, s in needs}
-    runs = {s: r for s, r in runs.items() if r[0] is not None}
-    if not runs:
-        return text + [f"No plot: {missing_text(results, needs)}.", ""]
-    fig, ax = plt.subplots(figsize=(6, 6))
-    rows = rc.table_head(["solver", rc.analysis_header("f t", "phase"),
-                          rc.analysis_header("shock location", "shock_location"),
-                          rc.analysis_header("maximum Ma in the layer", "max_mach")])
-    has_profile = False
-    for solver, (prof, table) in runs.items():
-        k = nearest(prof["phase"], 0.22)
-        ax.plot(10 * prof["nu"][k], prof["z"][k], label=f"{solver} 10 nu", **STYLE[solver])
+def figure_mach(runs):
+    """Fig. 3: nu and Ma against height at f t = FIG3_PHASE, side by side on one height axis;
+    runs: {solver: (profiles, analysis, analysis errors)}."""
+    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 6), sharey=True)
+    for solver, (prof, table, errors) in runs.items():
+        k = nearest(prof["phase"], FIG3_PHASE)
+        name = "MD" if solver == "md" else solver
+        rc.draw_profile(left, solver, prof["nu"][k], prof["z"][k],
+                        rc.profile_errors(prof, k)["nu"])
         if "mach" in prof:
-            has_profile = True
             # Ma of a nearly empty bin (a few particles in the dilute gas) is meaningless and
             # can reach 1e8: drawn only where there is material.
             dense = prof["nu"][k] > MACH_PLOT_MIN_NU
-            ax.plot(prof["mach"][k][dense], prof["z"][k][dense], label=f"{solver} Ma",
-                    **(dict(ls="none", marker="^", ms=4) if solver == "md" else dict(ls="--")))
+            right.plot(prof["mach"][k][dense], prof["z"][k][dense], label=f"{name} Ma(z)",
+                       **(dict(ls="none", marker="^", ms=4) if solver == "md" else dict(ls="--")))
         if not math.isnan(table["shock_location"][k]):
-            ax.plot([table["max_mach"][k]], [table["shock_location"][k]], "r^" if solver == "md"
-                    else "rs", ms=8, label=f"{solver} max Ma (at the shock)")
-        ax.axhline(prof["plate_z"][k], color="k", lw=2)
+            error = error_of(errors, "max_mach")
+            right.errorbar([table["max_mach"][k]], [table["shock_location"][k]],
+                           xerr=None if error is None else [error[k]],
+                           fmt="r^" if solver == "md" else "rs", ms=8,
+                           label=f"{name} max Ma (at the shock)")
+    plate = min(r[0]["plate_z"][nearest(r[0]["phase"], FIG3_PHASE)] for r in runs.values())
+    for ax in (left, right):
+        draw_plate(ax, None, plate, horizontal=True)
+        ax.legend(fontsize=8)
+    left.set_xlabel("volume fraction nu [1]")
+    right.set_xlabel("Mach number Ma [1]")
+    left.set_ylabel(HEIGHT_LAB)
+    left.set_ylim(plate - 1, plate + 30)
+    fig.tight_layout()
+    return fig
+
+
+def fig3_section(results, out_dir, link):
+    needs = [("base", "md"), ("base", "continuum")]
+    text = ["## Fig. 3: Mach number and nu against height at f t = 0.22 (base case)", ""]
+    runs = {s: (results.profiles("base", s), results.analysis_with_errors("base", s))
+            for _, s in needs}
+    runs = {s: (p, *t) for s, (p, t) in runs.items() if p is not None and t is not None}
+    if not runs:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    rows = rc.table_head(["solver", rc.analysis_header("f t", "phase"),
+                          rc.analysis_header("shock location", "shock_location"),
+                          rc.analysis_header("maximum Ma in the layer", "max_mach")])
+    for solver, (prof, table, _) in runs.items():
+        k = nearest(prof["phase"], FIG3_PHASE)
         rows.append(f"| {solver} | {prof['phase'][k]:.2f} | {fmt(table['shock_location'][k])} | "
                     f"{fmt(table['max_mach'][k])} |")
-    ax.set_xlabel("Ma, 10 nu")
-    ax.set_ylabel("z / sigma (lab frame)")
-    plate = min(r[0]["plate_z"][nearest(r[0]["phase"], 0.22)] for r in runs.values())
-    ax.set_ylim(plate - 1, plate + 30)
-    ax.legend(fontsize=8)
-    name = save(fig, out_dir, "fig3-mach.png")
+    name = write(figure_mach(runs), out_dir, "fig3-mach.png")
+    has_profile = any("mach" in r[0] for r in runs.values())
     note = ("" if has_profile else " The Mach-number profile Ma(z) is not drawn: `shaker analyze` "
             "prints only the maximum Ma in the layer, which the paper locates at the leading "
             "edge of the shock; it is drawn there.")
     note += f" Ma is drawn where nu > {MACH_PLOT_MIN_NU:g}."
-    return text + ["Lines continuum, markers MD." + note, "", f"![Fig. 3]({link}/{name})", ""] \
-        + rows + [""]
+    return text + ["nu on the left, Ma on the right. Lines continuum, markers MD." + note, "",
+                   f"![Fig. 3]({link}/{name})", ""] + rows + [""]
 
 
-def figure4(results, out_dir, link):
+PAPER_FORMATION, PAPER_EXIT = 0.12, 0.35
+
+
+def figure_mach_width(tables):
+    """Fig. 4: maximum Ma (top) and d/xi (bottom) against f t; tables: {solver: (analysis,
+    errors)}."""
+    fig, axes = plt.subplots(2, 1, figsize=(7, 7), sharex=True)
+    for ax, column, label in ((axes[0], "max_mach", "maximum Mach number in the layer [1]"),
+                              (axes[1], "width_over_mfp", "shock width over mean free path "
+                                                          "d/xi [1]")):
+        for solver, (t, errors) in tables.items():
+            rc.draw_series(ax, solver, t["phase"], t[column], error_of(errors, column),
+                           label=rc.SOLVER_LABELS[solver])
+        ax.axvline(PAPER_FORMATION, color="0.6", lw=0.8, ls="--",
+                   label=f"paper: formation f t = {PAPER_FORMATION}")
+        ax.axvline(PAPER_EXIT, color="0.6", lw=0.8, ls=":",
+                   label=f"paper: exit f t = {PAPER_EXIT}")
+        ax.set_yscale("log")
+        ax.set_ylabel(textwrap.fill(label, 30))
+        ax.legend(fontsize=7)
+    axes[1].set_xlim(0, 0.5)
+    axes[1].set_xlabel(PHASE)
+    fig.tight_layout()
+    return fig
+
+
+def fig4_section(results, out_dir, link):
     needs = [("base", "md"), ("base", "continuum")]
     text = ["## Fig. 4: maximum Mach number and d/xi against f t (base case)", ""]
-    tables = {s: results.analysis("base", s) for _, s in needs}
+    tables = {s: results.analysis_with_errors("base", s) for _, s in needs}
     tables = {s: t for s, t in tables.items() if t is not None}
     if not tables:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
-    fig, ax = plt.subplots(figsize=(7, 5))
     rows = rc.table_head([rc.analysis_header("f t", "phase")] + [
         header for s in tables for header in (rc.analysis_header(f"{s} max Ma", "max_mach"),
                                               rc.analysis_header(f"{s} d/xi", "width_over_mfp"))])
-    for solver, t in tables.items():
-        marker = dict(ls="none", marker="^") if solver == "md" else dict(ls="--")
-        ax.plot(t["phase"], t["max_mach"], label=f"{solver} max Ma", **marker)
-        marker = dict(ls="none", marker="o") if solver == "md" else dict(ls="-")
-        ax.plot(t["phase"], t["width_over_mfp"], label=f"{solver} d/xi", **marker)
-    ax.axvline(0.12, color="0.6", lw=0.8)
-    ax.axvline(0.35, color="0.6", lw=0.8)
-    ax.set_xlim(0, 0.5)
-    ax.set_yscale("log")
-    ax.set_xlabel("f t")
-    ax.legend(fontsize=8)
-    name = save(fig, out_dir, "fig4-mach-width.png")
-    first = next(iter(tables.values()))
+    name = write(figure_mach_width(tables), out_dir, "fig4-mach-width.png")
+    first = next(iter(tables.values()))[0]
     for k, phase in enumerate(first["phase"]):
         if phase > 0.5:
             break
         cells = []
-        for t in tables.values():
+        for t, _ in tables.values():
             cells += [fmt(t["max_mach"][k]), fmt(t["width_over_mfp"][k])]
         rows.append(f"| {phase:.2f} | " + " | ".join(cells) + " |")
-    return text + ["Grey lines: the paper's formation (0.12) and exit (0.35) phases.", "",
-                   f"![Fig. 4]({link}/{name})", ""] + rows + [""]
+    return text + [f"Dashed and dotted grey lines: the paper's formation ({PAPER_FORMATION}) and "
+                   f"exit ({PAPER_EXIT}) phases.", "", f"![Fig. 4]({link}/{name})", ""] \
+        + rows + [""]
 
 
-def figure5(results, out_dir, link):
+def figure_shock_speed(points):
+    """Fig. 5: shock speed against e; points: {solver: sorted [(e, speed, error or None)]}."""
+    fig, ax = plt.subplots(figsize=(6, 5))
+    for solver, pts in points.items():
+        if not pts:
+            continue
+        e, v, err = zip(*pts)
+        if solver == "md":
+            ax.errorbar(e, v, yerr=[x or 0 for x in err], fmt="o", capsize=3,
+                        label="MD (pooled, ± jackknife standard error)")
+        else:
+            ax.plot(e, v, "-s", label="continuum")
+    ax.set_xlabel("restitution coefficient e [1]")
+    ax.set_ylabel("shock speed, plate frame [sqrt(g sigma)]")
+    ax.legend()
+    fig.tight_layout()
+    return fig
+
+
+def fig5_section(results, out_dir, link):
     text = ["## Fig. 5: average shock speed against e (single shock, plate frame)", ""]
     points = {"md": [], "continuum": []}
     for key, v in sorted(results.views.items()):
@@ -338,88 +437,99 @@ def figure5(results, out_dir, link):
                                         v.get("shock_speed_error")))
     if not any(points.values()):
         return text + ["No plot: no single-shock run is available.", ""]
-    fig, ax = plt.subplots(figsize=(6, 5))
     rows = rc.table_head([rc.with_units("e", rc.DIMENSIONLESS),
                           rc.analysis_header("MD v_shock", "shock_speed"),
                           rc.analysis_header("continuum v_shock", "shock_speed")])
-    for solver, pts in points.items():
-        pts = sorted((e, v, err) for e, v, err in pts if v is not None)
-        if not pts:
-            continue
-        e, v, err = zip(*pts)
-        if solver == "md":
-            ax.errorbar(e, v, yerr=[x or 0 for x in err], fmt="o", capsize=3,
-                        label="MD (pooled, jackknife error)")
-        else:
-            ax.plot(e, v, "-s", label="continuum")
+    drawn = {s: sorted((e, v, err) for e, v, err in pts if v is not None)
+             for s, pts in points.items()}
     for e in sorted({p[0] for pts in points.values() for p in pts}):
         cell = {s: next((f"{fmt(v)}{pm(err)}" for ee, v, err in points[s] if ee == e), "–")
                 for s in points}
         rows.append(f"| {e:.2f} | {cell['md']} | {cell['continuum']} |")
-    ax.set_xlabel("e")
-    ax.set_ylabel("v_shock / sqrt(g sigma)")
-    ax.legend()
-    name = save(fig, out_dir, "fig5-shock-speed.png")
+    name = write(figure_shock_speed(drawn), out_dir, "fig5-shock-speed.png")
     return text + [f"![Fig. 5]({link}/{name})", ""] + rows + [""]
 
 
-def figure6(results, out_dir, link):
-    pair = (("single_shock_e0p90", "constant e = 0.9"), ("velocity_dependent", "e(v_n)"))
-    needs = [(c, "md") for c, _ in pair]
+RESTITUTION_PAIR = (("single_shock_e0p90", "constant e = 0.9"), ("velocity_dependent", "e(v_n)"))
+
+
+def figure_restitution(tables):
+    """Fig. 6: MD shock location and centre of mass for two restitution models; tables:
+    [(label, analysis, errors)]."""
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for (label, t, errors), (shock, com) in zip(tables, (("r^", "bo"), ("mx", "c+"))):
+        for column, what, style in (("shock_location", "shock", shock),
+                                    ("center_of_mass", "centre of mass", com)):
+            rc.draw_series(ax, "md", t["phase"], t[column], error_of(errors, column),
+                           label=f"MD {what}, {label}", marker=style[1], color=style[0])
+    draw_plate(ax, tables[0][1]["phase"], tables[0][1]["plate_z"])
+    ax.set_xlabel(PHASE)
+    ax.set_ylabel(HEIGHT_LAB)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def fig6_section(results, out_dir, link):
+    needs = [(c, "md") for c, _ in RESTITUTION_PAIR]
     text = ["## Fig. 6: constant against velocity-dependent restitution (MD, single shock)", ""]
-    tables = [(label, results.analysis(c, "md"), c) for c, label in pair]
-    tables = [t for t in tables if t[1] is not None]
+    tables = [(label, results.analysis_with_errors(c, "md"), c) for c, label in RESTITUTION_PAIR]
+    tables = [(label, *t, c) for label, t, c in tables if t is not None]
     if not tables:
         return text + [f"No plot: {missing_text(results, needs)}.", ""]
-    fig, ax = plt.subplots(figsize=(7, 5))
     rows = rc.table_head(["restitution", rc.analysis_header("shock speed", "shock_speed"),
                           rc.analysis_header("centre-of-mass apex", "center_of_mass_apex")])
-    for (label, t, case), (shock, com) in zip(tables, (("r^", "bo"), ("mx", "c+"))):
-        ax.plot(t["phase"], t["shock_location"], shock, label=f"shock, {label}")
-        ax.plot(t["phase"], t["center_of_mass"], com, label=f"centre of mass, {label}")
-        ax.plot(t["phase"], t["plate_z"], "k-", lw=2.5)
+    for label, t, _, case in tables:
         v = results.views[f"{case}/md"]
         rows.append(f"| {label} | {fmt(v['shock_speed'])}{pm(v.get('shock_speed_error'))} | "
                     f"{fmt(float(np.max(t['center_of_mass'])))} |")
-    ax.set_xlabel("f t")
-    ax.set_ylabel("z / sigma (lab frame)")
-    ax.legend(fontsize=8)
-    name = save(fig, out_dir, "fig6-restitution-models.png")
+    name = write(figure_restitution([t[:3] for t in tables]), out_dir,
+                 "fig6-restitution-models.png")
     note = missing_text(results, needs)
     return text + ([f"Missing: {note}.", ""] if note else []) + \
         [f"![Fig. 6]({link}/{name})", ""] + rows + [""]
 
 
-def figure7(results, out_dir, link):
+def figure_depths(runs):
+    """Fig. 7: centre of mass (top) and shock location (bottom) over a cycle per depth;
+    runs: [(depth label, solver, analysis, errors)]."""
+    fig, (a, b) = plt.subplots(2, 1, figsize=(7, 9), sharex=True)
+    colors = {}
+    for label, solver, t, errors in runs:
+        color = colors.setdefault(label, f"C{len(colors)}")
+        for ax, column in ((a, "center_of_mass"), (b, "shock_location")):
+            rc.draw_series(ax, solver, t["phase"], t[column], error_of(errors, column),
+                           label=f"{label} {rc.SOLVER_LABELS[solver]}", color=color)
+    a.set_ylabel("centre of mass, lab frame [sigma]")
+    b.set_ylabel("shock location, lab frame [sigma]")
+    b.set_xlabel(PHASE)
+    rc.legend_above(fig, columns=3)
+    return fig
+
+
+def fig7_section(results, out_dir, link):
     needs = [(c, s) for c, _ in DEPTHS for s in ("md", "continuum")]
     text = ["## Fig. 7: centre of mass over a cycle and shock location for H = 4.5, 9, 13.5",
             ""]
-    if not any(results.analysis(c, s) is not None for c, s in needs):
-        return text + [f"No plot: {missing_text(results, needs)}.", ""]
-    fig, (a, b) = plt.subplots(2, 1, figsize=(7, 9), sharex=True)
     # H: the depth of the layer at rest, in particle diameters.
     rows = rc.table_head([rc.with_units("H", "sigma"), "solver",
                           rc.analysis_header("mean centre of mass", "center_of_mass_mean"),
                           rc.analysis_header("formation f t", "phase"),
                           rc.analysis_header("shock speed", "shock_speed")])
-    for (case, label), color in zip(DEPTHS, ("C0", "C1", "C2")):
+    runs = []
+    for case, label in DEPTHS:
         for solver in ("md", "continuum"):
-            t = results.analysis(case, solver)
-            if t is None:
+            table = results.analysis_with_errors(case, solver)
+            if table is None:
                 continue
-            style = dict(ls="none", marker="o", ms=3) if solver == "md" else dict(ls="-")
-            a.plot(t["phase"], t["center_of_mass"], color=color, label=f"{label} {solver}",
-                   **style)
-            b.plot(t["phase"], t["shock_location"], color=color, label=f"{label} {solver}",
-                   **style)
+            t = table[0]
+            runs.append((label, solver, *table))
             v = results.views[f"{case}/{solver}"]
             rows.append(f"| {label[4:]} | {solver} | {fmt(float(np.mean(t['center_of_mass'])))}"
                         f" | {fmt(first_shock(t))} | {fmt(v['shock_speed'])} |")
-    a.set_ylabel("centre of mass z / sigma")
-    b.set_ylabel("shock location z / sigma")
-    b.set_xlabel("f t")
-    a.legend(fontsize=7)
-    name = save(fig, out_dir, "fig7-depths.png")
+    if not runs:
+        return text + [f"No plot: {missing_text(results, needs)}.", ""]
+    name = write(figure_depths(runs), out_dir, "fig7-depths.png")
     note = missing_text(results, needs)
     return text + (["Missing: " + note + ".", ""] if note else []) + \
         [f"![Fig. 7]({link}/{name})", ""] + rows + [""]
@@ -753,8 +863,9 @@ def main():
     link = os.path.basename(out_dir)
     body = []
     try:
-        for figure in (figure1, figure2, figure3, figure4, figure5, figure6, figure7):
-            body += figure(results, out_dir, link)
+        for section in (fig1_section, fig2_section, fig3_section, fig4_section, fig5_section,
+                        fig6_section, fig7_section):
+            body += section(results, out_dir, link)
         claims, counts = claims_section(results)
         text = header(results, counts) + body + claims + diagnoses_section(results) \
             + width_section(results) + sampling_section(results) + metrics_section(results)

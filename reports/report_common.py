@@ -5,10 +5,12 @@ Nothing under a final output name is ever half-written: text and figures go to a
 name in the same directory and are renamed into place.
 """
 import datetime
+import math
 import os
 import platform
 import re
 import subprocess
+import sys
 import tempfile
 
 
@@ -90,6 +92,72 @@ def save_figure_atomically(figure, path, dpi=90):
         if os.path.exists(temporary):
             os.unlink(temporary)
         raise
+
+
+# ---- figures --------------------------------------------------------------------------------
+# Every figure follows reports/figure_rules.py: units on both axes, MD drawn with its standard
+# errors, a legend naming everything drawn, a colorbar for a colour that carries a value.
+
+MD_STYLE = dict(marker="o", ms=3, ls="none", capsize=0, elinewidth=0.8)
+CONTINUUM_STYLE = dict(ls="-", lw=1.2)
+SOLVER_LABELS = {"md": "MD (± standard error)", "continuum": "continuum"}
+NU_PER_N = math.pi / 6  # nu = (pi/6) n (docs/analysis.md), so se(nu) = (pi/6) se(n)
+
+
+def profile_errors(profiles, k):
+    """The MD run file's standard errors of nu and T at stored phase k (n_se, T_se,
+    docs/output-schema.md), None where the run file has none (a continuum run)."""
+    if "n_se" not in profiles:
+        return {"nu": None, "T": None}
+    return {"nu": NU_PER_N * profiles["n_se"][k], "T": profiles["T_se"][k]}
+
+
+def draw_profile(ax, solver, value, z, error=None, label=None):
+    """A field against height: MD as points with horizontal standard-error bars, the continuum
+    as a line."""
+    label = label or SOLVER_LABELS[solver]
+    if solver == "md":
+        return ax.errorbar(value, z, xerr=error, label=label, **MD_STYLE)
+    return ax.plot(value, z, label=label, **CONTINUUM_STYLE)
+
+
+def draw_series(ax, solver, x, y, error=None, label=None, **style):
+    """A quantity against phase: MD as points with vertical standard-error bars (where the
+    analysis gives them), the continuum as a line."""
+    if solver == "md":
+        return ax.errorbar(x, y, yerr=error, label=label, **{**MD_STYLE, **style})
+    return ax.plot(x, y, label=label, **{**CONTINUUM_STYLE, **style})
+
+
+def legend_above(fig, columns=4, fontsize=8, where="top"):
+    """One legend for every panel, above them (below them, where="bottom", for a figure with a
+    title): each label drawn in any axes, once. Lays the figure out leaving it room."""
+    handles = {}
+    for ax in fig.axes:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(label, handle)
+    columns = min(columns, len(handles)) or 1
+    room = (0.25 * -(-len(handles) // columns) + 0.15) / fig.get_figheight()
+    top = where == "top"
+    fig.tight_layout(rect=(0, 0, 1, 1 - room) if top else (0, room, 1, 1))
+    fig.legend(handles.values(), handles.keys(), loc="upper center" if top else "lower center",
+               ncol=columns, fontsize=fontsize, frameon=False)
+
+
+def write_figure(figure, out_dir, name):
+    """Writes a laid-out figure as out_dir/name (atomically) and closes it; returns name.
+    What breaks the rules of figure_rules.py (data the tests did not foresee: a legend on the
+    points, a label too long) is named on stderr; the figure is written all the same."""
+    import matplotlib.pyplot as plt  # only the generators that draw need matplotlib
+    if __package__:
+        from . import figure_rules
+    else:  # a generator run as a script: reports/ is first on sys.path
+        import figure_rules
+    for problem in figure_rules.figure_problems(figure):
+        print(f"{name}: not fit to publish: {problem}", file=sys.stderr)
+    save_figure_atomically(figure, os.path.join(out_dir, name))
+    plt.close(figure)
+    return name
 
 
 def fmt(x, digits=4):

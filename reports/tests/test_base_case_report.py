@@ -35,14 +35,17 @@ def write_md_run(runs):
         profiles["phase"] = np.arange(PHASES) / PHASES
         profiles["plate_z"] = np.zeros(PHASES)
         profiles["z"] = z
-        profiles["nu"] = 0.3 * np.exp(-z / 10.0)
-        profiles["T"] = 0.1 + 0.01 * z
+        nu, T = 0.3 * np.exp(-z / 10.0), 0.1 + 0.01 * z
+        profiles["nu"], profiles["T"], profiles["n"] = nu, T, nu * 6 / np.pi
+        # The MD run file's standard errors (docs/output-schema.md).
+        profiles["n_se"], profiles["T_se"] = 0.02 * nu * 6 / np.pi, 0.02 * T
     with open(os.path.join(runs, "md-analysis.csv"), "w") as f:
-        f.write(",".join(ANALYSIS_COLUMNS) + "\n")
+        # As `shaker analyze --csv` writes it: the values, then an _error column for each.
+        f.write(",".join(ANALYSIS_COLUMNS + tuple(c + "_error" for c in ANALYSIS_COLUMNS))
+                + "\n")
         for k in range(PHASES):
-            f.write(",".join([str(k / PHASES)] + [str(10 * k + c)
-                                                  for c in range(1, len(ANALYSIS_COLUMNS))])
-                    + "\n")
+            values = [k / PHASES] + [10 * k + c for c in range(1, len(ANALYSIS_COLUMNS))]
+            f.write(",".join(str(x) for x in values + [0.1] * len(values)) + "\n")
     with open(os.path.join(runs, "md.log"), "w") as f:
         f.write("synthetic MD run\n")
 
