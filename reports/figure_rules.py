@@ -34,6 +34,9 @@ OVERLAP_PIXELS = 0.5
 
 
 def figure_problems(fig):
+    if not hasattr(fig.canvas, "get_renderer"):  # a Figure made without pyplot has no backend
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        FigureCanvasAgg(fig)
     fig.canvas.draw()
     colorbars = colorbars_of(fig)
     problems = []

@@ -51,8 +51,7 @@ def resolution(attrs):
 
 
 def read_analysis(path):
-    data = np.genfromtxt(path, delimiter=",", names=True)
-    return data
+    return rc.read_shaker_csv(path)[0]
 
 
 def nearest(phases, target):
@@ -88,7 +87,7 @@ def figure_trajectories(analyses):
         name = "MD" if solver == "md" else solver
         for column, what, style in (("center_of_mass", "centre of mass", {}),
                                     ("shock_location", "shock", dict(marker="^", ls="none"))):
-            error = a[column + "_error"] if column + "_error" in a.dtype.names else None
+            error = a[column + "_error"] if column + "_error" in a else None
             rc.draw_series(ax, solver, a["phase"], a[column], error,
                            label=f"{name} {what}", **style)
     plate = next(iter(analyses.values()))
@@ -151,8 +150,8 @@ def main():
             lines += [f"## {solver}: analysis per phase (every fifth stored phase)", ""]
             lines += rc.table_head([rc.analysis_header(label, column)
                                     for label, column in PHASE_TABLE_COLUMNS])
-            for row in a[::5]:
-                lines.append("| " + " | ".join(fmt(row[column])
+            for k in range(0, len(a["phase"]), 5):
+                lines.append("| " + " | ".join(fmt(a[column][k])
                                                for _, column in PHASE_TABLE_COLUMNS) + " |")
             lines.append("")
     else:

@@ -210,10 +210,10 @@ SOLVER_NAMES = {"md": "MD", "continuum": "continuum (validation settings)"}
 def read_profiles(path):
     """`shaker analyze --profiles-csv`: per phase, the columns as arrays, Kn the larger of
     Kn_n and Kn_T (NaN where neither is defined)."""
-    table = np.genfromtxt(path, delimiter=",", names=True)
+    table = rc.read_shaker_csv(path)[0]
     phases = {}
     for phase in np.unique(table["phase"]):
-        rows = table[table["phase"] == phase]
+        rows = {name: values[table["phase"] == phase] for name, values in table.items()}
         kn = np.fmax(rows["kn_n"], rows["kn_T"])
         phases[round(float(phase), 6)] = dict(z=rows["z"], nu=rows["nu"], T=rows["T"], kn=kn)
     return phases

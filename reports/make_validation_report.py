@@ -14,7 +14,6 @@ header of a column holding one quantity, in a units column where rows hold diffe
 (the claims', evidence's and metrics' units come with them in results.json).
 """
 import argparse
-import csv
 import json
 import math
 import os
@@ -94,11 +93,9 @@ class Results:
             prof = {k: np.array(f["profiles"][k]) for k in f["profiles"]}
         mach_csv = v["path"] + ".profiles.csv"  # `shaker analyze --profiles-csv`
         if os.path.exists(mach_csv):
-            with open(mach_csv) as f:
-                rows = list(csv.DictReader(f))
-            if len(rows) == prof["z"].size:
-                prof["mach"] = np.array([float(r["mach"]) for r in rows]).reshape(
-                    prof["z"].shape)
+            mach = rc.read_shaker_csv(mach_csv)[0]["mach"]
+            if mach.size == prof["z"].size:
+                prof["mach"] = mach.reshape(prof["z"].shape)
         return prof
 
     def status(self, case, solver):

@@ -13,6 +13,8 @@ import subprocess
 import sys
 import tempfile
 
+import numpy as np
+
 
 def git_commit(repository):
     try:
@@ -102,6 +104,20 @@ MD_STYLE = dict(marker="o", ms=3, ls="none", capsize=0, elinewidth=0.8)
 CONTINUUM_STYLE = dict(ls="-", lw=1.2)
 SOLVER_LABELS = {"md": "MD (± standard error)", "continuum": "continuum"}
 NU_PER_N = math.pi / 6  # nu = (pi/6) n (docs/analysis.md), so se(nu) = (pi/6) se(n)
+
+
+def read_shaker_csv(path):
+    """A CSV of `shaker analyze` (--csv, --profiles-csv), whose header names each column with
+    its units in brackets ("z [sigma]"): {name: float array}, {name: units}."""
+    with open(path) as f:
+        header = f.readline().rstrip("\n").split(",")
+    names, units = [], {}
+    for cell in header:
+        name, _, unit = cell.partition(" [")
+        names.append(name)
+        units[name] = unit.rstrip("]")
+    table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return {name: table[:, i] for i, name in enumerate(names)}, units
 
 
 def profile_errors(profiles, k):

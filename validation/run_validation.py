@@ -173,30 +173,13 @@ def fill_view(view, data):
         view.replicates.append(rep)
 
 
-# The units of the metrics of `shaker compare --csv` (comparison_metrics in
-# solvers/app/commands.cpp; docs/analysis.md): RMS differences of a height over the phases
-# where both runs have it, the same over the reference's RMS, the number of those phases, and
-# the mean and largest (over phases) bin-mean |difference| of the nu and T profiles.
-COMPARISON_METRIC_UNITS = {
-    "shock_location_fractional_rms": "1",
-    "shock_location_absolute_rms": "sigma",
-    "shock_location_phases": "1",
-    "center_of_mass_fractional_rms": "1",
-    "center_of_mass_absolute_rms": "sigma",
-    "center_of_mass_phases": "1",
-    "nu_l1_mean_over_phases": "1",
-    "nu_linf_max_over_phases": "1",
-    "T_l1_mean_over_phases": "g sigma",
-    "T_linf_max_over_phases": "g sigma",
-}
-
-
 class Comparer:
     """`shaker compare --csv A B`, cached per pair of files; a replicate view gets the
-    matching jackknife replicate of the comparison."""
+    matching jackknife replicate of the comparison; `units` collects each metric's units as
+    the CSV gives them."""
 
     def __init__(self, shaker, directory):
-        self.shaker, self.directory, self.cache = shaker, directory, {}
+        self.shaker, self.directory, self.cache, self.units = shaker, directory, {}, {}
 
     def __call__(self, a, b):
         index = a.replicate_index if a.replicate_index is not None else b.replicate_index
@@ -211,6 +194,7 @@ class Comparer:
                 raise quantities.NotMeasured(f"shaker compare failed: {result.stderr.strip()}")
             with open(out) as f:
                 self.cache[key] = list(csv.DictReader(f))
+            self.units.update({r["metric"]: r["units"] for r in self.cache[key]})
         rows = self.cache[key]
         if index is None:
             return {r["metric"]: float(r["value"]) for r in rows}
@@ -753,9 +737,7 @@ def main(argv=None):
         wall_seconds=time.monotonic() - started,
         simulated_seconds=sum(r["seconds"] for r in runs if not r["reused"]),
         runs=runs, metrics=metrics, claims=results, diagnoses=diagnosed, sampling=sampling,
-        # Only metrics with declared units: the report refuses to show one without them.
-        metric_units={name: COMPARISON_METRIC_UNITS[name] for m in metrics.values()
-                      for name in m if name in COMPARISON_METRIC_UNITS},
+        metric_units={name: comparer.units[name] for m in metrics.values() for name in m},
         undiagnosed=undiagnosed,
         views={f"{c}/{s}": dict(case=c, solver=s, status=v.status, path=v.path,
                                 analysis_json=getattr(v, "analysis_json", None),

@@ -32,21 +32,20 @@ def plot_profiles(run, quantities=("n", "T"), phases=(0.0, 0.25, 0.5, 0.75), zma
     """Profiles against height, one axis per quantity, a line per phase (the stored phases
     nearest `phases`) and the plate's height at that phase; for MD a band of one standard
     error."""
-    figure = figure or Figure(figsize=(7, 0.5 + 3.5 * len(quantities)), layout="constrained")
+    figure = figure or Figure(figsize=(10, 0.5 + 3.5 * len(quantities)), layout="constrained")
     axes = figure.subplots(len(quantities), 1, squeeze=False)[:, 0]
     rows = [_row_of(run, phase) for phase in phases]
     for ax, quantity in zip(axes, quantities):
-        for i, (row, colour) in enumerate(zip(rows, _colours(len(rows)))):
-            label = f"{_solver_name(run)}, f t = {run.profiles['phase'][row]:.3g}"
-            first = i == 0
-            _draw_profile(ax, run, quantity, row, colour, label,
-                          "± 1 standard error (shaded)" if first else None)
+        for row, colour in zip(rows, _colours(len(rows))):
+            phase = f"f t = {run.profiles['phase'][row]:.3g}"
+            _draw_profile(ax, run, quantity, row, colour, f"{_solver_name(run)}, {phase}")
             ax.axvline(run.plate_height()[row], color=colour, linestyle=":",
-                       label="plate (dotted, colour of its phase)" if first else None)
+                       label=f"plate, {phase} (dotted)")
         ax.set_xlabel(height_label(run.frame, run.profiles.units["z"]))
         ax.set_ylabel(profile_label(run, quantity))
         ax.set_xlim(*_height_range(run, rows, zmax))
-        ax.legend(fontsize="small", ncol=2)
+        # Beside the axes, where it hides no data.
+        ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0))
     return figure
 
 
@@ -104,7 +103,7 @@ def plot_md_against_continuum(md, continuum, quantity="n", phases=(0.0, 0.25, 0.
         if abs(md_phase - continuum_phase) > 1e-9:
             raise ValueError(f"no common stored phase near f t = {phase}: MD has {md_phase}, "
                              f"the continuum {continuum_phase}")
-        _draw_profile(ax, md, quantity, md_row, "tab:blue", "MD", "MD ± 1 standard error")
+        _draw_profile(ax, md, quantity, md_row, "tab:blue", "MD")
         _draw_profile(ax, continuum, quantity, continuum_row, "tab:orange", "continuum")
         ax.axvline(md.plate_height()[md_row], color="black", linestyle=":", label="plate")
         ax.set_title(f"f t = {md_phase:.3g}")
@@ -115,16 +114,15 @@ def plot_md_against_continuum(md, continuum, quantity="n", phases=(0.0, 0.25, 0.
     return figure
 
 
-def _draw_profile(ax, run, quantity, row, colour, label, band_label=None):
+def _draw_profile(ax, run, quantity, row, colour, label):
     """The profile at `row`, and where the run has standard errors (MD) a band of one."""
     p = run.profiles
     z, values = p["z"][row], p[quantity][row]
     ax.plot(z, values, color=colour, label=label)
     error = p.get(f"{quantity}_se")
     if error is not None:
-        # A label starting with "_" keeps the band out of the legend.
         ax.fill_between(z, values - error[row], values + error[row], color=colour, alpha=0.25,
-                        linewidth=0, label=band_label or "_band")
+                        linewidth=0, label=f"{label}: ± 1 standard error (shaded)")
 
 
 def _space_time_edges(phase, z, bin_height):

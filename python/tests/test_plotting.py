@@ -102,3 +102,26 @@ def test_md_against_continuum(runs):
     with pytest.raises(ValueError, match="the MD run is in the lab frame, the continuum run in "
                                          "the plate frame"):
         plotting.plot_md_against_continuum(md, gs.read_run(runs[1], frame="plate"))
+
+
+def every_figure(runs):
+    """Every plot_* helper of granular_shaker.plotting, drawn once."""
+    md, continuum = gs.read_run(runs[0]), gs.read_run(runs[1])
+    return {
+        "plot_profiles": plotting.plot_profiles(md, ("n", "T", "uz"), phases=(0.0, 0.5)),
+        "plot_center_of_mass_and_shock": plotting.plot_center_of_mass_and_shock(
+            [gs.read_analysis_json(synthetic.analysis_json())]),
+        "plot_space_time": plotting.plot_space_time(continuum, "T"),
+        "plot_md_against_continuum": plotting.plot_md_against_continuum(md, continuum, "n"),
+    }
+
+
+def test_every_helper_meets_the_reports_figure_rules(runs):
+    """The rules every report figure meets (reports/figure_rules.py: units in brackets, legends,
+    colorbars, MD errors, nothing overlapping), for every public helper."""
+    from reports.figure_rules import figure_problems
+    figures = every_figure(runs)
+    helpers = {name for name in dir(plotting) if name.startswith("plot_")}
+    assert set(figures) == helpers
+    for name, figure in figures.items():
+        assert figure_problems(figure) == [], name

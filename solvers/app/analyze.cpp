@@ -163,8 +163,9 @@ std::string analysis_json(const std::vector<std::string>& inputs, const RunRecor
 
 std::string analysis_csv(const Estimates& phases) {
   std::vector<std::string> header;
-  for (const auto& c : phases.central) header.push_back(c.name);
-  for (const auto& c : phases.central) header.push_back(c.name + "_error");
+  // Each column's units in brackets after its name, as in the profiles CSV.
+  for (const auto& c : phases.central) header.push_back(fmt::format("{} [{}]", c.name, c.unit));
+  for (const auto& c : phases.central) header.push_back(fmt::format("{}_error [{}]", c.name, c.unit));
   std::string csv = fmt::format("{}\n", fmt::join(header, ","));
   const std::size_t rows = phases.central.front().values.size();
   for (std::size_t k = 0; k < rows; ++k) {
@@ -209,7 +210,7 @@ void print_table(const std::string& title, const Estimates& phases, const Estima
 // One row per stored phase and bin: the profile, its Mach number (for plots of Ma(z)) and its
 // local Knudsen numbers (NaN where undefined).
 void write_profiles_csv(const RunRecord& run, const std::string& path) {
-  std::string csv = "phase,z,n,nu,uz,T,mach,kn_n,kn_T\n";
+  std::string csv = "phase [1],z [sigma],n [1/sigma^3],nu [1],uz [sqrt(g sigma)],T [g sigma],mach [1],kn_n [1],kn_T [1]\n";
   for (const auto& p : run.profiles) {
     const auto mach = analysis::mach_number(p, run.e);
     const auto kn = analysis::knudsen_numbers(p);

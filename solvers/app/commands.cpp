@@ -129,6 +129,13 @@ std::vector<std::pair<std::string, double>> comparison_metrics(const analysis::R
           {"T_linf_max_over_phases", T_max}};
 }
 
+/// The units of each metric of comparison_metrics (docs/analysis.md).
+std::string metric_units(const std::string& metric) {
+  if (metric.find("absolute_rms") != std::string::npos || metric.rfind("T_", 0) == 0)
+    return metric.rfind("T_", 0) == 0 ? "g sigma" : "sigma";
+  return "1";  // fractional RMS, counts of phases, volume fractions
+}
+
 /// Replicate s leaves sample s out of each run that has more than s samples (a paired
 /// jackknife: for independent runs its variance is the sum of the two runs' variances).
 std::vector<std::vector<std::pair<std::string, double>>> comparison_replicates(const RunRecord& a,
@@ -207,12 +214,12 @@ int command_compare(const std::string& first, const std::string& second,
                r.nu_norms[k].l1, r.nu_norms[k].l2, r.nu_norms[k].linf, r.T_norms[k].l1,
                r.T_norms[k].l2, r.T_norms[k].linf);
   if (!csv_file.empty()) {
-    std::string csv = "metric,value,error,replicates\n";
+    std::string csv = "metric,value,error,units,replicates\n";
     for (std::size_t i = 0; i < metrics.size(); ++i) {
       std::vector<std::string> reps;
       for (const auto& rep : replicates) reps.push_back(fmt::format("{}", rep[i].second));
-      csv += fmt::format("{},{},{},{}\n", metrics[i].first, metrics[i].second, errors[i],
-                         fmt::join(reps, ";"));
+      csv += fmt::format("{},{},{},{},{}\n", metrics[i].first, metrics[i].second, errors[i],
+                         metric_units(metrics[i].first), fmt::join(reps, ";"));
     }
     write_text_atomically(csv_file, csv);
   }

@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
                  "location and centre of mass, profile norms of nu and T");
   compare->add_option("A", first, "HDF5 run file")->required();
   compare->add_option("B", second, "HDF5 run file (the reference)")->required();
-  compare->add_option("--csv", compare_csv, "also write the metrics as metric,value CSV");
+  compare->add_option("--csv", compare_csv, "also write the metrics as CSV (metric,value,error,units,replicates)");
 
   try {
     app.parse(argc, argv);
