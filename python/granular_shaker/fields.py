@@ -9,6 +9,8 @@ from ._common import (SchemaError, Table, check_frame, check_schema_version, pro
 
 KIND = "shaker continuum fields"
 FIELD_NAMES = ("n", "ux", "uy", "uz", "T")
+# Written by newer versions of shaker (nu, the velocity vector nz x ny x nx x 3, the cycle).
+OPTIONAL_FIELD_NAMES = ("nu", "velocity")
 # The snapshot groups' attributes and their units (output-schema.md).
 _SNAPSHOT_ATTRIBUTES = {"time": "sqrt(sigma/g)", "phase": "1", "plate_z": "sigma",
                         "plate_v": "sqrt(g sigma)"}
@@ -20,7 +22,8 @@ class Fields:
 
     snapshots: `time`, `phase`, `plate_z`, `plate_v` (S; the plate's lab-frame motion), `z`
     (S x nz, the cell centres' heights in this frame), `points` (S x P x 3, cell corners in this
-    frame), and the fields `n`, `ux`, `uy`, `uz`, `T` (S x nz x ny x nx, z slowest). hexahedra:
+    frame), and the fields `n`, `ux`, `uy`, `uz`, `T` (S x nz x ny x nx, z slowest), with `nu`,
+    `velocity` (S x nz x ny x nx x 3) and `cycle` where the file has them. hexahedra:
     the corners of each cell (N x 8, VTK order). shape: (nx, ny, nz).
     """
     path: str
@@ -63,9 +66,14 @@ def read_fields(path, frame="lab"):
         snapshots = Table(
             {key: np.array([float(g.attrs[key]) for g in groups]) for key in _SNAPSHOT_ATTRIBUTES},
             _SNAPSHOT_ATTRIBUTES)
-        for name in ("points", *FIELD_NAMES):
+        for name in ("points", *FIELD_NAMES, *OPTIONAL_FIELD_NAMES):
+            if name in OPTIONAL_FIELD_NAMES and name not in groups[0]:
+                continue
             snapshots[name] = np.stack([g[name][()] for g in groups])
             snapshots.units[name] = units_of(groups[0][name], path)
+        if "cycle" in groups[0].attrs:
+            snapshots["cycle"] = np.array([int(g.attrs["cycle"]) for g in groups])
+            snapshots.units["cycle"] = "1"
         hexahedra = f["hexahedra"][()]
     plate_z = snapshots["plate_z"]
     snapshots["z"] = (np.arange(nz) + 0.5) * h + plate_z[:, None]
@@ -75,5 +83,8 @@ def read_fields(path, frame="lab"):
         snapshots["points"] = snapshots["points"].copy()
         snapshots["points"][:, :, 2] -= plate_z[:, None]
         snapshots["uz"] = snapshots["uz"] - snapshots["plate_v"][:, None, None, None]
+        if "velocity" in snapshots:
+            snapshots["velocity"] = snapshots["velocity"].copy()
+            snapshots["velocity"][..., 2] -= snapshots["plate_v"][:, None, None, None]
     return Fields(str(path), frame, attributes, configuration, h, (nx, ny, nz), hexahedra,
                   snapshots)

@@ -174,6 +174,9 @@ def write_fields(path, seed=2):
             fields = {name: rng.uniform(0.1, 1.0, size=(NZ, NY, NX)) for name in FIELD_UNITS}
             for name, data in fields.items():
                 _dataset(g, name, data, FIELD_UNITS[name])
+            fields["velocity"] = np.stack([fields["ux"], fields["uy"], fields["uz"]], axis=-1)
+            _dataset(g, "velocity", fields["velocity"], "sqrt(g sigma)")
+            g.attrs["cycle"] = np.int64(10)
             snapshots.append({"plate_z": plate_z, "plate_v": plate_v, "points": points,
                               **fields})
     return snapshots

@@ -128,6 +128,10 @@ def test_fields_frames_and_horizontal_averages(work_dir):
                                    w["points"][:, 2] - w["plate_z"], atol=1e-13)
         np.testing.assert_array_equal(plate.snapshots["uz"][s], w["uz"] - w["plate_v"])
         np.testing.assert_array_equal(plate.snapshots["T"][s], w["T"])
+        np.testing.assert_array_equal(lab.snapshots["velocity"][s], w["velocity"])
+        np.testing.assert_array_equal(plate.snapshots["velocity"][s][..., 2],
+                                      w["uz"] - w["plate_v"])
+        assert lab.snapshots["cycle"][s] == 10
         averages = lab.horizontal_averages()
         n = w["n"].reshape(nz, -1)
         np.testing.assert_allclose(averages["n"][s], n.mean(axis=1), rtol=1e-14)
