@@ -444,8 +444,8 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   const bool continued = !checkpoints.restart_from.empty();
   const std::string here = continued ? " in this continuation" : "";
   const auto print_counts = [](const std::string& span, const CollisionCounts& c) {
-    fmt::print("  collisions{}: {} (pair {}, plate {}, ceiling {}); collapse guard activations{}: {}\n",
-               span, count(c.total()), count(c.pair), count(c.plate), count(c.ceiling), span,
+    fmt::print("  collisions{}: {} (pair {}, plate {}, ceiling {}), collapse guard activations {}\n",
+               span, count(c.total()), count(c.pair), count(c.plate), count(c.ceiling),
                count(c.guard_activations));
   };
   print_counts(here, all.this_run);

@@ -377,12 +377,15 @@ std::map<std::string, CollisionLine> collision_lines(const std::string& printed)
   const std::string start = "  collisions";
   for (std::string line; std::getline(lines, line);) {
     if (line.rfind(start, 0) != 0) continue;
-    const std::size_t colon = line.find(": ");
+    const std::string guard_label = "collapse guard activations ";
+    const std::size_t colon = line.find(": "), guard_at = line.rfind(guard_label);
     CollisionLine c;
-    const int read = std::sscanf(line.c_str() + colon + 2, "%llu (pair %llu, plate %llu, ceiling %llu)",
-                                 &c.total, &c.pair, &c.plate, &c.ceiling);
-    const int guard = std::sscanf(line.c_str() + line.rfind(": ") + 2, "%llu", &c.guard);
-    EXPECT_TRUE(read == 4 && guard == 1) << line;
+    const bool parsed =
+        colon != std::string::npos && guard_at != std::string::npos &&
+        std::sscanf(line.c_str() + colon + 2, "%llu (pair %llu, plate %llu, ceiling %llu)", &c.total,
+                    &c.pair, &c.plate, &c.ceiling) == 4 &&
+        std::sscanf(line.c_str() + guard_at + guard_label.size(), "%llu", &c.guard) == 1;
+    EXPECT_TRUE(parsed) << line;
     out[line.substr(start.size(), colon - start.size())] = c;
   }
   return out;
