@@ -599,14 +599,15 @@ Profile removed(const Profile& p, const std::vector<std::size_t>& gone) {
 bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 
 TEST(UndefinedBins, EmptyBinsInAndAboveTheLayerChangeNoResult) {
-  // A shock moving up through a layer (bottom at the plate, top near 34), with standard
-  // errors; empty bins inside the layer (z = 8.5, 29.5) and in the gas above it (40.5, 45.5,
-  // both in the span of temperature_slope_above) must give the numbers of the same profiles
-  // without those bins: nothing undefined reaches a defined result.
-  const std::vector<std::size_t> gone{8, 29, 40, 45};
+  // A shock at zs = 16 + k moving up through a layer (bottom at the plate, top near zs + 15),
+  // with standard errors; empty bins inside the layer (z = 8.5, 29.5, and zs - 1.5, just
+  // above the temperature maximum, where the walk to the steepest drop passes) and in the gas
+  // above it (40.5, 45.5, both in the span of temperature_slope_above) must give the numbers
+  // of the same profiles without those bins: nothing undefined reaches a defined result.
   std::vector<Profile> with_empty, without;
-  for (int k = 0; k < 6; ++k) {
-    Profile p = at(0.5 * k, 0.0, shock_profile(16.0 + k, 0.8));
+  for (std::size_t k = 0; k < 6; ++k) {
+    const std::vector<std::size_t> gone{8, 14 + k, 29, 40, 45};
+    Profile p = at(0.5 * static_cast<double>(k), 0.0, shock_profile(16.0 + static_cast<double>(k), 0.8));
     p.n_se.assign(p.size(), 0.01);
     p.uz_se.assign(p.size(), 0.02);
     p.T_se.assign(p.size(), 0.03);
@@ -647,6 +648,7 @@ TEST(UndefinedBins, EmptyBinsInAndAboveTheLayerChangeNoResult) {
               "front width %.6f at the first phase\n", a.phases[0].layer_temperature,
               a.phases[0].temperature_slope_above, a.shock->speed, a.phases[0].front->width);
   // The agreement metrics leave out the heights where a run is undefined.
+  const std::vector<std::size_t> gone{8, 29, 40, 45};
   const Profile reference = shock_profile(18.0, 0.8);
   const Profile md = emptied(shock_profile(18.0, 0.8), gone);
   const auto T = profile_difference(md, reference, "T");
