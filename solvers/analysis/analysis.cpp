@@ -20,8 +20,10 @@ double crossing(const Profile& p, std::size_t i, std::size_t j, double level) {
 
 bool in_layer(const Profile& p, std::size_t i) { return p.nu[i] > layer_volume_fraction; }
 
+/// A standard error not stored, or undefined (NaN: fewer than two samples), counts as 0:
+/// then only the relative criteria apply.
 double standard_error(const std::vector<double>& se, std::size_t i) {
-  return se.empty() ? 0.0 : se[i];
+  return se.empty() || !std::isfinite(se[i]) ? 0.0 : se[i];
 }
 
 /// The smallest change of T between bins i and j that is not noise.
@@ -69,6 +71,18 @@ double interpolate(const std::vector<double>& z, const std::vector<double>& f, d
   return f[j - 1] + s * (f[j] - f[j - 1]);
 }
 
+Profile with_defined_temperature(const Profile& p) {
+  Profile q = p;
+  for (auto field : {&Profile::z, &Profile::n, &Profile::nu, &Profile::uz, &Profile::T,
+                     &Profile::samples, &Profile::n_se, &Profile::uz_se, &Profile::T_se}) {
+    if ((p.*field).empty()) continue;
+    (q.*field).clear();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!std::isnan(p.T[i])) (q.*field).push_back((p.*field)[i]);
+  }
+  return q;
+}
+
 std::optional<Layer> find_layer(const Profile& p) {
   std::optional<std::size_t> first, last;
   for (std::size_t i = 0; i < p.size(); ++i)
@@ -82,6 +96,10 @@ std::optional<Layer> find_layer(const Profile& p) {
                              : crossing(p, *first - 1, *first, layer_volume_fraction);
   layer.top = *last + 1 == p.size() ? p.z[*last] + 0.5 * p.bin_height
                                      : crossing(p, *last, *last + 1, layer_volume_fraction);
+  // MD bins are fixed in the lab frame: one cut by the raised plate has its material above the
+  // plate, though the interpolation spreads it over the whole bin.
+  layer.bottom = std::max(layer.bottom, p.plate_z);
+  layer.top = std::max(layer.top, p.plate_z);
   return layer;
 }
 
@@ -97,7 +115,11 @@ double center_of_mass(const Profile& p) {
 std::vector<double> mach_number(const Profile& p, double e) {
   std::vector<double> ma(p.size(), 0.0);
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (!(p.nu[i] > 0.0 && p.T[i] > 0.0)) continue;
+    if (!(p.nu[i] > 0.0) || std::isnan(p.T[i]) || std::isnan(p.uz[i])) {
+      ma[i] = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    if (!(p.T[i] > 0.0)) continue;
     // An MD bin can be packed beyond nu_max; c diverges as nu -> nu_max, so Ma -> 0 there.
     if (p.nu[i] >= nu_max) continue;
     ma[i] = std::abs(p.uz[i] - p.plate_v) / model::sound_speed(p.nu[i], p.T[i], e);
@@ -109,11 +131,12 @@ double max_mach_in_layer(const Profile& p, double e) {
   const auto ma = mach_number(p, e);
   double best = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (in_layer(p, i)) best = std::max(best, ma[i]);
+    if (in_layer(p, i) && !std::isnan(ma[i])) best = std::max(best, ma[i]);
   return best;
 }
 
-std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& c) {
+std::optional<Shock> find_shock(const Profile& profile, const ShockCriteria& c) {
+  const Profile p = with_defined_temperature(profile);
   // Walk up from the plate: the running temperature maximum inside the layer becomes the top
   // of the compressed region once T has fallen significantly below it; the running minimum
   // after it becomes the bottom of the undisturbed region once T has risen again.
@@ -161,12 +184,12 @@ std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& c) {
   Shock shock;
   shock.location = steepest_descent_height(p, steepest);
   // Once the steepest drop is above the layer's top the shock has left the layer.
-  const auto layer = find_layer(p);
+  const auto layer = find_layer(profile);
   if (!layer || shock.location > layer->top) return std::nullopt;
   shock.compressed_top = p.z[*peak];
   shock.undisturbed_bottom = p.z[*trough];
   shock.width = shock.undisturbed_bottom - shock.compressed_top;
-  shock.mean_free_path = model::mean_free_path(interpolate(p.z, p.n, shock.location));
+  shock.mean_free_path = model::mean_free_path(interpolate(profile.z, profile.n, shock.location));
   return shock;
 }
 
@@ -209,6 +232,7 @@ ProfileNorms profile_difference(const Profile& a, const Profile& b, const std::s
   for (std::size_t i = 0; i < a.size(); ++i) {
     if (a.z[i] < b.z.front() || a.z[i] > b.z.back()) continue;
     const double d = std::abs((a.*member)[i] - interpolate(b.z, b.*member, a.z[i]));
+    if (std::isnan(d)) continue;  // undefined in either run (an MD bin without particles)
     sum += d;
     squares += d * d;
     norms.linf = std::max(norms.linf, d);

@@ -13,7 +13,8 @@ namespace shaker::analysis {
 inline constexpr double layer_volume_fraction = 0.04 * 0.65;
 
 struct Layer {
-  double bottom = 0.0;  ///< lowest height where nu crosses the threshold (interpolated)
+  /// lowest height where nu crosses the threshold (interpolated), never below the plate
+  double bottom = 0.0;
   double top = 0.0;     ///< highest such height
 };
 /// The layer, or nothing if no bin exceeds the threshold.
@@ -25,7 +26,8 @@ double interpolate(const std::vector<double>& z, const std::vector<double>& f, d
 /// Centre-of-mass height of all the material, sum(n z) / sum(n).
 double center_of_mass(const Profile& p);
 
-/// Ma = |u_z - V_p| / c in every bin (0 where there is no material).
+/// Ma = |u_z - V_p| / c in every bin (NaN where there is no material or u_z or T is
+/// undefined, 0 where T = 0).
 std::vector<double> mach_number(const Profile& p, double e);
 /// Largest Ma inside the layer (0 if there is no layer).
 double max_mach_in_layer(const Profile& p, double e);
@@ -55,11 +57,16 @@ struct Shock {
 /// below the layer's top (see find_shock in analysis.cpp for why).
 std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& criteria = {});
 
+/// The bins of p where T is defined (NaN marks an MD bin with fewer than two particles), every
+/// field of p kept for those bins. What walks T from bin to bin (the shock, the fitted front)
+/// skips an undefined bin as if it were not there.
+Profile with_defined_temperature(const Profile& p);
+
 /// Local Knudsen numbers per bin (docs/analysis.md): the mean free path xi over the gradient
 /// length of density, Kn_n = xi |dn/dz| / n, and of temperature, Kn_T = xi |dT/dz| / T.
 /// Gradients are central differences over the neighbouring bins with material (one-sided at
 /// the ends and beside an empty bin); NaN where the bin has no material or no defined
-/// neighbour, and Kn_T NaN where T is not positive.
+/// neighbour, and Kn_T NaN where T is not positive or undefined.
 struct KnudsenNumbers {
   std::vector<double> density, temperature;
 };
@@ -95,7 +102,8 @@ struct ProfileNorms {
   std::size_t count = 0;                  ///< heights compared
 };
 /// Norms of a.field - b.field at a's heights inside the range both cover (b interpolated
-/// linearly). field is "nu" or "T".
+/// linearly), leaving out heights where either is undefined (NaN: an MD bin without
+/// particles). field is "nu" or "T".
 ProfileNorms profile_difference(const Profile& a, const Profile& b, const std::string& field);
 
 /// The metrics of physics.md between two runs sampled at the same phases.

@@ -17,13 +17,16 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
+/// Height below which `fraction` of the material lies, the material spread evenly over each
+/// bin; never below the plate, which a lab-frame MD bin cut by the plate reaches below.
 double mass_quantile_height(const Profile& p, double fraction) {
   const double total = std::accumulate(p.n.begin(), p.n.end(), 0.0);
   if (!(total > 0.0)) return nan;
   double below = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (below + p.n[i] >= fraction * total)
-      return p.z[i] - 0.5 * p.bin_height + p.bin_height * (fraction * total - below) / p.n[i];
+      return std::max(p.plate_z, p.z[i] - 0.5 * p.bin_height +
+                                     p.bin_height * (fraction * total - below) / p.n[i]);
     below += p.n[i];
   }
   return p.z.back() + 0.5 * p.bin_height;
@@ -33,7 +36,7 @@ double layer_temperature(const Profile& p, const std::optional<Layer>& layer) {
   if (!layer) return nan;
   double n = 0.0, nT = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (p.z[i] >= layer->bottom && p.z[i] <= layer->top) {
+    if (p.z[i] >= layer->bottom && p.z[i] <= layer->top && !std::isnan(p.T[i])) {
       n += p.n[i];
       nT += p.n[i] * p.T[i];
     }
@@ -45,7 +48,8 @@ std::optional<FrontFit> fitted_front(const Profile& p, const Shock& shock, const
   const double half = std::max(1.5 * shock.width, front_window_minimum);
   const double lo = std::max(shock.location - half, layer.bottom);
   const double hi = std::min(shock.location + half, layer.top);
-  auto fit = fit_front(p.z, p.T, p.T_se, lo, hi);
+  const Profile defined = with_defined_temperature(p);
+  auto fit = fit_front(defined.z, defined.T, defined.T_se, lo, hi);
   if (!fit || !(fit->width_error < fit->width) || !(fit->high < fit->low)) return std::nullopt;
   return fit;
 }
@@ -120,7 +124,8 @@ double temperature_slope_above(const Profile& p, const std::optional<Layer>& lay
   if (!layer) return nan;
   std::vector<double> z, T;
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (p.z[i] > layer->top && p.z[i] <= layer->top + gas_span_above_layer && p.n[i] > 0.0) {
+    if (p.z[i] > layer->top && p.z[i] <= layer->top + gas_span_above_layer && p.n[i] > 0.0 &&
+        !std::isnan(p.T[i])) {
       z.push_back(p.z[i]);
       T.push_back(p.T[i]);
     }

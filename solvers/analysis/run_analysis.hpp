@@ -17,13 +17,14 @@ struct PhaseQuantities {
   double phase = 0.0, time = 0.0, plate_z = 0.0, center_of_mass = 0.0, max_mach = 0.0;
   std::optional<Layer> layer;
   /// Height below which 1 % of the material lies: a layer bottom that does not depend on a
-  /// volume-fraction threshold in the dilute gas.
+  /// volume-fraction threshold in the dilute gas. Never below the plate.
   double mass_bottom = 0.0;
-  double layer_temperature = 0.0;  ///< number-weighted mean T inside the layer (NaN without)
+  /// number-weighted mean T over the bins inside the layer where T is defined (NaN without)
+  double layer_temperature = 0.0;
   /// The fraction of the material where the local Knudsen number exceeds knudsen_limit.
   double knudsen_mass_fraction = 0.0;
-  /// dT/dz of a least-squares line through the bins with material in the span above the
-  /// layer's top (the dilute gas above the layer); NaN with fewer than 3 such bins.
+  /// dT/dz of a least-squares line through the bins with material and a defined T in the span
+  /// above the layer's top (the dilute gas above the layer); NaN with fewer than 3 such bins.
   double temperature_slope_above = 0.0;
   std::optional<Shock> shock;
   /// A tanh front fitted to T across the shock (front_fit.hpp), where the fit resolves it

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "common/profile.hpp"
@@ -10,9 +11,12 @@
 namespace shaker {
 namespace {
 
-/// Standard error of the mean from a sum and a sum of squares of m values (0 if m < 2).
+constexpr double undefined = std::numeric_limits<double>::quiet_NaN();
+
+/// Standard error of the mean from a sum and a sum of squares of m values (NaN if m < 2: one
+/// value has no spread to estimate it from).
 double standard_error(double sum, double squares, double m) {
-  if (m < 2.0) return 0.0;
+  if (m < 2.0) return undefined;
   const double mean = sum / m;
   const double variance = std::max(0.0, (squares - m * mean * mean) / (m - 1.0));
   return std::sqrt(variance / m);
@@ -125,8 +129,10 @@ void CycleSamples::pool(std::size_t k, Profile& into, const std::vector<char>& u
                                   : static_cast<double>(std::count(use.begin(), use.end(), 1));
   into.n.assign(bins_, 0.0);
   into.nu.assign(bins_, 0.0);
-  into.uz.assign(bins_, 0.0);
-  into.T.assign(bins_, 0.0);
+  // A bin without particles has no velocity, and one with a single particle no temperature
+  // (the spread of one velocity): NaN, where n = 0 is a defined density.
+  into.uz.assign(bins_, undefined);
+  into.T.assign(bins_, undefined);
   into.samples.assign(bins_, 0.0);
   into.n_se.assign(bins_, 0.0);
   into.uz_se.assign(bins_, 0.0);
@@ -136,10 +142,8 @@ void CycleSamples::pool(std::size_t k, Profile& into, const std::vector<char>& u
     const double n = cycles > 0.0 ? a.count / (cycles * bin_volume_) : 0.0;
     into.n[j] = n;
     into.nu[j] = volume_fraction(n);
-    if (a.count > 0.0) {
-      into.uz[j] = a.vz / a.count;
-      into.T[j] = std::max(0.0, temperature(a));
-    }
+    if (a.count >= 1.0) into.uz[j] = a.vz / a.count;
+    if (a.count >= 2.0) into.T[j] = std::max(0.0, temperature(a));
     into.samples[j] = a.count;
     const Moments& mo = moments[j];
     into.n_se[j] = standard_error(mo.n_sum, mo.n_sq, used);

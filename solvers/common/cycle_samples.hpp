@@ -41,7 +41,9 @@ class CycleSamples {
 
   /// Sets n, nu, uz, T, samples and the standard errors over samples (n_se, uz_se, T_se) of
   /// `into` (bin centres and scalars untouched) from the samples of phase k that `use`
-  /// selects (every sample if `use` is empty).
+  /// selects (every sample if `use` is empty). What is undefined is NaN: uz in a bin without
+  /// particles, T in a bin with fewer than two, a standard error from fewer than two samples
+  /// (of the bin with a particle, for uz_se; with two, for T_se). n and nu are always defined.
   void pool(std::size_t k, Profile& into, const std::vector<char>& use = {}) const;
 
   /// Rebuilds a store from its stored form (run files); throws std::invalid_argument if the

@@ -26,14 +26,15 @@ struct FieldName {
   FieldOf field;
   bool optional;
   const char* units;  ///< docs/units.md notation, stored as the dataset's attribute `units`
+  bool may_be_undefined = false;  ///< NaN marks a bin where the field is undefined
 };
 // Per-phase fields stored as [phases x bins] matrices.
 constexpr FieldName profile_fields[] = {
     {"z", &Profile::z, false, "sigma"},
     {"n", &Profile::n, false, "1/sigma^3"},
     {"nu", &Profile::nu, false, "1"},
-    {"uz", &Profile::uz, false, "sqrt(g sigma)"},
-    {"T", &Profile::T, false, "g sigma"},
+    {"uz", &Profile::uz, false, "sqrt(g sigma)", true},
+    {"T", &Profile::T, false, "g sigma", true},
     {"samples", &Profile::samples, true, "1"},
     {"n_se", &Profile::n_se, true, "1/sigma^3"},
     {"uz_se", &Profile::uz_se, true, "sqrt(g sigma)"},
@@ -88,7 +89,7 @@ void write_profiles(hid_t file, const std::vector<Profile>& profiles) {
     for (const auto& p : profiles) values.push_back(p.*field);
     h5::write(group.id(), name, values, {phases}, units);
   }
-  for (const auto& [name, field, optional, units] : profile_fields) {
+  for (const auto& [name, field, optional, units, may_be_undefined] : profile_fields) {
     const bool present = phases && !(profiles.front().*field).empty();
     if (!present && optional) continue;
     std::vector<double> matrix;
@@ -115,7 +116,7 @@ std::vector<Profile> read_profiles(hid_t file) {
     for (std::size_t k = 0; k < profiles.size(); ++k) profiles[k].*field = values[k];
   }
   std::optional<std::size_t> bins;  // of the first field (z); every other field must agree
-  for (const auto& [name, field, optional, units] : profile_fields) {
+  for (const auto& [name, field, optional, units, may_be_undefined] : profile_fields) {
     if (optional && !h5::exists(group.id(), name)) continue;
     const auto dims = h5::shape(group.id(), name);
     if (dims.size() != 2 || dims[0] != profiles.size())
@@ -126,11 +127,12 @@ std::vector<Profile> read_profiles(hid_t file) {
       throw InputError(fmt::format("profiles/{} has {} bins, profiles/z has {}; allowed: the same "
                                    "number of bins in every profile field", name, dims[1], *bins));
     const auto values = h5::read_doubles(group.id(), name);
-    if (!optional)  // the fields the analysis computes with: finite
+    if (!optional)  // the fields the analysis computes with: finite, or NaN where undefined
       for (std::size_t i = 0; i < values.size(); ++i)
-        if (!std::isfinite(values[i]))
+        if (!std::isfinite(values[i]) && !(may_be_undefined && std::isnan(values[i])))
           throw InputError(fmt::format("profiles/{} holds {} at phase index {}, bin {}; allowed: "
-                                       "finite values", name, values[i], i / *bins, i % *bins));
+                                       "finite values{}", name, values[i], i / *bins, i % *bins,
+                                       may_be_undefined ? " (NaN where undefined)" : ""));
     for (std::size_t k = 0; k < profiles.size(); ++k)
       profiles[k].*field = std::vector<double>(values.begin() + static_cast<long>(k * dims[1]),
                                                values.begin() + static_cast<long>((k + 1) * dims[1]));

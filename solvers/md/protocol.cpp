@@ -208,6 +208,7 @@ RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, PhaseSam
   out.overlaps = sim.count_overlaps(end, 1e-9);
   out.queue_consistent = sim.queue_consistent();
   const Tally& tally = sim.tally();
+  out.at_start = origin.tally;
   out.collisions = tally.collisions() - origin.tally.collisions();
   out.events = out.collisions + (tally.cell - origin.tally.cell) + (tally.stale - origin.tally.stale) +
                (tally.grazes - origin.tally.grazes);

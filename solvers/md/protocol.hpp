@@ -73,7 +73,10 @@ struct RunOutcome {
   /// in time order (empty without snapshots).
   std::vector<ParticleFrame> frames;
   double seconds = 0.0;      ///< wall-clock time of the event loop
-  std::uint64_t collisions = 0, events = 0;
+  std::uint64_t collisions = 0, events = 0;  ///< in this run
+  /// The simulation's running totals when this run started: zero, or those of the checkpoint
+  /// it continues (the tally is continued across checkpoints).
+  Tally at_start;
 };
 
 /// The simulation as the run loop drives it.

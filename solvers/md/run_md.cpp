@@ -216,17 +216,27 @@ void check_replicas(const config::Config& config, const CheckpointSettings& chec
 /// What the root rank needs of a replica: its samples, its time series and the numbers of the
 /// summary. Sent between ranks as doubles (counts stay exact below 2^53); the series' column
 /// names, the same for every replica, are not sent.
+/// Collisions counted over one span of simulated time.
+struct CollisionCounts {
+  double pair = 0.0, plate = 0.0, ceiling = 0.0, guard_activations = 0.0;
+  double total() const { return pair + plate + ceiling; }
+};
+
 struct ReplicaSummary {
   CycleSamples samples;
   TimeSeries series;
-  double time = 0.0, seconds = 0.0, collisions = 0.0, events = 0.0;
-  double pair = 0.0, plate = 0.0, ceiling = 0.0, guard_activations = 0.0, overlaps = 0.0;
+  double time = 0.0, seconds = 0.0, events = 0.0, overlaps = 0.0;
+  /// Since the start of this run, and since the start of the run that wrote the first
+  /// checkpoint (the same unless this run continues one: the tally is continued).
+  CollisionCounts this_run, since_first_start;
   EnergyBudget budget;
   bool queue_consistent = false;
 
   void pack(std::vector<double>& out) const {
-    out.insert(out.end(), {time, seconds, collisions, events, pair, plate, ceiling, guard_activations,
-                           overlaps, budget.plate_work, budget.collisional_loss, budget.energy_change,
+    out.insert(out.end(), {time, seconds, events, overlaps});
+    for (const CollisionCounts& c : {this_run, since_first_start})
+      out.insert(out.end(), {c.pair, c.plate, c.ceiling, c.guard_activations});
+    out.insert(out.end(), {budget.plate_work, budget.collisional_loss, budget.energy_change,
                            budget.relative_closure, queue_consistent ? 1.0 : 0.0,
                            static_cast<double>(samples.phases()), static_cast<double>(samples.bins()),
                            samples.bin_volume()});
@@ -243,9 +253,12 @@ struct ReplicaSummary {
   /// The summary packed at `at`, its series' columns named `names` (replica 0's).
   static ReplicaSummary unpack(const double*& at, const std::vector<std::string>& names) {
     ReplicaSummary r;
-    for (double* x : {&r.time, &r.seconds, &r.collisions, &r.events, &r.pair, &r.plate, &r.ceiling,
-                      &r.guard_activations, &r.overlaps, &r.budget.plate_work, &r.budget.collisional_loss,
-                      &r.budget.energy_change, &r.budget.relative_closure})
+    for (double* x : {&r.time, &r.seconds, &r.events, &r.overlaps})
+      *x = *at++;
+    for (CollisionCounts* c : {&r.this_run, &r.since_first_start})
+      for (double* x : {&c->pair, &c->plate, &c->ceiling, &c->guard_activations}) *x = *at++;
+    for (double* x : {&r.budget.plate_work, &r.budget.collisional_loss, &r.budget.energy_change,
+                      &r.budget.relative_closure})
       *x = *at++;
     r.queue_consistent = *at++ != 0.0;
     const auto phases = static_cast<std::size_t>(*at++), bins = static_cast<std::size_t>(*at++);
@@ -278,13 +291,16 @@ ReplicaSummary summary_of(const Simulation& simulation, const RunOutcome& outcom
   r.series = outcome.series;
   r.time = simulation.time();
   r.seconds = outcome.seconds;
-  r.collisions = static_cast<double>(outcome.collisions);
   r.events = static_cast<double>(outcome.events);
-  const Tally& tally = simulation.tally();
-  r.pair = static_cast<double>(tally.pair);
-  r.plate = static_cast<double>(tally.plate);
-  r.ceiling = static_cast<double>(tally.ceiling);
-  r.guard_activations = static_cast<double>(tally.guard_activations);
+  const Tally& now = simulation.tally();
+  const Tally& start = outcome.at_start;
+  const auto counts = [](std::uint64_t pair, std::uint64_t plate, std::uint64_t ceiling, std::uint64_t guard) {
+    return CollisionCounts{static_cast<double>(pair), static_cast<double>(plate),
+                           static_cast<double>(ceiling), static_cast<double>(guard)};
+  };
+  r.since_first_start = counts(now.pair, now.plate, now.ceiling, now.guard_activations);
+  r.this_run = counts(now.pair - start.pair, now.plate - start.plate, now.ceiling - start.ceiling,
+                      now.guard_activations - start.guard_activations);
   r.overlaps = static_cast<double>(outcome.overlaps);
   r.budget = outcome.budget;
   r.queue_consistent = outcome.queue_consistent;
@@ -299,9 +315,14 @@ ReplicaSummary combined(const std::vector<ReplicaSummary>& replicas) {
   all.time = replicas.front().time;
   all.queue_consistent = true;
   for (const ReplicaSummary& r : replicas) {
-    for (auto [into, x] : {std::pair{&all.seconds, r.seconds}, {&all.collisions, r.collisions},
-                           {&all.events, r.events}, {&all.pair, r.pair}, {&all.plate, r.plate},
-                           {&all.ceiling, r.ceiling}, {&all.guard_activations, r.guard_activations},
+    for (auto [into, x] : {std::pair{&all.seconds, r.seconds}, {&all.events, r.events},
+                           {&all.this_run.pair, r.this_run.pair}, {&all.this_run.plate, r.this_run.plate},
+                           {&all.this_run.ceiling, r.this_run.ceiling},
+                           {&all.this_run.guard_activations, r.this_run.guard_activations},
+                           {&all.since_first_start.pair, r.since_first_start.pair},
+                           {&all.since_first_start.plate, r.since_first_start.plate},
+                           {&all.since_first_start.ceiling, r.since_first_start.ceiling},
+                           {&all.since_first_start.guard_activations, r.since_first_start.guard_activations},
                            {&all.overlaps, r.overlaps}, {&all.budget.plate_work, r.budget.plate_work},
                            {&all.budget.collisional_loss, r.budget.collisional_loss},
                            {&all.budget.energy_change, r.budget.energy_change}})
@@ -418,15 +439,24 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   if (replicas > 1)
     fmt::print("  {} replicas on {} rank(s); counts below are summed over replicas, the closure "
                "is the worst\n", replicas, ranks.size());
-  fmt::print("  collisions: {} (pair {}, plate {}, ceiling {}), {:.4g} collisions/s, {:.4g} events/s\n",
-             count(all.collisions), count(all.pair), count(all.plate), count(all.ceiling),
-             all.collisions / all.seconds,
+  // A continued run's tally holds the running totals of the runs before it: each count is
+  // printed once over this run and once over all, labelled, so that no total mixes the two.
+  const bool continued = !checkpoints.restart_from.empty();
+  const std::string here = continued ? " in this continuation" : "";
+  const auto print_counts = [](const std::string& span, const CollisionCounts& c) {
+    fmt::print("  collisions{}: {} (pair {}, plate {}, ceiling {}), collapse guard activations {}\n",
+               span, count(c.total()), count(c.pair), count(c.plate), count(c.ceiling),
+               count(c.guard_activations));
+  };
+  print_counts(here, all.this_run);
+  if (continued) print_counts(" since the start of the run that wrote the first checkpoint", all.since_first_start);
+  fmt::print("  rates{}: {:.4g} collisions/s, {:.4g} events/s\n", here, all.this_run.total() / all.seconds,
              all.events / all.seconds);
-  fmt::print("  energy budget: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
-             "relative closure {:.3g}\n", all.budget.plate_work, all.budget.collisional_loss,
+  fmt::print("  energy budget{}: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
+             "relative closure {:.3g}\n", here, all.budget.plate_work, all.budget.collisional_loss,
              all.budget.energy_change, all.budget.relative_closure);
-  fmt::print("  collapse guard activations: {}; overlaps at end: {}; event queue consistent: {}\n",
-             count(all.guard_activations), count(all.overlaps), all.queue_consistent ? "yes" : "NO");
+  fmt::print("  overlaps at end: {}; event queue consistent: {}\n", count(all.overlaps),
+             all.queue_consistent ? "yes" : "NO");
   fmt::print("  output: {}\n", parameters.run.output);
   if (!frames.empty())
     fmt::print("  particle snapshots: {} frames in {} and {}\n", frames.size(),

@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <numeric>
+#include <sstream>
 #include <string>
 
 #include "analysis/analysis.hpp"
@@ -361,6 +363,43 @@ TEST(MdVibrated, RestartFromCheckpointContinuesBitForBit) {
   EXPECT_TRUE(same_bits(straight.save(), restarted.save()));
 }
 
+/// A line of the summary `shaker md` prints: collisions over a span, their parts and the
+/// collapse guard's activations over the same span.
+struct CollisionLine {
+  unsigned long long total = 0, pair = 0, plate = 0, ceiling = 0, guard = 0;
+};
+
+/// The summary's collision lines by their span ("" for a run that continues nothing), from
+/// the text the run printed.
+std::map<std::string, CollisionLine> collision_lines(const std::string& printed) {
+  std::map<std::string, CollisionLine> out;
+  std::istringstream lines(printed);
+  const std::string start = "  collisions";
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(start, 0) != 0) continue;
+    const std::string guard_label = "collapse guard activations ";
+    const std::size_t colon = line.find(": "), guard_at = line.rfind(guard_label);
+    CollisionLine c;
+    const bool parsed =
+        colon != std::string::npos && guard_at != std::string::npos &&
+        std::sscanf(line.c_str() + colon + 2, "%llu (pair %llu, plate %llu, ceiling %llu)", &c.total,
+                    &c.pair, &c.plate, &c.ceiling) == 4 &&
+        std::sscanf(line.c_str() + guard_at + guard_label.size(), "%llu", &c.guard) == 1;
+    EXPECT_TRUE(parsed) << line;
+    out[line.substr(start.size(), colon - start.size())] = c;
+  }
+  return out;
+}
+
+/// `run(config)` with what it prints to stdout.
+std::string printed_by_run(const config::Config& config) {
+  ::testing::internal::CaptureStdout();
+  const int status = run(config);
+  std::string printed = ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(status, 0) << printed;
+  return printed;
+}
+
 TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
   // shaker md for 2 cycles with run.checkpoint, then the 3-cycle run continued from it with
   // run.restart_from, against the 3-cycle run straight through.
@@ -370,20 +409,20 @@ TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
   first.set("run.transient_cycles=1");
   first.set("run.sampled_cycles=1");
   first.set("run.checkpoint=" + (dir / "a-end.h5").string());
-  ASSERT_EQ(run(first), 0);
+  const auto first_lines = collision_lines(printed_by_run(first));
   config::Config second = base_case(dir / "b.h5");
   second.set("md.crossing_heights=[12.5]");
   second.set("run.transient_cycles=1");
   second.set("run.sampled_cycles=2");
   second.set("run.restart_from=" + (dir / "a-end.h5").string());
   second.set("run.checkpoint=" + (dir / "b-end.h5").string());
-  ASSERT_EQ(run(second), 0);
+  const auto continued_lines = collision_lines(printed_by_run(second));
   config::Config straight = base_case(dir / "c.h5");
   straight.set("md.crossing_heights=[12.5]");
   straight.set("run.transient_cycles=1");
   straight.set("run.sampled_cycles=2");
   straight.set("run.checkpoint=" + (dir / "c-end.h5").string());
-  ASSERT_EQ(run(straight), 0);
+  const auto straight_lines = collision_lines(printed_by_run(straight));
   const Checkpoint b = read_checkpoint(dir / "b-end.h5"), c = read_checkpoint(dir / "c-end.h5");
   EXPECT_NEAR(b.data.time, 3.0 / 0.095, 1e-12);
   EXPECT_TRUE(same_bits(b.data, c.data));
@@ -400,6 +439,34 @@ TEST(MdVibrated, RestartThroughTheRunDriverMatchesAStraightRun) {
     EXPECT_EQ(part.back(), all.back() - all[cycle_start]) << name;
     EXPECT_GT(part.back(), 0.0) << name;
   }
+
+  // The summary: a straight run prints one collision line, a continuation two, one over
+  // itself and one since the first run's start; every total is the sum of its parts.
+  ASSERT_EQ(first_lines.size(), 1u);
+  ASSERT_EQ(straight_lines.size(), 1u);
+  ASSERT_EQ(continued_lines.size(), 2u);
+  const CollisionLine &before = first_lines.at(""), &whole_run = straight_lines.at("");
+  const CollisionLine& here = continued_lines.at(" in this continuation");
+  const CollisionLine& since = continued_lines.at(" since the start of the run that wrote the first checkpoint");
+  for (const CollisionLine* line : {&before, &whole_run, &here, &since})
+    EXPECT_EQ(line->total, line->pair + line->plate + line->ceiling);
+  // Since the first start: the straight run's counts; in the continuation: the straight run's
+  // less the first run's.
+  for (auto member : {&CollisionLine::total, &CollisionLine::pair, &CollisionLine::plate,
+                      &CollisionLine::ceiling, &CollisionLine::guard}) {
+    EXPECT_EQ(since.*member, whole_run.*member);
+    EXPECT_EQ(here.*member, whole_run.*member - before.*member);
+  }
+  EXPECT_GT(here.pair, 0u);
+  EXPECT_GT(before.pair, 0u);
+  // The time series count as docs/output-schema.md says: pair_collisions a running total
+  // continued across the checkpoint, collisions the pair collisions of this run alone.
+  EXPECT_EQ(restarted.series.column("pair_collisions").back(), static_cast<double>(since.pair));
+  EXPECT_EQ(whole.series.column("pair_collisions").back(), static_cast<double>(whole_run.pair));
+  EXPECT_EQ(restarted.series.column("collisions").back(), static_cast<double>(here.pair));
+  EXPECT_EQ(whole.series.column("collisions").back(), static_cast<double>(whole_run.pair));
+  std::printf("measured: collisions %llu straight = %llu before the checkpoint + %llu in the continuation\n",
+              whole_run.total, before.total, here.total);
 }
 
 TEST(MdVibrated, CollapseIsDetectedAndReportedForLowE) {

@@ -216,8 +216,8 @@ md::Simulation make_simulation(const CaseParameters& c, const md::MdSettings& s)
                         s.queue);
 }
 
-/// A single-cycle profile carries se = 0 (no spread from one cycle): drop them so that the
-/// shock detection treats the standard errors as unknown rather than zero.
+/// A single-cycle profile has no spread to give standard errors (NaN): drop them, so that the
+/// shock detection sees them as not stored.
 Profile without_standard_errors(Profile p) {
   p.n_se.clear();
   p.uz_se.clear();

@@ -195,7 +195,11 @@ shaker::config::Config study_config(const StudyDesign& d, std::size_t sampled, d
 double max_abs_difference(const std::vector<double>& a, const std::vector<double>& b) {
   if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
   double d = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    // NaN marks an undefined value (an empty bin): equal only to NaN.
+    if (std::isnan(a[i]) != std::isnan(b[i])) return std::numeric_limits<double>::infinity();
+    if (!std::isnan(a[i])) d = std::max(d, std::abs(a[i] - b[i]));
+  }
   return d;
 }
 

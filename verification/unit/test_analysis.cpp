@@ -141,7 +141,10 @@ TEST(FindShock, CountsTheLowestBinAboveThePlateEvenWhenThePlateCutsIt) {
   // maximum still marks a forming shock (physics.md).
   Profile p = shock_profile(4.0, 0.5, 1.0);
   p.plate_z = 2.3;
-  for (std::size_t i = 0; i < 2; ++i) p.n[i] = p.nu[i] = p.T[i] = p.uz[i] = 0.0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    p.n[i] = p.nu[i] = 0.0;  // below the plate: no particles, so no T and no u_z
+    p.T[i] = p.uz[i] = std::numeric_limits<double>::quiet_NaN();
+  }
   p.nu[2] = 0.02;
   p.n[2] = number_density(0.02);
   p.T[2] = 30.0;
@@ -399,7 +402,7 @@ TEST(MachNumber, IsTheSpeedRelativeToThePlateOverTheSoundSpeed) {
   EXPECT_NEAR(ma[0], 3.25 / c_dilute, 1e-12);
   EXPECT_EQ(ma[1], 0.0);  // moving with the plate
   EXPECT_NEAR(ma[2], 1.75 / c_dense, 1e-12);
-  EXPECT_EQ(ma[3], 0.0);  // no material
+  EXPECT_TRUE(std::isnan(ma[3]));  // no material
   EXPECT_EQ(ma[4], 0.0);  // no temperature
   EXPECT_NEAR(ma[5], 2.0 / c_mid, 1e-12);
   // Only bins inside the layer count for the maximum (bin 0 is too dilute).
@@ -560,6 +563,140 @@ TEST(CompareRuns, AShockDisplacedByOneBinGivesThatDifference) {
   RunRecord shifted = b;
   shifted.profiles[3].phase += 0.01;
   EXPECT_THROW(compare_runs(a, shifted), std::invalid_argument);
+}
+
+// ---- undefined bins and the plate ----------------------------------------------------------
+
+constexpr double undefined = std::numeric_limits<double>::quiet_NaN();
+
+/// p with the bins `gone` emptied as the MD leaves a bin no particle visits: n = nu = 0, T and
+/// u_z undefined, and their standard errors undefined.
+Profile emptied(Profile p, const std::vector<std::size_t>& gone) {
+  for (std::size_t i : gone) {
+    p.n[i] = p.nu[i] = 0.0;
+    p.T[i] = p.uz[i] = undefined;
+    if (!p.n_se.empty()) p.n_se[i] = 0.0;
+    if (!p.T_se.empty()) p.T_se[i] = p.uz_se[i] = undefined;
+  }
+  return p;
+}
+
+/// p without the bins `gone` at all.
+Profile removed(const Profile& p, const std::vector<std::size_t>& gone) {
+  std::vector<char> keep(p.size(), 1);
+  for (std::size_t i : gone) keep[i] = 0;
+  Profile q = p;
+  for (auto field : {&Profile::z, &Profile::n, &Profile::nu, &Profile::uz, &Profile::T,
+                     &Profile::n_se, &Profile::uz_se, &Profile::T_se}) {
+    (q.*field).clear();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (keep[i]) (q.*field).push_back((p.*field)[i]);
+  }
+  return q;
+}
+
+/// Equal, or both NaN.
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+TEST(UndefinedBins, EmptyBinsInAndAboveTheLayerChangeNoResult) {
+  // A shock at zs = 16 + k moving up through a layer (bottom at the plate, top near zs + 15),
+  // with standard errors; empty bins inside the layer (z = 8.5, 29.5, and zs - 1.5, just
+  // above the temperature maximum, where the walk to the steepest drop passes) and in the gas
+  // above it (40.5, 45.5, both in the span of temperature_slope_above) must give the numbers
+  // of the same profiles without those bins: nothing undefined reaches a defined result.
+  std::vector<Profile> with_empty, without;
+  for (std::size_t k = 0; k < 6; ++k) {
+    const std::vector<std::size_t> gone{8, 14 + k, 29, 40, 45};
+    Profile p = at(0.5 * static_cast<double>(k), 0.0, shock_profile(16.0 + static_cast<double>(k), 0.8));
+    p.n_se.assign(p.size(), 0.01);
+    p.uz_se.assign(p.size(), 0.02);
+    p.T_se.assign(p.size(), 0.03);
+    with_empty.push_back(emptied(p, gone));
+    without.push_back(removed(emptied(p, gone), gone));
+  }
+  AnalysisOptions o;
+  o.periodic = false;
+  o.frequency = kTestFrequency;
+  const RunQuantities a = analyze_profiles(with_empty, 0.9, o), b = analyze_profiles(without, 0.9, o);
+  ASSERT_TRUE(a.shock.has_value());
+  EXPECT_EQ(a.shock->phases.size(), 6u);
+  const auto columns_a = phase_columns(a), columns_b = phase_columns(b);
+  for (std::size_t q = 0; q < columns_a.size(); ++q) {
+    // Kn takes one-sided gradients beside an empty bin, and central ones across a removed
+    // one: the bins differ by design (KnudsenNumbers); it must be defined all the same.
+    const bool knudsen = columns_a[q].name == "knudsen_mass_fraction";
+    for (std::size_t k = 0; k < columns_a[q].values.size(); ++k) {
+      if (knudsen) {
+        EXPECT_TRUE(std::isfinite(columns_a[q].values[k])) << "phase " << k;
+      } else {
+        EXPECT_TRUE(same(columns_a[q].values[k], columns_b[q].values[k]))
+            << columns_a[q].name << " at phase " << k << ": " << columns_a[q].values[k]
+            << " against " << columns_b[q].values[k];
+      }
+    }
+  }
+  const auto runs_a = run_values(a), runs_b = run_values(b);
+  for (std::size_t q = 0; q < runs_a.size(); ++q)
+    EXPECT_TRUE(same(runs_a[q].values[0], runs_b[q].values[0])) << runs_a[q].name;
+  for (const auto& q : a.phases) {
+    EXPECT_TRUE(std::isfinite(q.layer_temperature));
+    EXPECT_TRUE(std::isfinite(q.temperature_slope_above));
+    EXPECT_TRUE(std::isfinite(q.max_mach));
+    EXPECT_TRUE(q.front.has_value());
+  }
+  std::printf("[measured] with empty bins: layer T %.6f, slope above %.6f, shock speed %.6f, "
+              "front width %.6f at the first phase\n", a.phases[0].layer_temperature,
+              a.phases[0].temperature_slope_above, a.shock->speed, a.phases[0].front->width);
+  // The agreement metrics leave out the heights where a run is undefined.
+  const std::vector<std::size_t> gone{8, 29, 40, 45};
+  const Profile reference = shock_profile(18.0, 0.8);
+  const Profile md = emptied(shock_profile(18.0, 0.8), gone);
+  const auto T = profile_difference(md, reference, "T");
+  EXPECT_EQ(T.count, reference.size() - gone.size());
+  EXPECT_EQ(T.l1, 0.0);
+  // The other way round an undefined bin also leaves out the bin below it, whose height
+  // interpolates between the two.
+  EXPECT_EQ(profile_difference(reference, md, "T").count, reference.size() - 2 * gone.size());
+  EXPECT_EQ(profile_difference(md, reference, "nu").count, reference.size());
+}
+
+TEST(UndefinedBins, TheLayerBottomIsNeverBelowThePlate) {
+  // MD bins fixed in the lab frame from z = 0, the plate at 2.3: bins [0, 1] and [1, 2] lie
+  // below it and are empty, the bin [2, 3] straddles it with its material above 2.3 (nu 0.3
+  // over the whole bin), a layer of nu 0.5 above it up to z = 16, nothing higher.
+  Profile p = make_profile([](double z) { return z < 2.0 ? 0.0 : z < 3.0 ? 0.3 : z < 16.0 ? 0.5 : 0.0; },
+                           [](double) { return 1.0; }, [](double) { return 0.0; }, 30);
+  p.plate_z = 2.3;
+  p = emptied(p, {0, 1});
+  for (std::size_t i = 16; i < p.size(); ++i) p = emptied(p, {i});
+  // Unclipped, both bottoms would lie below the plate: the threshold crossing between the
+  // centres 1.5 and 2.5, and 1 % of the material spread over the whole bin [2, 3].
+  const double crossing = 1.5 + layer_volume_fraction / 0.3;
+  double total = 0.0;
+  for (double n : p.n) total += n;
+  const double spread = 2.0 + 0.01 * total / p.n[2];
+  ASSERT_LT(crossing, p.plate_z);
+  ASSERT_LT(spread, p.plate_z);
+  const auto layer = find_layer(p);
+  ASSERT_TRUE(layer.has_value());
+  EXPECT_EQ(layer->bottom, 2.3);
+  EXPECT_NEAR(layer->top, 15.5 + (0.5 - layer_volume_fraction) / 0.5, 1e-12);
+  AnalysisOptions o;
+  const RunQuantities r = analyze_profiles({p}, 0.9, o);
+  EXPECT_EQ(r.phases[0].mass_bottom, 2.3);
+  for (const auto& column : phase_columns(r)) {
+    if (column.name == "layer_bottom" || column.name == "mass_bottom") {
+      EXPECT_GE(column.values[0], p.plate_z) << column.name;
+    }
+    if (column.name == "layer_gap" || column.name == "mass_gap") {
+      EXPECT_EQ(column.values[0], 0.0) << column.name;
+    }
+  }
+  std::printf("[measured] plate 2.3: unclipped layer bottom %.4f and 1 %% bottom %.4f, reported %.4f and %.4f\n",
+              crossing, spread, layer->bottom, r.phases[0].mass_bottom);
+  // A bottom found above the plate is left alone.
+  p.plate_z = 1.0;
+  EXPECT_NEAR(find_layer(p)->bottom, crossing, 1e-12);
 }
 
 }  // namespace
