@@ -103,14 +103,14 @@ int main(int argc, char** argv) {
       throw std::runtime_error(fmt::format("cannot write to standard output ({})", std::strerror(errno)));
     return code;
   } catch (const StopRequested& stop) {
-    if (*stop.what() != '\0') terminal_log::print(stderr, fmt::format("{}\n", stop.what()));
+    if (*stop.what() != '\0') terminal_log::say(stderr, "{}\n", stop.what());
     return stop.exit_code();
   } catch (const InputError& error) {
     // Every rank reads the same input and fails alike, so none is left waiting.
-    terminal_log::print(stderr, fmt::format("shaker: error: {}\n", error.what()));
+    terminal_log::say(stderr, "shaker: error: {}\n", error.what());
     return 2;
   } catch (const std::exception& error) {
-    terminal_log::print(stderr, fmt::format("shaker: failed: {}\n", error.what()));
+    terminal_log::say(stderr, "shaker: failed: {}\n", error.what());
     Ranks::abort_others(1);
     return 1;
   }

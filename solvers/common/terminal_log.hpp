@@ -1,10 +1,13 @@
 #pragma once
 // What a run shows on the terminal, kept in a log file beside its output (run.log), so that a
 // run's messages, progress, summary and warnings survive the terminal that showed them.
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "common/case_parameters.hpp"
@@ -29,6 +32,10 @@ void start(const RunProtocol& run, const std::string& configuration);
 
 /// Writes `text` to `stream` and, once a log is started, to the log.
 void print(std::FILE* stream, std::string_view text);
+/// fmt::print to `stream`, and to the log.
+template <class... Args> void say(std::FILE* stream, fmt::format_string<Args...> format, Args&&... args) {
+  print(stream, std::string_view(fmt::format(format, std::forward<Args>(args)...)));
+}
 /// Writes `text` to the log only: the plain form of what the terminal shows in place (a live
 /// progress line).
 void to_log(std::string_view text);

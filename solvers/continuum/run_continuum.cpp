@@ -445,8 +445,8 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
     if (!box.writer()) return 1;
     const std::filesystem::path last_good = last_good_path(output);
     write(last_good, checkpointing.next());
-    terminal_log::print(stderr, fmt::format("shaker continuum: {}\nThe last good state is in {}\n",
-                                            failure.what(), last_good.string()));
+    terminal_log::say(stderr, "shaker continuum: {}\nThe last good state is in {}\n", failure.what(),
+                      last_good.string());
     return 1;
   }
   if (!box.writer()) return 0;
@@ -465,7 +465,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
     write_fields(derived_name(output, ".fields.h5"), c.grid, fields.snapshots, record);
   }
   write_run_file(output, record);
-  terminal_log::print(stdout, fmt::format("shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
+  terminal_log::say(stdout, "shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
              "temperature floor used {} times; mass drift {:.3e}; periodicity (centre of mass, last "
              "two cycles) {:.3e} (series column periodicity_last_two_cycles); energy budget residual "
              "{:.3e} of the accumulated loss {:.6g}\nwrote {}\n",
@@ -473,10 +473,9 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
              counters.rejected_steps, counters.temperature_floor_uses,
              (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
              recorder.periodicity(), recorder.budget_residual.back(),
-             recorder.collisional_loss.back() - recorder.initial_loss, output.string()));
+             recorder.collisional_loss.back() - recorder.initial_loss, output.string());
   for (const std::string& doubt : record.warnings)
-    terminal_log::print(stderr, fmt::format("shaker continuum: warning: {} (kept in the run file's "
-                                            "attribute warnings)\n", doubt));
+    terminal_log::say(stderr, "shaker continuum: warning: {} (kept in the run file's attribute warnings)\n", doubt);
   return 0;
 }
 

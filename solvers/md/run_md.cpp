@@ -433,36 +433,36 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
     write_particle_files(parameters.run.output, frames, ParticleBox{geometry.width, geometry.height}, record);
   write_run_file(parameters.run.output, record);
 
-  fmt::print("shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", parameters.particles,
+  terminal_log::say(stdout, "shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", parameters.particles,
              parameters.run.transient_cycles + (switched ? 1 : parameters.run.sampled_cycles),
              all.time, duration_text(wall.seconds()));
   if (replicas > 1)
-    fmt::print("  {} replicas on {} rank(s); counts below are summed over replicas, the closure "
+    terminal_log::say(stdout, "  {} replicas on {} rank(s); counts below are summed over replicas, the closure "
                "is the worst\n", replicas, ranks.size());
   // A continued run's tally holds the running totals of the runs before it: each count is
   // printed once over this run and once over all, labelled, so that no total mixes the two.
   const bool continued = !checkpoints.restart_from.empty();
   const std::string here = continued ? " in this continuation" : "";
   const auto print_counts = [](const std::string& span, const CollisionCounts& c) {
-    fmt::print("  collisions{}: {} (pair {}, plate {}, ceiling {}), collapse guard activations {}\n",
+    terminal_log::say(stdout, "  collisions{}: {} (pair {}, plate {}, ceiling {}), collapse guard activations {}\n",
                span, count(c.total()), count(c.pair), count(c.plate), count(c.ceiling),
                count(c.guard_activations));
   };
   print_counts(here, all.this_run);
   if (continued) print_counts(" since the start of the run that wrote the first checkpoint", all.since_first_start);
-  fmt::print("  rates{}: {:.4g} collisions/s, {:.4g} events/s\n", here, all.this_run.total() / all.seconds,
+  terminal_log::say(stdout, "  rates{}: {:.4g} collisions/s, {:.4g} events/s\n", here, all.this_run.total() / all.seconds,
              all.events / all.seconds);
-  fmt::print("  energy budget{}: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
+  terminal_log::say(stdout, "  energy budget{}: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
              "relative closure {:.3g}\n", here, all.budget.plate_work, all.budget.collisional_loss,
              all.budget.energy_change, all.budget.relative_closure);
-  fmt::print("  overlaps at end: {}; event queue consistent: {}\n", count(all.overlaps),
+  terminal_log::say(stdout, "  overlaps at end: {}; event queue consistent: {}\n", count(all.overlaps),
              all.queue_consistent ? "yes" : "NO");
-  fmt::print("  output: {}\n", parameters.run.output);
+  terminal_log::say(stdout, "  output: {}\n", parameters.run.output);
   if (!frames.empty())
-    fmt::print("  particle snapshots: {} frames in {} and {}\n", frames.size(),
+    terminal_log::say(stdout, "  particle snapshots: {} frames in {} and {}\n", frames.size(),
                particle_h5_path(parameters.run.output).string(), particle_xyz_path(parameters.run.output).string());
   const bool ok = all.overlaps == 0 && all.queue_consistent && all.budget.relative_closure <= 1e-9;
-  if (!ok) fmt::print(stderr, "shaker md: end-of-run invariant check FAILED (see summary)\n");
+  if (!ok) terminal_log::say(stderr, "shaker md: end-of-run invariant check FAILED (see summary)\n");
   return ok ? 0 : 1;
 }
 
