@@ -3,7 +3,8 @@
 
 Reads only files: <runs>/<solver>.h5 (the HDF5 run-file schema of docs/output-schema.md),
 <runs>/<solver>-analysis.csv (written by `shaker analyze --csv`, so the analysis is the
-project's one C++ implementation) and <runs>/<solver>.log (the solver's stdout summary).
+project's one C++ implementation) and <runs>/<solver>.log (the run's log: what the solver
+showed, after its configuration).
 """
 import argparse
 import datetime
@@ -48,6 +49,14 @@ def resolution(attrs):
     if attrs.get("solver") == "continuum":
         return f"cell {config['continuum']['cell_size']:g} sigma"
     return f"bins {config['md']['bin_height']:g} sigma"
+
+
+def terminal_part(log):
+    """What the run showed on the terminal: its log after the header and the configuration
+    (docs/output-schema.md, the log)."""
+    with open(log) as f:
+        text = f.read()
+    return text.split("# ---- terminal ----\n", 1)[-1].strip()
 
 
 def read_analysis(path):
@@ -137,7 +146,7 @@ def main():
     for solver in SOLVERS:
         log = os.path.join(args.runs, f"{solver}.log")
         if solver in runs and os.path.exists(log):
-            lines += [f"## {solver} run summary", "", "```", open(log).read().strip(), "```", ""]
+            lines += [f"## {solver} run summary", "", "```", terminal_part(log), "```", ""]
     if runs:
         profiles = rc.write_figure(figure_profiles(runs), out_dir, "base-case-profiles.png")
         trajectories = rc.write_figure(figure_trajectories(analyses), out_dir,

@@ -47,7 +47,8 @@ def write_md_run(runs):
             values = [k / PHASES] + [10 * k + c for c in range(1, len(ANALYSIS_COLUMNS))]
             f.write(",".join(str(x) for x in values + [0.1] * len(values)) + "\n")
     with open(os.path.join(runs, "md.log"), "w") as f:
-        f.write("synthetic MD run\n")
+        f.write("# shaker (synthetic)\n# ---- configuration ----\n[layer]\nparticles = 3937\n"
+                "# ---- terminal ----\nsynthetic MD run\n")
 
 
 def test_units_in_the_headers(work_dir):
