@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -164,6 +165,37 @@ TEST(ShakerProgram, AnalyzeAndCompareAcceptAValidRunFile) {
   const Result compare =
       run_shaker({"compare", (dir / "sample.h5").string(), (dir / "sample.h5").string()});
   EXPECT_EQ(compare.exit_code, 0) << compare.output;
+}
+
+std::string first_line(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+// Every column of the CSV tables carries its units in its header, "name [units]", as the
+// JSON carries them, and compare's CSV has a units column.
+TEST(ShakerProgram, CsvHeadersCarryUnits) {
+  const shaker::testing::TemporaryDirectory dir;
+  shaker::write_run_file(dir / "sample.h5", shaker::testing::make_sample_record(true));
+  const std::string run = (dir / "sample.h5").string();
+  const Result analyze = run_shaker({"analyze", run, "--quiet", "--csv", (dir / "phases.csv").string(),
+                                     "--profiles-csv", (dir / "profiles.csv").string()});
+  ASSERT_EQ(analyze.exit_code, 0) << analyze.output;
+  const std::regex with_units(R"([A-Za-z_0-9]+ \[[^\]]+\])");
+  for (const char* table : {"phases.csv", "profiles.csv"}) {
+    const std::string header = first_line(dir / table);
+    std::stringstream cells(header);
+    int columns = 0;
+    for (std::string cell; std::getline(cells, cell, ','); ++columns)
+      EXPECT_TRUE(std::regex_match(cell, with_units)) << table << ": '" << cell << "'";
+    EXPECT_GE(columns, 9) << header;
+  }
+  EXPECT_EQ(first_line(dir / "profiles.csv").rfind("phase [1],z [sigma],n [1/sigma^3],", 0), 0u);
+  const Result compare = run_shaker({"compare", run, run, "--csv", (dir / "compare.csv").string()});
+  ASSERT_EQ(compare.exit_code, 0) << compare.output;
+  EXPECT_EQ(first_line(dir / "compare.csv"), "metric,value,error,units,replicates");
 }
 
 /// The cycle counts k of the progress lines "LABEL: cycle k of n, ..." (n must be `cycles`).
