@@ -9,6 +9,7 @@ showed, after its configuration).
 import argparse
 import datetime
 import os
+import re
 import platform
 import sys
 import tomllib
@@ -56,7 +57,9 @@ def terminal_part(log):
     (docs/output-schema.md, the log)."""
     with open(log) as f:
         text = f.read()
-    return text.split("# ---- terminal ----\n", 1)[-1].strip()
+    shown = text.split("# ---- terminal ----\n", 1)[-1].splitlines()
+    progress = re.compile(r"^shaker \w+: cycle \d+ of \d+, ")
+    return "\n".join(line for line in shown if not progress.match(line)).strip()
 
 
 def read_analysis(path):
