@@ -78,7 +78,7 @@ Profile with_defined_temperature(const Profile& p) {
     if ((p.*field).empty()) continue;
     (q.*field).clear();
     for (std::size_t i = 0; i < p.size(); ++i)
-      if (!std::isnan(p.T[i])) (q.*field).push_back((p.*field)[i]);
+      if (p.n[i] > 0.0 && !std::isnan(p.T[i])) (q.*field).push_back((p.*field)[i]);
   }
   return q;
 }
@@ -189,7 +189,9 @@ std::optional<Shock> find_shock(const Profile& profile, const ShockCriteria& c) 
   shock.compressed_top = p.z[*peak];
   shock.undisturbed_bottom = p.z[*trough];
   shock.width = shock.undisturbed_bottom - shock.compressed_top;
-  shock.mean_free_path = model::mean_free_path(interpolate(profile.z, profile.n, shock.location));
+  // n between the bins the shock was found on: an empty bin between them (skipped) would give
+  // a density of 0 at its centre.
+  shock.mean_free_path = model::mean_free_path(interpolate(p.z, p.n, shock.location));
   return shock;
 }
 

@@ -57,9 +57,10 @@ struct Shock {
 /// below the layer's top (see find_shock in analysis.cpp for why).
 std::optional<Shock> find_shock(const Profile& p, const ShockCriteria& criteria = {});
 
-/// The bins of p where T is defined (NaN marks an MD bin with fewer than two particles), every
-/// field of p kept for those bins. What walks T from bin to bin (the shock, the fitted front)
-/// skips an undefined bin as if it were not there.
+/// The bins of p with material and a defined T (NaN marks an MD bin with fewer than two
+/// particles; an older file's empty bin holds T = 0 with n = 0), every field of p kept for
+/// those bins. What walks T from bin to bin (the shock, the fitted front, their mean free
+/// paths) skips the other bins as if they were not there.
 Profile with_defined_temperature(const Profile& p);
 
 /// Local Knudsen numbers per bin (docs/analysis.md): the mean free path xi over the gradient

@@ -43,13 +43,13 @@ double layer_temperature(const Profile& p, const std::optional<Layer>& layer) {
   return n > 0.0 ? nT / n : nan;
 }
 
-/// T across the shock fitted by a tanh front, within the layer, if the fit resolves it.
+/// T across the shock fitted by a tanh front, within the layer, if the fit resolves it; `p`
+/// holds the bins with a defined T (with_defined_temperature).
 std::optional<FrontFit> fitted_front(const Profile& p, const Shock& shock, const Layer& layer) {
   const double half = std::max(1.5 * shock.width, front_window_minimum);
   const double lo = std::max(shock.location - half, layer.bottom);
   const double hi = std::min(shock.location + half, layer.top);
-  const Profile defined = with_defined_temperature(p);
-  auto fit = fit_front(defined.z, defined.T, defined.T_se, lo, hi);
+  auto fit = fit_front(p.z, p.T, p.T_se, lo, hi);
   if (!fit || !(fit->width_error < fit->width) || !(fit->high < fit->low)) return std::nullopt;
   return fit;
 }
@@ -275,8 +275,12 @@ RunQuantities analyze_profiles(const std::vector<Profile>& profiles, double e,
     q.knudsen_mass_fraction = knudsen_mass_fraction(p, knudsen_numbers(p));
     q.temperature_slope_above = temperature_slope_above(p, q.layer);
     q.shock = find_shock(p, options.criteria);
-    if (q.shock) q.front = fitted_front(p, *q.shock, *q.layer);
-    if (q.front) q.front_mean_free_path = model::mean_free_path(interpolate(p.z, p.n, q.front->location));
+    if (q.shock) {
+      const Profile defined = with_defined_temperature(p);
+      q.front = fitted_front(defined, *q.shock, *q.layer);
+      if (q.front)
+        q.front_mean_free_path = model::mean_free_path(interpolate(defined.z, defined.n, q.front->location));
+    }
     r.phases.push_back(std::move(q));
   }
   if (r.phases.empty()) return r;

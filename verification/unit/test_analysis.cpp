@@ -588,6 +588,7 @@ Profile removed(const Profile& p, const std::vector<std::size_t>& gone) {
   Profile q = p;
   for (auto field : {&Profile::z, &Profile::n, &Profile::nu, &Profile::uz, &Profile::T,
                      &Profile::n_se, &Profile::uz_se, &Profile::T_se}) {
+    if ((p.*field).empty()) continue;
     (q.*field).clear();
     for (std::size_t i = 0; i < p.size(); ++i)
       if (keep[i]) (q.*field).push_back((p.*field)[i]);
@@ -647,6 +648,18 @@ TEST(UndefinedBins, EmptyBinsInAndAboveTheLayerChangeNoResult) {
   std::printf("[measured] with empty bins: layer T %.6f, slope above %.6f, shock speed %.6f, "
               "front width %.6f at the first phase\n", a.phases[0].layer_temperature,
               a.phases[0].temperature_slope_above, a.shock->speed, a.phases[0].front->width);
+  // An empty bin where T falls steepest (z = 16.5, the shock at 16): the drop is taken across
+  // it, and the mean free path from the density of the bins around it, not the 0 at its centre.
+  const Profile cut = emptied(shock_profile(16.0, 0.8), {16});
+  std::optional<Shock> across;
+  ASSERT_NO_THROW(across = find_shock(cut));
+  ASSERT_TRUE(across.has_value());
+  const auto expected = find_shock(removed(cut, {16}));
+  ASSERT_TRUE(expected.has_value());
+  EXPECT_EQ(across->location, expected->location);
+  EXPECT_EQ(across->mean_free_path, expected->mean_free_path);
+  EXPECT_TRUE(std::isfinite(across->mean_free_path));
+
   // The agreement metrics leave out the heights where a run is undefined.
   const std::vector<std::size_t> gone{8, 29, 40, 45};
   const Profile reference = shock_profile(18.0, 0.8);
