@@ -6,7 +6,7 @@ Checks: the layer bottom and the 1 % mass bottom are at the plate, not below it 
 [2, 3] straddles the plate; unclipped, both would be below it), the gaps are 0, the layer
 temperature is the n-weighted mean of the defined T (nothing undefined leaks into it), the
 per-phase values reach the runner's view as numbers, and the profiles CSV writes `nan` where
-u_z, T and Ma are undefined and numbers everywhere else.
+u_z, T and Ma are undefined and numbers everywhere else (read as the reports read it).
 
     python3 -m pytest validation/tests/test_undefined_bins.py --shaker SHAKER
 """
@@ -17,6 +17,7 @@ import subprocess
 import h5py
 import numpy as np
 
+from reports import report_common
 from validation import run_validation as runner
 
 PLATE_Z = 2.3
@@ -93,7 +94,8 @@ def test_undefined_bins_and_the_plate(shaker, work_dir):
         assert np.all(np.isfinite(a[name])), f"{name} = {a[name]}: undefined bins leaked in"
     assert abs(a["temperature_slope_above_layer"][0] - 0.1) < 1e-12
 
-    profiles = np.genfromtxt(path + ".profiles.csv", delimiter=",", names=True)
+    profiles, units = report_common.read_shaker_csv(path + ".profiles.csv")
+    assert units["T"] == "g sigma"
     empty = profiles["n"] == 0
     assert empty.sum() == 2 * (2 + 14), "two phases of 2 bins below the plate, 14 above the gas"
     for column in ("uz", "T", "mach"):
