@@ -8,7 +8,8 @@ from ._common import (SchemaError, Table, check_frame, check_schema_version, pro
                       read_group, text)
 
 # Profile datasets that are undefined in a bin where the MD found no particle.
-_UNDEFINED_WHEN_EMPTY = ("uz", "T", "n_se", "uz_se", "T_se")
+# n_se is defined there: a density of 0 in every sample has no spread (the solver writes 0).
+_UNDEFINED_WHEN_EMPTY = ("uz", "T", "uz_se", "T_se")
 
 
 @dataclass
@@ -80,8 +81,8 @@ def _read_series(group, path):
 
 
 def _mask_empty_bins(profiles):
-    """MD bins no particle was found in: n and nu 0, the mean velocity, the temperature and the
-    standard errors NaN, whether the file stores them as 0 or NaN."""
+    """MD bins no particle was found in: n and nu 0, the mean velocity, the temperature and
+    their standard errors NaN, whether the file stores them as 0 or NaN."""
     if "samples" not in profiles:
         return
     empty = profiles["samples"] == 0

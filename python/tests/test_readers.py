@@ -28,9 +28,10 @@ def test_md_run_lab_frame_values_units_and_empty_bins(work_dir, empty_value):
     # Empty bins: no particle, so n = nu = 0; the rest is undefined, whatever was stored.
     for name in ("n", "nu"):
         assert np.all(run.profiles[name][empty] == 0)
-    for name in ("uz", "T", "n_se", "uz_se", "T_se"):
+    for name in ("uz", "T", "uz_se", "T_se"):
         assert np.all(np.isnan(run.profiles[name][empty])), name
         assert np.all(np.isfinite(run.profiles[name][~empty])), name
+    np.testing.assert_array_equal(run.profiles["n_se"], profiles["n_se"])  # defined everywhere
     np.testing.assert_array_equal(run.profiles["T"][~empty], profiles["T"][~empty])
     assert len(run.replica_timeseries) == 1
     np.testing.assert_array_equal(run.replica_timeseries[0]["com_z"], series["com_z"] + 0.5)
