@@ -77,6 +77,14 @@ def test_effective_configurations(shaker):
     assert problems == []
 
 
+def set_value(text):
+    """The value of `--set key=text` as shaker reads it: TOML, or else a bare string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
 def test_every_planned_run_is_accepted(shaker):
     """Every run the runner would start, full and quick, with pool and fallback overrides."""
     for quick in (False, True):
@@ -84,11 +92,19 @@ def test_every_planned_run_is_accepted(shaker):
         plan = run_validation.plan_runs(shaker, STUDIES, names, quick)
         if not quick:
             plan += run_validation.resampled_runs(STUDIES, plan)
+        assert plan
         for run in plan:
-            run_validation.run_key(shaker, run)
-            if run["fallback"]:
-                run_validation.run_key(shaker, dict(run, overrides=run["overrides"]
-                                                    + run["fallback"]))
+            runs = [run] + ([dict(run, overrides=run["overrides"] + run["fallback"])]
+                            if run["fallback"] else [])
+            for r in runs:
+                text, key = run_validation.run_key(shaker, r)
+                assert len(key) == 64, key
+                # Every override is in the effective configuration, with its value.
+                config = tomllib.loads(text)
+                for override in r["overrides"]:
+                    name, value = override.split("=", 1)
+                    section, field = name.split(".", 1)
+                    assert config[section][field] == set_value(value), (r["case"], override)
 
 
 def test_unknown_key_is_refused(shaker, work_dir):
