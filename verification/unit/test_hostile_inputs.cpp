@@ -1,6 +1,7 @@
-// Regression cases of the fuzz targets (verification/fuzz): each input that crashed, hung or
-// escaped with something other than InputError, fed to the same reader through the normal
-// build. The contract: InputError naming what is wrong, quickly.
+// Hostile inputs to the readers of configuration and run files: deep nesting after every kind
+// of string, long dotted keys, invalid UTF-8, sample shapes that would allocate without end
+// (the fuzz targets of verification/fuzz found them), each fed to the reader through the
+// normal build. The contract: InputError naming what is wrong, quickly.
 #include <gtest/gtest.h>
 
 #include <hdf5.h>
@@ -37,7 +38,7 @@ std::string repeated(const std::string& piece, int times) {
 // A multi-line string holding a quote ("""a"b""") ended the nesting check's string one quote
 // early, so the check took the rest of the document for a string and let a deep array through
 // to toml11's recursive parser: a stack overflow (SIGSEGV).
-TEST(FuzzRegressionConfig, DeepArrayAfterMultiLineStringWithQuoteIsRefused) {
+TEST(HostileConfiguration, DeepArrayAfterMultiLineStringWithQuoteIsRefused) {
   const std::string document = joined("[case]\nname = \"\"\"a\"b\"\"\"\n[md]\ncrossing_heights = ",
                                       repeated("[", 20000), repeated("]", 20000), "\n");
   expect_input_error([&] { Config::from_toml(document, "case.toml"); }, {"case.toml", "nested 20000 deep"});
@@ -48,7 +49,7 @@ TEST(FuzzRegressionConfig, DeepArrayAfterMultiLineStringWithQuoteIsRefused) {
 
 // Multi-line strings that end in their own quotes ("""a"""" holds a"), and escapes, still
 // leave the rest of the document counted.
-TEST(FuzzRegressionConfig, NestingIsCountedAfterEveryKindOfString) {
+TEST(HostileConfiguration, NestingIsCountedAfterEveryKindOfString) {
   for (const std::string& string : std::vector<std::string>{"\"\"\"a\"\"\"\"", "\"\"\"a\"\"\"\"\"", "\"a\\\"b\"", "'a\\'",
                                    "'''a''''", "\"\"", "''"}) {
     const std::string document = joined("x = ", string, "\ny = ", repeated("[", 40), repeated("]", 40), "\n");
@@ -58,7 +59,7 @@ TEST(FuzzRegressionConfig, NestingIsCountedAfterEveryKindOfString) {
 
 // A dotted key or table header of 50,000 parts did not finish in 60 s (toml11 is quadratic in
 // the parts: 8,000 took 2.4 s and 120 MB); it is refused before parsing.
-TEST(FuzzRegressionConfig, DeeplyDottedKeyIsRefusedQuickly) {
+TEST(HostileConfiguration, DeeplyDottedKeyIsRefusedQuickly) {
   expect_input_error([&] { Config::from_toml(joined("a", repeated(".a", 50000), " = 1\n"), "case.toml"); },
                      {"case.toml", "dotted-key parts nested"}, 1.0);
   expect_input_error([&] { Config::from_toml(joined("[a", repeated(".a", 50000), "]\nx = 1\n"), "case.toml"); },
@@ -69,7 +70,7 @@ TEST(FuzzRegressionConfig, DeeplyDottedKeyIsRefusedQuickly) {
 
 // The nesting count does not refuse ordinary documents: numbers with dots, dates, the schema's
 // two-part keys, a list.
-TEST(FuzzRegressionConfig, OrdinaryDocumentsPassTheNestingCheck) {
+TEST(HostileConfiguration, OrdinaryDocumentsPassTheNestingCheck) {
   const Config c = Config::from_toml(
       "[md]\ncrossing_heights = [10.5, 20.25, 1e3]\n[material]\ne = 0.5 # a.b.c.d\n"
       "[case]\nname = \"a.b.c.d.e.f.g.h.i.j.k.l.m.n.o.p.q.r.s.t.u.v.w.x.y.z.a.b.c.d.e.f.g.h\"\n",
@@ -82,7 +83,7 @@ TEST(FuzzRegressionConfig, OrdinaryDocumentsPassTheNestingCheck) {
 // invalid UTF-8 sequence inside a literal string (an ASan heap-buffer-overflow; in a Release
 // build an out-of-bounds read). Text that is not UTF-8 is now refused before toml11 sees it.
 // The input is the fuzzer's, minimised by hand; the debug-asan preset runs this test under ASan.
-TEST(FuzzRegressionConfig, InvalidUtf8IsRefusedBeforeParsing) {
+TEST(HostileConfiguration, InvalidUtf8IsRefusedBeforeParsing) {
   expect_input_error([] { Config::from_toml("'a\xe4" "b' = 1\n", "case.toml"); },
                      {"case.toml", "not valid UTF-8 at byte 2 (line 1, byte 0xe4)"});
   expect_input_error(
@@ -101,7 +102,7 @@ TEST(FuzzRegressionConfig, InvalidUtf8IsRefusedBeforeParsing) {
 // 30,000 samples per phase (a few MB in all) made the reader allocate the per-sample sums,
 // 3 x 30,000 x 30,000 bins (108 GB), before it checked the sums' shapes: std::bad_alloc, exit 1.
 // The shapes are now checked first.
-TEST(FuzzRegressionRunFile, SampleShapesAreCheckedBeforeTheSumsAreAllocated) {
+TEST(HostileRunFile, SampleShapesAreCheckedBeforeTheSumsAreAllocated) {
   const shaker::testing::TemporaryDirectory dir;
   const auto path = dir / "huge-samples.h5";
   shaker::write_run_file(path, shaker::testing::make_sample_record(false));
