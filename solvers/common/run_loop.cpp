@@ -2,12 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
 #include "common/errors.hpp"
 
 namespace shaker {
+
+bool PhaseInstant::selected(const std::vector<std::int64_t>& chosen_phases,
+                            const std::vector<std::int64_t>& chosen_cycles) const {
+  const bool in_cycle = chosen_cycles.empty() ? last_cycle()
+                                              : std::binary_search(chosen_cycles.begin(), chosen_cycles.end(), cycle);
+  return in_cycle && std::binary_search(chosen_phases.begin(), chosen_phases.end(), phase);
+}
 
 PhaseSchedule::PhaseSchedule(const RunProtocol& run, const ShakerKinematics& shaker, Clock clock,
                              double start_time, double origin)

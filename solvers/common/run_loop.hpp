@@ -46,6 +46,9 @@ struct PhaseInstant {
   /// cycles_done() where this process took the run up: 0, or a continued run's checkpoint.
   double resumed_at = 0.0;
   bool last_cycle() const { return cycle + 1 == cycles; }
+  /// Whether this is one of `chosen_phases` in one of `chosen_cycles` (both increasing, as
+  /// stored_phase_indices and cycle_indices give them); no cycles: the last cycle.
+  bool selected(const std::vector<std::int64_t>& chosen_phases, const std::vector<std::int64_t>& chosen_cycles) const;
   /// Cycles of the run behind this instant, fractions included.
   double cycles_done() const {
     return static_cast<double>(cycle) + static_cast<double>(phase) / static_cast<double>(phases);

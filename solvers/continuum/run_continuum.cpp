@@ -208,15 +208,14 @@ class ProfileAverage final : public RunObserver {
   std::vector<int> cycles_;
 };
 
-/// 3D fields at the stored phases of continuum.field_phases, in the last cycle.
+/// 3D fields at the stored phases of continuum.field_phases, in the last cycle or in those of
+/// continuum.field_cycles.
 class FieldSnapshots final : public RunObserver {
  public:
   FieldSnapshots(const Box& box, const ShakerKinematics& shaker, const ContinuumCase& c)
       : box_(box), shaker_(shaker), phases_(c.field_phases), cycles_(c.field_cycles) {}
   void at_phase(const PhaseInstant& instant) override {
-    const bool in_cycle = cycles_.empty() ? instant.last_cycle()
-                                          : std::binary_search(cycles_.begin(), cycles_.end(), instant.cycle);
-    if (box_.writer() && in_cycle && std::binary_search(phases_.begin(), phases_.end(), instant.phase))
+    if (box_.writer() && instant.selected(phases_, cycles_))
       snapshots.push_back(snapshot(box_.view(), shaker_, instant.cycle));
   }
   std::vector<FieldSnapshot> snapshots;

@@ -146,9 +146,7 @@ class ParticleSnapshots final : public RunObserver {
   ParticleSnapshots(const ShakerKinematics& shaker, const MdSettings& settings, PhaseSnapshot& snapshot)
       : shaker_(shaker), settings_(settings), snapshot_(snapshot) {}
   void at_phase(const PhaseInstant& at) override {
-    if (!std::binary_search(settings_.snapshot_cycles.begin(), settings_.snapshot_cycles.end(), at.cycle) ||
-        !std::binary_search(settings_.snapshot_phases.begin(), settings_.snapshot_phases.end(), at.phase))
-      return;
+    if (!at.selected(settings_.snapshot_phases, settings_.snapshot_cycles)) return;
     snapshot_.take(at.t);
     frames.push_back(ParticleFrame{at.cycle * at.phases + at.phase, at.cycle, at.t,
                                    static_cast<double>(at.phase) / static_cast<double>(at.phases),

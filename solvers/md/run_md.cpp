@@ -77,19 +77,15 @@ State state_from_file(const CaseParameters& c, const MdSettings& s, const Geomet
                                  "(particles/all/box/edges); allowed: md.box_width = {}, the periodic box "
                                  "of the file's particles", g.width, which, stored.edges[0], stored.edges[1],
                                  stored.edges[0]));
-  State state;
-  state.time = frame.time;
-  state.particles.resize(frame.r.size());
-  for (std::size_t i = 0; i < frame.r.size(); ++i) state.particles[i] = Particle{frame.r[i], frame.v[i], frame.time};
   SimulationData data;
-  data.time = state.time;
-  data.particles = state.particles;
+  data.time = frame.time;
+  for (std::size_t i = 0; i < frame.r.size(); ++i) data.particles.push_back(Particle{frame.r[i], frame.v[i], frame.time});
   try {
     validate_state(g, data);
   } catch (const InputError& error) {
     throw InputError(fmt::format("{} cannot start this run: {}", which, error.what()));
   }
-  return state;
+  return State{data.time, std::move(data.particles), {}};
 }
 
 /// The simulation at the case's initial state, or at the checkpoint `restart_from` (whose
@@ -213,14 +209,19 @@ void check_replicas(const config::Config& config, const CheckpointSettings& chec
                                  spec.range.describe()));
 }
 
-/// What the root rank needs of a replica: its samples, its time series and the numbers of the
-/// summary. Sent between ranks as doubles (counts stay exact below 2^53); the series' column
-/// names, the same for every replica, are not sent.
 /// Collisions counted over one span of simulated time.
 struct CollisionCounts {
   double pair = 0.0, plate = 0.0, ceiling = 0.0, guard_activations = 0.0;
   double total() const { return pair + plate + ceiling; }
+  CollisionCounts& operator+=(const CollisionCounts& o) {
+    pair += o.pair, plate += o.plate, ceiling += o.ceiling, guard_activations += o.guard_activations;
+    return *this;
+  }
 };
+
+/// What the root rank needs of a replica: its samples, its time series and the numbers of the
+/// summary. Sent between ranks as doubles (counts stay exact below 2^53); the series' column
+/// names, the same for every replica, are not sent.
 
 struct ReplicaSummary {
   CycleSamples samples;
@@ -315,14 +316,9 @@ ReplicaSummary combined(const std::vector<ReplicaSummary>& replicas) {
   all.time = replicas.front().time;
   all.queue_consistent = true;
   for (const ReplicaSummary& r : replicas) {
+    all.this_run += r.this_run;
+    all.since_first_start += r.since_first_start;
     for (auto [into, x] : {std::pair{&all.seconds, r.seconds}, {&all.events, r.events},
-                           {&all.this_run.pair, r.this_run.pair}, {&all.this_run.plate, r.this_run.plate},
-                           {&all.this_run.ceiling, r.this_run.ceiling},
-                           {&all.this_run.guard_activations, r.this_run.guard_activations},
-                           {&all.since_first_start.pair, r.since_first_start.pair},
-                           {&all.since_first_start.plate, r.since_first_start.plate},
-                           {&all.since_first_start.ceiling, r.since_first_start.ceiling},
-                           {&all.since_first_start.guard_activations, r.since_first_start.guard_activations},
                            {&all.overlaps, r.overlaps}, {&all.budget.plate_work, r.budget.plate_work},
                            {&all.budget.collisional_loss, r.budget.collisional_loss},
                            {&all.budget.energy_change, r.budget.energy_change}})
