@@ -108,6 +108,8 @@ def variants_table(results):
              + (". Not run or not finished (so their claims are not measured): "
                 + ", ".join(f"{c} ({status})" for c, status in v["failed"].items())
                 if v.get("failed") else "")
+             + (f". Judged at commit {v['archived_at'][:10]} (from the study's archive)"
+                if v.get("archived_at") else "")
              for v in results["variants"]]
     return ["## Every variant", "",
             "Verdicts as the validation report gives them: pass or **FAIL** by more than two "

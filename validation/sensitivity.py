@@ -4,7 +4,7 @@
     validation/sensitivity.py --shaker build/release/solvers/app/shaker [--workdir DIR]
         [--variants validation,plate_inelastic] [--cases base] [--jobs 2]
         [--results DIR/sensitivity.json] [--report reports/continuum-sensitivity.md]
-        [--reuse-only] [--rerun]
+        [--archive reports/continuum-sensitivity/judged.json] [--reuse-only] [--rerun]
 
 Each variant of validation/sensitivity.toml appends its `--set` overrides to the continuum
 cases of the study; the MD runs of the study's md_cases are run once, as the validation study
@@ -16,10 +16,19 @@ does, with MD's jackknife errors), the 1 % mass bottom above the plate at chosen
 single-shock speed at e = 0.99, and its cost per cycle. reports/make_sensitivity_report.py
 writes the report.
 
+A work folder lives as long as its machine; the study outlives it through its archive, a JSON
+file kept with the report: every variant judged from finished runs is stored with a signature
+of what its judgement depends on (the keys of its continuum runs and of the MD runs, the
+claims' definitions, the phases of the mass bottoms) and the commit that judged it. A later
+call judges an archived variant with an unchanged signature from the archive instead of
+running it again. The MD runs and the reference variant's base case are always run (minutes),
+since the MD numbers and the Knudsen maps are drawn from their files.
+
 Exit status 0 when the results and report are written; 1 if a run or the report failed; 2 for
 bad arguments.
 """
 import argparse
+import hashlib
 import json
 import os
 import subprocess
@@ -33,6 +42,8 @@ else:  # run as a script: its folder, validation/, is first on sys.path
 
 HERE = rv.HERE
 ROOT = rv.ROOT
+ARCHIVE = os.path.join(ROOT, "reports", "continuum-sensitivity", "judged.json")
+REFERENCE = "validation"  # the variant without overrides: the validation settings
 
 
 def load_variants(path, studies):
@@ -54,8 +65,10 @@ def load_variants(path, studies):
     return study, variants
 
 
-def plan(shaker, studies, study, variants, case_filter):
-    """The solver runs: the MD references once, every variant's continuum cases."""
+def plan(shaker, studies, study, variants, case_filter, archived=()):
+    """The solver runs: the MD references once, every variant's continuum cases except those
+    of `archived` variants (the reference variant's base case is always run: the Knudsen maps
+    are drawn from it)."""
     md_cases = [c for c in study["md_cases"] if not case_filter or c in case_filter]
     runs = [dict(r, variant=None) for r in rv.plan_runs(shaker, studies, md_cases, False)
             if r["solver"] == "md"]
@@ -63,10 +76,51 @@ def plan(shaker, studies, study, variants, case_filter):
         for case in v.get("cases", study["cases"]):
             if case_filter and case not in case_filter:
                 continue
+            if v["name"] in archived and not (v["name"] == REFERENCE and case == "base"):
+                continue
             runs.append(dict(case=case, solver="continuum", replicas=1,
                              overrides=list(v["overrides"]), timeout=study["timeout"],
                              fallback=[], expect_failure=False, variant=v["name"]))
     return runs
+
+
+def signatures(shaker, runs, variants, study, claims):
+    """Each variant's signature: a hash of what its judgement depends on (its continuum runs'
+    keys, the MD runs' keys, the definitions of the claims it is judged by, the phases of the
+    mass bottoms). Sets each run's "key"."""
+    for r in runs:
+        r["key"] = rv.run_key(shaker, r)[1]
+    md = sorted(r["key"] for r in runs if r["solver"] == "md")
+    used = [c for c in claims if c["id"] in study["claims"]]
+    out = {}
+    for v in variants:
+        own = sorted(r["key"] for r in runs if r.get("variant") == v["name"])
+        text = json.dumps(dict(continuum=own, md=md, claims=used,
+                               phases=study["mass_gap_phases"]), sort_keys=True, default=str)
+        out[v["name"]] = hashlib.sha256(text.encode()).hexdigest()
+    return out
+
+
+def load_archive(path):
+    """The archive's judged variants by signature ({} without an archive)."""
+    if not path or not os.path.exists(path):
+        return {}
+    with open(path) as f:
+        return json.load(f)["judged"]
+
+
+def write_archive(path, archive, judged, signature, commit):
+    """Adds every variant judged here from finished runs (no run failed or missing) under its
+    signature, with the commit that judged it; the archive's other entries are kept (a subset
+    of the cases has its own signature, so it never stands in for the whole)."""
+    entries = dict(archive)
+    for v in judged:
+        if not v.get("archived_at") and not v["failed"]:
+            entries[signature[v["name"]]] = dict(variant=v["name"], commit=commit, judged=v)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path + ".partial", "w") as f:
+        json.dump(rv.plain(dict(judged=dict(sorted(entries.items())))), f, indent=1)
+    os.replace(path + ".partial", path)
 
 
 def cycles_of(config):
@@ -167,7 +221,10 @@ def main(argv=None):
     parser.add_argument("--results", help="results JSON (default WORKDIR/sensitivity.json)")
     parser.add_argument("--report", default=os.path.join(ROOT, "reports",
                                                          "continuum-sensitivity.md"))
-    parser.add_argument("--rerun", action="store_true", help="ignore finished runs")
+    parser.add_argument("--archive", default=ARCHIVE,
+                        help="judged variants kept across machines ('' for none)")
+    parser.add_argument("--rerun", action="store_true",
+                        help="ignore finished runs and the archive")
     parser.add_argument("--reuse-only", action="store_true",
                         help="never start a solver; use finished runs in --workdir only")
     args = parser.parse_args(argv)
@@ -193,9 +250,16 @@ def main(argv=None):
                          + ", ".join(study["cases"]))
     claims = rv.load_toml(args.claims)["claim"]
     os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
+    archive_path = os.path.abspath(args.archive) if args.archive else None
+    archive = load_archive(archive_path)
+    signature = signatures(shaker, plan(shaker, studies, study, variants, case_filter),
+                           variants, study, claims)
+    archived = set() if args.rerun else {n for n in signature if signature[n] in archive}
+    commit = rv.git("rev-parse", "HEAD")
 
     started = time.monotonic()
-    runs = rv.execute_all(shaker, workdir, plan(shaker, studies, study, variants, case_filter),
+    runs = rv.execute_all(shaker, workdir, plan(shaker, studies, study, variants, case_filter,
+                                                archived),
                           args.jobs, args.rerun, args.reuse_only)
     md_views = {(r["case"], "md"): rv.build_view(shaker, r["case"], "md", r["record"], workdir)
                 for r in runs if r["solver"] == "md"}
@@ -204,13 +268,19 @@ def main(argv=None):
     for v in variants:
         continuum = {r["case"]: rv.build_view(shaker, r["case"], "continuum", r["record"], workdir)
                      for r in runs if r.get("variant") == v["name"]}
-        if v["name"] == "validation":
+        if v["name"] == REFERENCE:
             reference_base = continuum.get("base")
-        judged.append(judge_variant(v, md_views, continuum, claims, study, comparer))
+        if v["name"] in archived:
+            entry = archive[signature[v["name"]]]
+            judged.append(dict(entry["judged"], archived_at=entry["commit"]))
+        else:
+            judged.append(judge_variant(v, md_views, continuum, claims, study, comparer))
         verdicts = [f"{k} {c['status']} {rv._format_value(c['value'])}"
                     for k, c in judged[-1]["claims"].items()]
         rv.log(f"{v['name']}: " + ", ".join(verdicts))
-    summary = dict(commit=rv.git("rev-parse", "HEAD"),
+    if archive_path:
+        write_archive(archive_path, archive, judged, signature, commit)
+    summary = dict(commit=commit,
                    knudsen=knudsen_inputs(md_views.get(("base", "md")), reference_base),
                    shaker_version=subprocess.run([shaker, "--version"], capture_output=True,
                                                  text=True).stdout.strip(),

@@ -71,7 +71,8 @@ def test_pipeline_on_synthetic_runs(shaker, work_dir):
     result = subprocess.run(
         [sys.executable, os.path.join(rv.HERE, "sensitivity.py"), "--shaker", shaker,
          "--workdir", workdir, "--variants", "validation,plate_inelastic",
-         "--cases", "base,depth_h4p5,depth_h13p5", "--reuse-only", "--report", report],
+         "--cases", "base,depth_h4p5,depth_h13p5", "--reuse-only", "--report", report,
+         "--archive", ""],
         capture_output=True, text=True)
     assert result.returncode == 0, result.stdout + result.stderr
     results = json.load(open(os.path.join(workdir, "sensitivity.json")))
@@ -106,3 +107,53 @@ def test_pipeline_on_synthetic_runs(shaker, work_dir):
     assert "plate_inelastic" in text and "`continuum.plate_energy=inelastic`" in text
     png = os.path.join(work_dir, "continuum-sensitivity", "variants.png")
     assert os.path.getsize(png) > 10000
+
+
+def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
+    """A variant judged from finished runs is archived under its signature; once its runs are
+    gone, the study judges it from the archive, with the same numbers and the commit that
+    judged it. A changed claim definition changes the signature: the archive no longer
+    stands in, and the lost runs show as not run."""
+    studies, study, variants = load()
+    chosen = [v for v in variants if v["name"] in ("validation", "plate_inelastic")]
+    workdir = os.path.join(work_dir, "work")
+    cases = ["base", "depth_h4p5", "depth_h13p5"]
+    runs = sensitivity.plan(shaker, studies, study, chosen, cases)
+    synthetic_runs.write_plan(shaker, workdir, runs)
+    archive = os.path.join(work_dir, "judged.json")
+
+    def study_call(claims_file=None):
+        command = [sys.executable, os.path.join(rv.HERE, "sensitivity.py"), "--shaker", shaker,
+                   "--workdir", workdir, "--variants", "validation,plate_inelastic",
+                   "--cases", ",".join(cases), "--reuse-only", "--archive", archive,
+                   "--report", os.path.join(work_dir, "continuum-sensitivity.md")]
+        if claims_file:
+            command += ["--claims", claims_file]
+        result = subprocess.run(command, capture_output=True, text=True)
+        assert result.returncode == 0, result.stdout + result.stderr
+        return {v["name"]: v for v in
+                json.load(open(os.path.join(workdir, "sensitivity.json")))["variants"]}
+
+    first = study_call()
+    entries = json.load(open(archive))["judged"]
+    assert sorted(e["variant"] for e in entries.values()) == ["plate_inelastic", "validation"]
+    for r in runs:
+        if r["variant"] == "plate_inelastic":
+            os.remove(os.path.join(workdir, "runs",
+                                   f"continuum-{rv.run_key(shaker, r)[1][:20]}.h5"))
+    second = study_call()
+    assert second["plate_inelastic"]["claims"] == first["plate_inelastic"]["claims"]
+    assert second["plate_inelastic"]["mass_gap"] == first["plate_inelastic"]["mass_gap"]
+    assert second["plate_inelastic"]["archived_at"] == rv.git("rev-parse", "HEAD")
+    assert "archived_at" not in second["validation"], "a variant with its runs is judged anew"
+    assert "from the study's archive" in open(os.path.join(work_dir,
+                                                           "continuum-sensitivity.md")).read()
+
+    claims = open(os.path.join(rv.ROOT, "reference-data", "claims.toml")).read()
+    changed = os.path.join(work_dir, "claims.toml")
+    at = claims.index('id = "C10"')
+    band = claims.index("band = [0.03]", at)
+    open(changed, "w").write(claims[:band] + "band = [0.031]" + claims[band + 13:])
+    third = study_call(changed)
+    assert "archived_at" not in third["plate_inelastic"]
+    assert set(third["plate_inelastic"]["failed"]) == set(cases), "its lost runs: not run"
