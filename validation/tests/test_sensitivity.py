@@ -122,7 +122,7 @@ def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
     synthetic_runs.write_plan(shaker, workdir, runs)
     archive = os.path.join(work_dir, "judged.json")
 
-    def study_call(claims_file=None):
+    def study_call(claims_file=None, status=0):
         command = [sys.executable, os.path.join(rv.HERE, "sensitivity.py"), "--shaker", shaker,
                    "--workdir", workdir, "--variants", "validation,plate_inelastic",
                    "--cases", ",".join(cases), "--reuse-only", "--archive", archive,
@@ -130,7 +130,7 @@ def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
         if claims_file:
             command += ["--claims", claims_file]
         result = subprocess.run(command, capture_output=True, text=True)
-        assert result.returncode == 0, result.stdout + result.stderr
+        assert result.returncode == status, result.stdout + result.stderr
         return {v["name"]: v for v in
                 json.load(open(os.path.join(workdir, "sensitivity.json")))["variants"]}
 
@@ -145,7 +145,8 @@ def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
     assert second["plate_inelastic"]["claims"] == first["plate_inelastic"]["claims"]
     assert second["plate_inelastic"]["mass_gap"] == first["plate_inelastic"]["mass_gap"]
     assert second["plate_inelastic"]["archived_at"] == rv.git("rev-parse", "HEAD")
-    assert "archived_at" not in second["validation"], "a variant with its runs is judged anew"
+    assert second["validation"]["claims"] == first["validation"]["claims"]
+    assert second["validation"]["archived_at"], "an unchanged signature is never judged twice"
     assert "from the study's archive" in open(os.path.join(work_dir,
                                                            "continuum-sensitivity.md")).read()
 
@@ -154,6 +155,6 @@ def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
     at = claims.index('id = "C10"')
     band = claims.index("band = [0.03]", at)
     open(changed, "w").write(claims[:band] + "band = [0.031]" + claims[band + 13:])
-    third = study_call(changed)
+    third = study_call(changed, status=1)  # 1: runs are missing
     assert "archived_at" not in third["plate_inelastic"]
     assert set(third["plate_inelastic"]["failed"]) == set(cases), "its lost runs: not run"
