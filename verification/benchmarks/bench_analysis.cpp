@@ -1,7 +1,7 @@
 // `shaker analyze` throughput on an MD run of the size users store: 100 phases of 200 bins,
 // 10 sampled cycles. One iteration is what the command computes: the analysis of the pooled
 // profiles and of each leave-one-cycle-out replicate (run_analysis.hpp), file input aside.
-// Counters: runs analysed per second and seconds per run (the budget is 0.5 s).
+// Counters: runs analysed per second and seconds per run (the budget is 0.5 s a run).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
