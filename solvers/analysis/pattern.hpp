@@ -127,6 +127,9 @@ struct PatternSymmetryMeasure {
 };
 PatternSymmetryMeasure pattern_symmetry(const PowerSpectrum& spectrum, double k_star,
                                         const SymmetryOptions& options = {});
+/// The symmetry that moments A2, A4, A6 give under `threshold` (SymmetryOptions::threshold):
+/// also for moments averaged over samples.
+PatternSymmetry classify_symmetry(double a2, double a4, double a6, double threshold);
 
 /// Pearson correlation of two fields on the same grid over the cells (NaN if either is
 /// uniform).

@@ -144,16 +144,24 @@ PatternSymmetryMeasure pattern_symmetry(const PowerSpectrum& spectrum, double k_
       const double kx = spectrum.kx(i), ky = spectrum.ky(j), k = std::hypot(kx, ky);
       if (k == 0.0 || std::abs(k - k_star) > half_width) continue;
       const double p = spectrum.power[j * spectrum.grid.nx + i], theta = std::atan2(ky, kx);
-      m2 += std::polar(p, 2.0 * theta), m4 += std::polar(p, 4.0 * theta), m6 += std::polar(p, 6.0 * theta);
+      m2 += std::polar(p, 2.0 * theta);
+      m4 += std::polar(p, 4.0 * theta);
+      m6 += std::polar(p, 6.0 * theta);
       sum += p;
       ++measure.modes;
     }
   if (!(sum > 0.0)) return measure;  // no power near k*: nothing to order
   measure.a2 = std::abs(m2) / sum, measure.a4 = std::abs(m4) / sum, measure.a6 = std::abs(m6) / sum;
-  if (measure.a2 >= options.threshold) measure.symmetry = PatternSymmetry::stripes;
-  else if (measure.a4 >= options.threshold) measure.symmetry = PatternSymmetry::squares;
-  else if (measure.a6 >= options.threshold) measure.symmetry = PatternSymmetry::hexagons;
+  measure.symmetry = classify_symmetry(measure.a2, measure.a4, measure.a6, options.threshold);
   return measure;
+}
+
+PatternSymmetry classify_symmetry(double a2, double a4, double a6, double threshold) {
+  check_options({1.0, threshold});
+  if (a2 >= threshold) return PatternSymmetry::stripes;
+  if (a4 >= threshold) return PatternSymmetry::squares;
+  if (a6 >= threshold) return PatternSymmetry::hexagons;
+  return PatternSymmetry::disordered;
 }
 
 }  // namespace shaker::analysis

@@ -26,8 +26,11 @@ using an::PatternSymmetry;
 
 constexpr double two_pi = 2.0 * M_PI;
 
-double cell_x(const HorizontalGrid& g, std::size_t i) { return (static_cast<double>(i) + 0.5) * g.lx / static_cast<double>(g.nx); }
-double cell_y(const HorizontalGrid& g, std::size_t j) { return (static_cast<double>(j) + 0.5) * g.ly / static_cast<double>(g.ny); }
+double centre(std::size_t i, std::size_t n, double length) {
+  return (static_cast<double>(i) + 0.5) * length / static_cast<double>(n);
+}
+double cell_x(const HorizontalGrid& g, std::size_t i) { return centre(i, g.nx, g.lx); }
+double cell_y(const HorizontalGrid& g, std::size_t j) { return centre(j, g.ny, g.ly); }
 
 /// f(x, y) at the cell centres, plus white noise of standard deviation `noise` per cell.
 HorizontalField sampled(const HorizontalGrid& g, const std::function<double(double, double)>& f,
@@ -226,7 +229,8 @@ TEST(PatternFields, ColumnMassAndHeightFromADensity) {
   for (std::size_t kz = 0; kz < d.nz; ++kz)
     for (std::size_t j = 0; j < d.grid.ny; ++j)
       for (std::size_t i = 0; i < d.grid.nx; ++i) {
-        const double x = cell_x(d.grid, i), z = d.z_bottom + (static_cast<double>(kz) + 0.5) * d.dz, u = (z - h0 - a * std::cos(k * x)) / w;
+        const double x = cell_x(d.grid, i), z = d.z_bottom + centre(kz, 1, d.dz);
+        const double u = (z - h0 - a * std::cos(k * x)) / w;
         d.n.push_back((1.0 + b * std::cos(k * x)) * std::exp(-0.5 * u * u));
       }
   const HorizontalField mass = an::column_mass_field(d), height = an::center_of_mass_height_field(d);
@@ -433,6 +437,7 @@ TEST(PatternBadInput, RejectedWithMessagesNamingTheAllowedRange) {
   expect_input_error([] { an::saturation({0.0, 1.0, 2.0}, {1.0, 1.0, 1.0}, 1.5); }, {"fraction 1.5", "(0, 1]"});
   expect_input_error([] { an::saturation({0.0, 1.0}, {1.0, 1.0}); }, {"at least three"});
   expect_input_error([] { an::saturation({0.0, 2.0, 1.0}, {1.0, 1.0, 1.0}); }, {"strictly increasing"});
+  expect_input_error([] { an::classify_symmetry(0.1, 0.1, 0.1, 0.0); }, {"threshold 0", "(0, 1]"});
 }
 
 }  // namespace
