@@ -130,3 +130,13 @@ def test_values_equal_the_definitions(shaker, work_dir):
             else:
                 expected = correlation(computed[before[0]][index], computed[f][index])
                 assert got == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
+def test_a_cell_wider_than_half_the_box_is_refused(shaker, work_dir):
+    analyse(shaker, work_dir)
+    refused = subprocess.run([shaker, "analyze", "run.h5", "--patterns", "coarse.csv",
+                              "--pattern-cell", "11"], cwd=work_dir, capture_output=True, text=True)
+    assert refused.returncode == 2
+    assert "--pattern-cell = 11 gives 1 x 1 cells" in refused.stderr
+    assert "allowed: at most half the box width" in refused.stderr
+    assert not Path(work_dir, "coarse.csv").exists()

@@ -258,6 +258,16 @@ TEST(PatternSubharmonic, CorrelationFromCycleToCycle) {
   EXPECT_EQ(alternating.pairs, 4u);
   EXPECT_NEAR(an::cycle_to_cycle_correlation({f, f, f}).mean, 1.0, 1e-12);
 
+  // Stripes (variance 1/2) inverting every cycle under fresh noise (variance 1/4): the
+  // correlation is -(1/2) / (1/2 + 1/4) = -2/3. Over 1024 cells one pair scatters by about
+  // (1 - 4/9) / sqrt(1024) = 0.017, so the mean of 19 pairs is within 0.02.
+  std::vector<HorizontalField> inverting;
+  for (int c = 0; c < 20; ++c)
+    inverting.push_back(sampled(g, stripes(two_pi * 3 / 32.0, 0.0, c % 2 == 0 ? 0.0 : M_PI), 0.5, 300 + c));
+  const auto noisy = an::cycle_to_cycle_correlation(inverting);
+  EXPECT_NEAR(noisy.mean, -2.0 / 3.0, 0.02);
+  std::cout << "inverting stripes under noise: correlation " << noisy.mean << " +- " << noisy.standard_error << "\n";
+
   // Independent noise: the mean within 2 standard errors in about 95 % of repeats, and the
   // error near 1 / sqrt(cells pairs).
   int covered = 0, repeats = 400;
