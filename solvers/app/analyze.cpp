@@ -14,6 +14,7 @@
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
 #include "common/version.hpp"
+#include "md/particle_file.hpp"
 
 namespace shaker {
 namespace {
@@ -226,12 +227,23 @@ void write_profiles_csv(const RunRecord& run, const std::string& path) {
 int command_analyze(const AnalyzeOptions& o) {
   std::vector<NamedPath> outputs, inputs;
   for (const auto& [flag, path] : {std::pair{"--csv", o.csv_file}, {"--json", o.json_file},
-                                   {"--profiles-csv", o.profiles_csv}, {"--pooled", o.pooled_file}})
+                                   {"--profiles-csv", o.profiles_csv}, {"--pooled", o.pooled_file},
+                                   {"--patterns", o.patterns_csv}})
     if (!path.empty()) outputs.push_back({flag, path});
   for (const auto& file : o.run_files) inputs.push_back({"run file", file});
+  if (!o.patterns_csv.empty()) {
+    if (o.run_files.size() != 1)
+      throw InputError(fmt::format("--patterns with {} run files; allowed: one RUN, whose particle "
+                                   "file it reads", o.run_files.size()));
+    inputs.push_back({"particle file", md::particle_h5_path(o.run_files.front())});
+    check_input_file(inputs.back());
+  }
   check_output_paths(outputs, inputs);
   std::vector<RunRecord> runs;
   for (const auto& file : o.run_files) runs.push_back(read_run_file(file));
+  // Read before anything is printed or written: a bad particle file is bad input.
+  const PatternTables patterns =
+      o.patterns_csv.empty() ? PatternTables{} : pattern_tables(inputs.back().path, o.pattern_cell);
   const RunRecord run = pool_runs(runs);
   const auto config = config::Config::from_toml(run.configuration, o.run_files.front());
   analysis::AnalysisOptions options;
@@ -248,6 +260,10 @@ int command_analyze(const AnalyzeOptions& o) {
                             samples >= 2 ? fmt::format("jackknife over {} samples", samples)
                                          : std::string("none")),
                 phases, per_run, crossing);
+  if (!o.patterns_csv.empty()) {
+    if (!o.quiet) fmt::print("{}", patterns.summary);
+    write_text_atomically(o.patterns_csv, patterns.csv);
+  }
   if (!o.json_file.empty())
     write_text_atomically(o.json_file, analysis_json(o.run_files, run, phases, per_run, crossing));
   if (!o.csv_file.empty()) write_text_atomically(o.csv_file, analysis_csv(phases));

@@ -1,6 +1,7 @@
 #pragma once
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -32,10 +33,20 @@ int command_config(const RunOptions& options);
 struct AnalyzeOptions {
   std::vector<std::string> run_files;  ///< one run, or runs of one configuration to pool
   std::string csv_file, json_file, profiles_csv, pooled_file;
+  /// --patterns: the pattern quantities of the run's particle file, per frame, as CSV
+  std::string patterns_csv;
+  double pattern_cell = 2.0;  ///< --pattern-cell: width of the pattern grid's cells (sigma)
   analysis::ShockCriteria criteria;
   bool quiet = false;
 };
 int command_analyze(const AnalyzeOptions& options);
+/// The pattern quantities (docs/analysis.md, "Patterns") of every frame of the MD particle
+/// file `particles` on cells about `cell` wide: a CSV row per frame, and summary lines (means
+/// over the frames of each stored phase) for the printed table.
+struct PatternTables {
+  std::string csv, summary;
+};
+PatternTables pattern_tables(const std::filesystem::path& particles, double cell);
 int command_describe(bool markdown);  ///< shaker config --describe [--markdown]
 int command_compare(const std::string& first, const std::string& second,
                     const std::string& csv_file);

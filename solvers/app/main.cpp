@@ -55,6 +55,12 @@ int main(int argc, char** argv) {
                       "also write every profile with its Mach and Knudsen numbers (phase,z,n,nu,uz,T,mach,kn_n,kn_T)");
   analyze->add_option("--pooled", analysis.pooled_file,
                       "also write the pooled run (profiles and samples of all RUNs) to this file");
+  auto* patterns = analyze->add_option("--patterns", analysis.patterns_csv,
+                      "also write the pattern quantities of the run's particle file (RUN.particles.h5), "
+                      "one row per frame, as CSV (one RUN only)");
+  analyze->add_option("--pattern-cell", analysis.pattern_cell,
+                      "with --patterns: width of the cells the particles are binned on (sigma)")
+      ->check(finite_between(0.01, 1e6))->capture_default_str()->needs(patterns);
   analyze->add_flag("--quiet", analysis.quiet, "print nothing (with --json or --csv)");
   analyze->add_option("--relative-drop", analysis.criteria.relative_drop,
                       "shock rule: minimum (T_max - T_min) / T_max")

@@ -1,0 +1,142 @@
+// `shaker analyze --patterns`: the pattern quantities of docs/analysis.md ("Patterns") for
+// every frame of an MD run's particle file, and their means over cycles per stored phase.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <map>
+#include <optional>
+
+#include "analysis/pattern.hpp"
+#include "app/commands.hpp"
+#include "common/errors.hpp"
+#include "common/hdf5_file.hpp"
+#include "md/particle_file.hpp"
+
+namespace shaker {
+namespace {
+
+/// The two fields of a frame, and where the frame sits in the run.
+struct FramePatterns {
+  std::int64_t cycle = 0;
+  double phase = 0.0, time = 0.0;
+  analysis::HorizontalField mass, height;
+  analysis::PatternMeasure mass_measure, height_measure;
+};
+
+/// observables/<name>/value of the particle file, one value per frame.
+std::vector<double> per_frame(const std::filesystem::path& path, const std::string& name,
+                              std::int64_t frames, const std::string& source) {
+  const std::string dataset = "observables/" + name + "/value";
+  std::vector<double> values;
+  try {
+    const h5::Handle file = h5::open_file(path);
+    values = h5::read_doubles(file.id(), dataset);
+  } catch (const std::runtime_error& error) {
+    throw InputError(fmt::format("{}: {} is unreadable: {}", source, dataset, error.what()));
+  }
+  if (static_cast<std::int64_t>(values.size()) != frames)
+    throw InputError(fmt::format("{}: {} holds {} values for {} frames; allowed: one per frame", source,
+                                 dataset, values.size(), frames));
+  return values;
+}
+
+analysis::HorizontalGrid pattern_grid(const double edges[3], double cell, const std::string& source) {
+  const double cells_x = std::round(edges[0] / cell), cells_y = std::round(edges[1] / cell);
+  if (cells_x < 2.0 || cells_y < 2.0)
+    throw InputError(fmt::format("--pattern-cell = {} gives {} x {} cells across the box {} x {} sigma "
+                                 "of {}; allowed: at most half the box width", cell, cells_x, cells_y,
+                                 edges[0], edges[1], source));
+  return {static_cast<std::size_t>(cells_x), static_cast<std::size_t>(cells_y), edges[0], edges[1]};
+}
+
+std::vector<FramePatterns> frame_patterns(const std::filesystem::path& path, double cell) {
+  const std::string source = fmt::format("particle file '{}'", path.string());
+  const std::int64_t frames = md::read_particle_frame(path, 0, source).frames;
+  const std::vector<double> phases = per_frame(path, "phase", frames, source);
+  const std::vector<double> cycles = per_frame(path, "cycle", frames, source);
+  std::vector<FramePatterns> out;
+  for (std::int64_t f = 0; f < frames; ++f) {
+    const md::StoredFrame stored = md::read_particle_frame(path, f, source);
+    const analysis::HorizontalGrid grid = pattern_grid(stored.edges, cell, source);
+    analysis::ParticlePositions p;
+    for (const auto& r : stored.frame.r) p.x.push_back(r.x), p.y.push_back(r.y), p.z.push_back(r.z);
+    FramePatterns fp{static_cast<std::int64_t>(cycles[f]), phases[f], stored.frame.time,
+                     analysis::column_mass_field(p, grid), analysis::center_of_mass_height_field(p, grid),
+                     {}, {}};
+    try {
+      fp.mass_measure = analysis::measure_pattern(fp.mass);
+      fp.height_measure = analysis::measure_pattern(fp.height);
+    } catch (const InputError& error) {
+      throw InputError(fmt::format("{}, frame {}: {}", source, f, error.what()));
+    }
+    out.push_back(std::move(fp));
+  }
+  return out;
+}
+
+/// The frame at the same phase one cycle earlier, if the file holds it.
+std::optional<std::size_t> previous_cycle(const std::vector<FramePatterns>& frames, std::size_t f) {
+  for (std::size_t g = 0; g < frames.size(); ++g)
+    if (frames[g].cycle + 1 == frames[f].cycle && std::abs(frames[g].phase - frames[f].phase) < 1e-9)
+      return g;
+  return std::nullopt;
+}
+
+std::string measure_columns(const analysis::PatternMeasure& m, double correlation) {
+  return fmt::format("{},{},{},{},{},{},{},{}", m.dominant.k, m.dominant.wavelength, m.symmetry.a2,
+                     m.symmetry.a4, m.symmetry.a6, analysis::to_string(m.symmetry.symmetry),
+                     m.order_parameter, correlation);
+}
+
+/// "# patterns at phase P, FIELD over N cycles: ..." for one stored phase and field.
+std::string summary_line(double phase, const char* field, const char* unit,
+                         const std::vector<analysis::PatternMeasure>& measures,
+                         const std::vector<double>& correlations) {
+  const analysis::PatternSummary s = analysis::summarize_patterns(measures);
+  const analysis::MeanAndError c = analysis::mean_and_error(correlations);
+  const auto e = [](const analysis::MeanAndError& m) {
+    return fmt::format("{:.4g} ({:.2g})", m.mean, m.standard_error);
+  };
+  return fmt::format("# patterns at phase {}, {} over {} frame(s): k* {} 1/sigma, wavelength {} sigma, "
+                     "A2 {}, A4 {}, A6 {} ({}), order parameter {} {}, cycle-to-cycle correlation {} over "
+                     "{} pair(s)\n", phase, field, measures.size(), e(s.k), e(s.wavelength), e(s.a2),
+                     e(s.a4), e(s.a6),
+                     analysis::to_string(analysis::classify_symmetry(s.a2.mean, s.a4.mean, s.a6.mean,
+                                                                     analysis::SymmetryOptions{}.threshold)),
+                     e(s.order_parameter), unit, e(c), c.samples);
+}
+
+}  // namespace
+
+PatternTables pattern_tables(const std::filesystem::path& particles, double cell) {
+  const std::vector<FramePatterns> frames = frame_patterns(particles, cell);
+  std::string csv = "cycle [1],phase [1],time [sqrt(sigma/g)]";
+  for (const char* field : {"mass", "height"})
+    csv += fmt::format(",{0}_k [1/sigma],{0}_wavelength [sigma],{0}_a2 [1],{0}_a4 [1],{0}_a6 [1],{0}_symmetry,"
+                       "{0}_order_parameter [{1}],{0}_correlation_previous_cycle [1]", field,
+                       field == std::string("mass") ? "1/sigma^2" : "sigma");
+  csv += "\n";
+  struct PerPhase {
+    std::vector<analysis::PatternMeasure> mass, height;
+    std::vector<double> mass_correlation, height_correlation;
+  };
+  std::map<double, PerPhase> per_phase;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const auto& fr = frames[f];
+    const auto before = previous_cycle(frames, f);
+    const double mass_c = before ? analysis::field_correlation(frames[*before].mass, fr.mass) : NAN;
+    const double height_c = before ? analysis::field_correlation(frames[*before].height, fr.height) : NAN;
+    csv += fmt::format("{},{},{},{},{}\n", fr.cycle, fr.phase, fr.time, measure_columns(fr.mass_measure, mass_c),
+                       measure_columns(fr.height_measure, height_c));
+    PerPhase& p = per_phase[fr.phase];
+    p.mass.push_back(fr.mass_measure), p.height.push_back(fr.height_measure);
+    if (before) p.mass_correlation.push_back(mass_c), p.height_correlation.push_back(height_c);
+  }
+  std::string summary;
+  for (const auto& [phase, p] : per_phase)
+    summary += summary_line(phase, "column mass", "1/sigma^2", p.mass, p.mass_correlation) +
+               summary_line(phase, "centre-of-mass height", "sigma", p.height, p.height_correlation);
+  return {std::move(csv), std::move(summary)};
+}
+
+}  // namespace shaker

@@ -1,0 +1,142 @@
+"""ctest md.Patterns.AnalyzeAgreesWithNumpy: `shaker analyze --patterns` on the particle file of
+a small MD run, checked against the definitions of docs/analysis.md ("Patterns") computed
+here independently with h5py and numpy's FFT.
+
+    python3 -m pytest verification/md/test_pattern_cli.py --shaker SHAKER
+
+A run writes frames at two stored phases of three consecutive cycles. For every frame the
+column-mass and centre-of-mass-height fields are binned on the grid, and k*, the wavelength,
+A2, A4, A6, the order parameter and the correlation with the previous cycle's frame must
+equal the CSV's to 1e-9 (relative, or absolute for values near 0).
+"""
+import csv
+import subprocess
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+WIDTH, PARTICLES, CELL = 16.0, 300, 2.0
+
+CASE = f"""
+[layer]
+particles = {PARTICLES}
+[md]
+box_width = {WIDTH}
+ceiling = 60.0
+snapshot_phases = [0.0, 0.4]
+snapshot_cycles = [0, 1, 2]
+[run]
+transient_cycles = 1
+sampled_cycles = 2
+phases_per_cycle = 5
+output = "run.h5"
+"""
+
+
+def fields(position, edges, n):
+    """Column mass (particles per cell area) and centre-of-mass height on n x n cells, [j, i]."""
+    x, y, z = position[:, 0], position[:, 1], position[:, 2]
+    i = np.minimum((np.mod(x, edges[0]) / edges[0] * n).astype(int), n - 1)
+    j = np.minimum((np.mod(y, edges[1]) / edges[1] * n).astype(int), n - 1)
+    count = np.zeros((n, n))
+    height = np.zeros((n, n))
+    np.add.at(count, (j, i), 1.0)
+    np.add.at(height, (j, i), z)
+    mean_height = np.where(count > 0, height / np.maximum(count, 1.0), z.mean())
+    return count / (edges[0] * edges[1] / n**2), mean_height
+
+
+def measure(field, edges):
+    """k*, wavelength, A2, A4, A6 and order parameter by the definitions of docs/analysis.md."""
+    ny, nx = field.shape
+    power = np.abs(np.fft.fft2(field - field.mean()))**2 / field.size**2
+    kx = 2 * np.pi * np.fft.fftfreq(nx, d=edges[0] / nx)
+    ky = 2 * np.pi * np.fft.fftfreq(ny, d=edges[1] / ny)
+    # numpy puts the Nyquist mode of an even n at negative k; the analysis counts it positive.
+    kx[nx // 2] = abs(kx[nx // 2]) if nx % 2 == 0 else kx[nx // 2]
+    ky[ny // 2] = abs(ky[ny // 2]) if ny % 2 == 0 else ky[ny // 2]
+    KX, KY = np.meshgrid(kx, ky)
+    k = np.hypot(KX, KY)
+    dk = 2 * np.pi / max(edges[0], edges[1])
+    shell = np.floor(k / dk + 0.5).astype(int)
+    shell_power = np.bincount(shell[k > 0], weights=power[k > 0])
+    peak = int(np.argmax(shell_power))
+    near = (k > 0) & (np.abs(shell - peak) <= 1)
+    k_star = np.sum(power[near] * k[near]) / np.sum(power[near])
+    ring = (k > 0) & (np.abs(k - k_star) <= 1.5 * dk)
+    theta = np.arctan2(KY[ring], KX[ring])
+    moments = [abs(np.sum(power[ring] * np.exp(1j * m * theta))) / np.sum(power[ring])
+               for m in (2, 4, 6)]
+    return [k_star, 2 * np.pi / k_star, *moments, np.sqrt(power.sum())]
+
+
+def correlation(a, b):
+    da, db = a - a.mean(), b - b.mean()
+    return np.sum(da * db) / np.sqrt(np.sum(da * da) * np.sum(db * db))
+
+
+def analyse(shaker, directory):
+    """Runs the MD and `shaker analyze --patterns`: the CSV rows, the frames, the printed text."""
+    Path(directory, "case.toml").write_text(CASE)
+    subprocess.run([shaker, "md", "case.toml", "--quiet"], cwd=directory, check=True,
+                   capture_output=True)
+    printed = subprocess.run([shaker, "analyze", "run.h5", "--patterns", "patterns.csv",
+                              "--pattern-cell", str(CELL)], cwd=directory, check=True,
+                             capture_output=True, text=True).stdout
+    with open(Path(directory, "patterns.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    with h5py.File(Path(directory, "run.particles.h5"), "r") as f:
+        frames = {
+            "position": f["particles/all/position/value"][()],
+            "edges": f["particles/all/box/edges"][()],
+            "cycle": f["observables/cycle/value"][()],
+            "phase": f["observables/phase/value"][()],
+        }
+    return rows, frames, printed
+
+
+def test_one_row_per_frame_with_units(shaker, work_dir):
+    rows, frames, printed = analyse(shaker, work_dir)
+    assert len(rows) == len(frames["cycle"]) == 6
+    assert "mass_k [1/sigma]" in rows[0] and "height_order_parameter [sigma]" in rows[0]
+    assert [int(r["cycle [1]"]) for r in rows] == list(frames["cycle"])
+    # one summary line per stored phase and field
+    assert printed.count("# patterns at phase") == 4
+
+
+def test_values_equal_the_definitions(shaker, work_dir):
+    rows, frames, _ = analyse(shaker, work_dir)
+    n = int(round(WIDTH / CELL))
+    computed = []
+    for f in range(len(rows)):
+        mass, height = fields(frames["position"][f], frames["edges"], n)
+        computed.append((mass, height))
+        for name, field in (("mass", mass), ("height", height)):
+            expected = measure(field, frames["edges"])
+            keys = ["k [1/sigma]", "wavelength [sigma]", "a2 [1]", "a4 [1]", "a6 [1]"]
+            unit = "1/sigma^2" if name == "mass" else "sigma"
+            keys.append(f"order_parameter [{unit}]")
+            got = [float(rows[f][f"{name}_{key}"]) for key in keys]
+            assert got == pytest.approx(expected, rel=1e-9, abs=1e-12), (f, name)
+    for f in range(len(rows)):
+        before = [g for g in range(len(rows)) if frames["cycle"][g] + 1 == frames["cycle"][f]
+                  and frames["phase"][g] == frames["phase"][f]]
+        for index, name in ((0, "mass"), (1, "height")):
+            got = float(rows[f][f"{name}_correlation_previous_cycle [1]"])
+            if not before:
+                assert np.isnan(got)
+            else:
+                expected = correlation(computed[before[0]][index], computed[f][index])
+                assert got == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
+def test_a_cell_wider_than_half_the_box_is_refused(shaker, work_dir):
+    analyse(shaker, work_dir)
+    refused = subprocess.run([shaker, "analyze", "run.h5", "--patterns", "coarse.csv",
+                              "--pattern-cell", "11"], cwd=work_dir, capture_output=True, text=True)
+    assert refused.returncode == 2
+    assert "--pattern-cell = 11 gives 1 x 1 cells" in refused.stderr
+    assert "allowed: at most half the box width" in refused.stderr
+    assert not Path(work_dir, "coarse.csv").exists()
