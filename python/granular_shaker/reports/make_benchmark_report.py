@@ -1,9 +1,10 @@
-#!/usr/bin/python3
 """Writes reports/benchmarks.md (+ a PNG of the history) from a history of Google Benchmark runs.
 
 Usage:
-    make_benchmark_report.py --history DIR [--output reports/benchmarks.md]
-                             [--threshold 0.10] [--alpha 0.05] [--metric real_time|cpu_time]
+    shaker-benchmark-report --history DIR [--output reports/benchmarks.md] [--repository DIR]
+                            [--threshold 0.10] [--alpha 0.05] [--metric real_time|cpu_time]
+
+(or `python3 -m granular_shaker.reports.make_benchmark_report ...`).
 
 History layout (ci/nightly appends to it): DIR/<run-id>/<program>.json, one directory per
 nightly run, run ids sorting in time order (ci/nightly uses YYYYmmddTHHMMSSZ-<commit>). Each
@@ -42,10 +43,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-if __package__:
-    from . import report_common as rc
-else:  # run as a script: its folder, reports/, is first on sys.path
-    import report_common as rc
+from ..repository import add_repository_option, repository_argument  # noqa: E402
+from . import report_common as rc  # noqa: E402
 
 TIME_UNIT_NS = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}
 STANDARD_KEYS = {"name", "family_index", "per_family_instance_index", "run_name", "run_type",
@@ -185,7 +184,7 @@ def throughput_series(runs):
                 rc.units_of(THROUGHPUT_UNITS, counter, "benchmark counter")
             except rc.UnknownUnits as unknown:
                 raise InputProblem(f"{unknown}: declare them in THROUGHPUT_UNITS of "
-                                   "reports/make_benchmark_report.py") from None
+                                   "granular_shaker/reports/make_benchmark_report.py") from None
         if keys:
             out[kind] = {key: [float(np.median(run["benchmarks"][key[0]]["counters"][key[1]]))
                                if key[0] in run["benchmarks"]
@@ -309,14 +308,16 @@ def hand_measured_sections(path):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--history", required=True)
-    parser.add_argument("--output", default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                                         "benchmarks.md"))
+    parser.add_argument("--output", help="default: reports/benchmarks.md of the repository")
     parser.add_argument("--threshold", type=float, default=0.10,
                         help="relative slowdown that fails (fraction, default 0.10)")
     parser.add_argument("--alpha", type=float, default=0.05)
     parser.add_argument("--metric", choices=("real_time", "cpu_time"), default="real_time",
                         help="the time judged for slowdowns (both are shown)")
+    add_repository_option(parser)
     args = parser.parse_args(argv)
+    repository = repository_argument(parser, args)
+    args.output = args.output or os.path.join(repository, "reports", "benchmarks.md")
     if not (args.threshold > 0 and 0 < args.alpha < 1):
         print("make_benchmark_report: need --threshold > 0 and 0 < --alpha < 1", file=sys.stderr)
         return 2
@@ -337,7 +338,7 @@ def main(argv=None):
              f"- commit: {latest['commit'] if latest else 'no run'}",
              f"- date: {rc.utc_now()}",
              f"- machine: {rc.machine_description()}",
-             f"- history: {rc.repository_path(args.history)} ({len(runs)} runs)",
+             f"- history: {rc.repository_path(args.history, repository)} ({len(runs)} runs)",
              f"- slowdown threshold: {args.threshold:.0%} in {args.metric} with Mann-Whitney "
              f"p < {args.alpha:g}", ""]
     slowdowns = []

@@ -1,15 +1,15 @@
 """Writes synthetic run files (docs/output-schema.md, solver attribute "synthetic") for the
-runs that validation/run_validation.py plans, under the names it reuses, so that the whole
-validation pipeline (shaker analyze, shaker compare, pooling, claims, report) can be tested
-without the solvers.
+runs that the validation study (granular_shaker.validation) plans, under the names it reuses,
+so that the whole validation pipeline (shaker analyze, shaker compare, pooling, claims, report)
+can be tested without the solvers.
 
 The fields are a cartoon of a shaken layer, not physics: a block of material that flies
 ballistically above the plate, lands at f t = 0.12 and carries a temperature shock (a tanh
 drop of T) from the plate to the top of the layer between f t = 0.12 and about 0.33. Depth,
 restitution and solver shift it a little so that the claims get definite, varied values.
 
-    python3 -m validation.tests.synthetic_runs --shaker SHAKER --workdir DIR [--cases a,b]
-        [--quick]
+    PYTHONPATH=python:python/tests python3 -m harness.synthetic_runs --shaker SHAKER \
+        --workdir DIR --cases a,b [--quick]
 """
 import argparse
 import json
@@ -20,9 +20,9 @@ import tomllib
 import h5py
 import numpy as np
 
-from validation import run_validation
+from granular_shaker.validation.plan import load_studies, plan_runs, resampled_runs, run_key
 
-VALIDATION = os.path.dirname(os.path.abspath(run_validation.__file__))
+from . import REPOSITORY
 
 
 # Collisions each synthetic MD run records in its running totals (see write_run).
@@ -169,20 +169,20 @@ def write_run(path, config_text, solver, seed):
 
 def write_runs(shaker, workdir, cases, quick):
     """The synthetic run files of `cases` (comma-separated) under workdir/runs."""
-    studies = run_validation.load_studies(os.path.join(VALIDATION, "studies.toml"))
-    plan = run_validation.plan_runs(os.path.abspath(shaker), studies, cases.split(","), quick)
+    studies = load_studies(os.path.join(REPOSITORY, "validation", "studies.toml"))
+    plan = plan_runs(REPOSITORY, studies, cases.split(","), quick)
     if not quick:
-        plan += run_validation.resampled_runs(studies, plan)
+        plan += resampled_runs(studies, plan)
     write_plan(shaker, workdir, plan)
 
 
 def write_plan(shaker, workdir, plan):
-    """A synthetic run file for every run of a plan (run_validation.plan_runs' dicts), under
-    the name the runner reuses."""
+    """A synthetic run file for every run of a plan (granular_shaker.validation.plan.plan_runs'
+    dicts), under the name the runner reuses."""
     shaker = os.path.abspath(shaker)
     os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
     for i, run in enumerate(plan):
-        text, key = run_validation.run_key(shaker, run)
+        text, key = run_key(shaker, run)
         stem = os.path.join(workdir, "runs", f"{run['solver']}-{key[:20]}")
         record = dict(key=key, config=text, seconds=1.0 + i, returncode=0, command="synthetic",
                       stdout="", stderr="")

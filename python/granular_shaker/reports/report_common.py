@@ -25,11 +25,11 @@ def git_commit(repository):
         return "unknown"
 
 
-def repository_path(path):
+def repository_path(path, repository):
     """How a report names an input: relative to the repository root when it is inside the
     repository, else only its last component, marked as outside (a report never carries an
     absolute path of the machine it was written on)."""
-    root = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
+    root = os.path.realpath(repository)
     full = os.path.realpath(path)
     if os.path.commonpath([root, full]) == root:
         return os.path.relpath(full, root)
@@ -97,7 +97,7 @@ def save_figure_atomically(figure, path, dpi=90):
 
 
 # ---- figures --------------------------------------------------------------------------------
-# Every figure follows reports/figure_rules.py: units on both axes, MD drawn with its standard
+# Every figure follows figure_rules.py: units on both axes, MD drawn with its standard
 # errors, a legend naming everything drawn, a colorbar for a colour that carries a value.
 
 MD_STYLE = dict(marker="o", ms=3, ls="none", capsize=0, elinewidth=0.8)
@@ -165,10 +165,8 @@ def write_figure(figure, out_dir, name):
     What breaks the rules of figure_rules.py (data the tests did not foresee: a legend on the
     points, a label too long) is named on stderr; the figure is written all the same."""
     import matplotlib.pyplot as plt  # only the generators that draw need matplotlib
-    if __package__:
-        from . import figure_rules
-    else:  # a generator run as a script: reports/ is first on sys.path
-        import figure_rules
+
+    from . import figure_rules
     for problem in figure_rules.figure_problems(figure):
         print(f"{name}: not fit to publish: {problem}", file=sys.stderr)
     save_figure_atomically(figure, os.path.join(out_dir, name))

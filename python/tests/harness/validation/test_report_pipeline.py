@@ -2,7 +2,7 @@
 without the solvers.
 
 synthetic_runs.py writes cartoon run files (docs/output-schema.md) under the names the runner
-reuses; run_validation.py --reuse-only then analyses them with the real `shaker analyze` and
+reuses; the validation study (--reuse-only) then analyses them with the real `shaker analyze` and
 `shaker compare`, analyses the single-shock ensembles, evaluates every claim and writes the report.
 Checks: every claim id C1..C20 in the claims table, pass, FAIL and "not measured" marks all
 present, the seven figure PNGs exist and are non-empty, no run was re-simulated, values the
@@ -13,22 +13,19 @@ table gives units (header or units column; those the report declares for `shaker
 quantities are the ones its --json prints), and --require sets the exit status (0 for a
 passing claim, 1 for a failing one).
 
-    python3 -m pytest validation/tests/test_report_pipeline.py --shaker SHAKER
+    python3 -m pytest python/tests/harness/validation/test_report_pipeline.py --shaker SHAKER
 """
 import json
 import os
 import re
 import subprocess
-import sys
 
 import pytest
 
-from reports import report_common
-from validation import quantities
-from validation import run_validation as runner
-from validation.tests import synthetic_runs
+from granular_shaker.reports import report_common
+from granular_shaker.validation import quantities
 
-VALIDATION = os.path.dirname(os.path.abspath(runner.__file__))
+from .. import harness_command, package_environment, synthetic_runs
 CASES = ("base,single_shock_e0p99,single_shock_e0p90,single_shock_e0p85,velocity_dependent,"
          "depth_h4p5,depth_h13p5,collapse_e0p70")
 FIGURES = ("fig1-profiles.png", "fig2-single-shock.png", "fig3-mach.png", "fig4-mach-width.png",
@@ -52,10 +49,10 @@ def write_gci_table(path):
 
 
 def run_validation(shaker, workdir, report, require, gci):
-    cmd = [sys.executable, os.path.join(VALIDATION, "run_validation.py"), "--shaker", shaker,
-           "--workdir", workdir, "--report", report, "--cases", CASES, "--quick",
-           "--reuse-only", "--require", require, "--gci", gci]
-    result = subprocess.run(cmd, capture_output=True, text=True)
+    cmd = harness_command("validation", "--shaker", shaker,
+                          "--workdir", workdir, "--report", report, "--cases", CASES, "--quick",
+                          "--reuse-only", "--require", require, "--gci", gci)
+    result = subprocess.run(cmd, capture_output=True, text=True, env=package_environment())
     return result.returncode, result.stdout + result.stderr
 
 
@@ -208,7 +205,6 @@ def check_units(text, rows, claims, tmp):
 def check_missing_units_are_refused(results_path, tmp):
     """A claim's check or a metric without units in results.json is an error of the report
     generator (exit 2, naming it), not a blank cell."""
-    script = os.path.join(os.path.dirname(VALIDATION), "reports", "make_validation_report.py")
     for what, remove in (("claim", lambda r: r["claims"][0]["checks"][0].pop("units")),
                          ("metric", lambda r: r["metric_units"].pop(
                              "center_of_mass_absolute_rms"))):
@@ -217,8 +213,9 @@ def check_missing_units_are_refused(results_path, tmp):
         broken = os.path.join(tmp, f"results-without-{what}-units.json")
         json.dump(results, open(broken, "w"))
         report = os.path.join(tmp, f"without-{what}-units.md")
-        result = subprocess.run([sys.executable, script, "--results", broken, "--output", report],
-                                capture_output=True, text=True)
+        result = subprocess.run(harness_command("reports.make_validation_report", "--results",
+                                                broken, "--output", report),
+                                capture_output=True, text=True, env=package_environment())
         assert result.returncode == 2 and "no units" in result.stderr \
             and not os.path.exists(report), \
             f"{what} without units: exit {result.returncode}, {result.stderr.strip()[-300:]}"

@@ -17,10 +17,12 @@ import tomllib
 
 import pytest
 
-from validation import quantities, run_validation
+from granular_shaker.validation import quantities
+from granular_shaker.validation.diagnoses import validate_diagnoses
 
-VALIDATION = os.path.dirname(os.path.abspath(quantities.__file__))
-ROOT = os.path.dirname(VALIDATION)
+from .. import REPOSITORY as ROOT
+
+VALIDATION = os.path.join(ROOT, "validation")
 
 FIELDS = {"id": str, "statement": str, "paper_value": str, "cases": list, "quantity": str,
           "parameters": dict, "comparison": str, "band": list, "solvers": str,
@@ -169,14 +171,14 @@ def test_broken_claims_are_caught(description, broken):
 
 def test_diagnoses_file_is_clean():
     """validation/diagnoses.toml is clean, and its checker catches broken copies."""
-    errors = run_validation.validate_diagnoses(DIAGNOSES, CLAIMS, STUDIES)
+    errors = validate_diagnoses(DIAGNOSES, CLAIMS, STUDIES)
     assert errors == [], f"diagnoses.toml: {len(DIAGNOSES)} diagnoses, {len(errors)} problems"
 
 
 @pytest.mark.parametrize("description, broken", broken_diagnoses(DIAGNOSES),
                          ids=[d for d, _ in broken_diagnoses(DIAGNOSES)])
 def test_broken_diagnoses_are_caught(description, broken):
-    assert run_validation.validate_diagnoses(broken, CLAIMS, STUDIES), \
+    assert validate_diagnoses(broken, CLAIMS, STUDIES), \
         f"broken diagnoses ({description}) NOT CAUGHT"
 
 

@@ -1,5 +1,5 @@
-"""ctest base_case_report: reports/make_base_case_report.py on synthetic run files of
-ci/base-case.sh (an MD run file, its `shaker analyze --csv` table and log; the continuum
+"""ctest reports.base_case_report: granular_shaker.reports.make_base_case_report on synthetic run
+files of ci/base-case.sh (an MD run file, its `shaker analyze --csv` table and log; the continuum
 unavailable).
 
 Checks the status table and the per-phase analysis table: their units in the headers
@@ -8,15 +8,14 @@ column without declared units is an error rather than a blank.
 """
 import os
 import subprocess
-import sys
 
 import h5py
 import numpy as np
 import pytest
 
-from reports import make_base_case_report, report_common
+from granular_shaker.reports import report_common
 
-SCRIPT = os.path.abspath(make_base_case_report.__file__)
+from .. import harness_command, package_environment
 PHASES = 10
 ANALYSIS_COLUMNS = ("phase", "plate_z", "layer_bottom", "layer_top", "center_of_mass",
                     "shock_location", "shock_width", "width_over_mfp", "max_mach")
@@ -56,9 +55,10 @@ def test_units_in_the_headers(work_dir):
     os.makedirs(runs)
     write_md_run(runs)
     report = os.path.join(runs, "base-case.md")
-    result = subprocess.run([sys.executable, SCRIPT, "--runs", runs, "--output", report,
-                             "--status", "md=ok:6600", "continuum=unavailable:0"],
-                            capture_output=True, text=True)
+    result = subprocess.run(harness_command("reports.make_base_case_report", "--runs", runs,
+                                            "--output", report, "--status", "md=ok:6600",
+                                            "continuum=unavailable:0", repository=False),
+                            capture_output=True, text=True, env=package_environment())
     assert result.returncode == 0, f"exit {result.returncode}: {result.stderr}"
     lines = open(report).read().splitlines()
     assert "| solver | status | wall time [s] | model variant | resolution |" in lines, \

@@ -7,18 +7,20 @@
   --reuse-only judges each variant by the claims it names, with numbers equal to what
   `shaker compare` gives for the same files, and writes the report with its figure.
 
-    python3 -m pytest validation/tests/test_sensitivity.py --shaker SHAKER
+    python3 -m pytest python/tests/harness/validation/test_sensitivity.py --shaker SHAKER
 """
 import json
 import os
 import subprocess
-import sys
 
-from validation import run_validation as rv
-from validation import sensitivity
-from validation.tests import synthetic_runs
+from granular_shaker.validation import sensitivity
+from granular_shaker.validation.plan import case_file, effective_config, load_studies, run_key
+from granular_shaker.validation.summary import git
 
-SPEC = os.path.join(rv.HERE, "sensitivity.toml")
+from .. import REPOSITORY, harness_command, package_environment, synthetic_runs
+
+VALIDATION = os.path.join(REPOSITORY, "validation")
+SPEC = os.path.join(VALIDATION, "sensitivity.toml")
 # The choices the study must vary (the paper leaves them open, or the project made them).
 REQUIRED_CHOICES = (
     "transport variant", "artificial dissipation: form and coefficient",
@@ -29,7 +31,7 @@ REQUIRED_CHOICES = (
 
 
 def load():
-    studies = rv.load_studies(os.path.join(rv.HERE, "studies.toml"))
+    studies = load_studies(os.path.join(VALIDATION, "studies.toml"))
     return (studies,) + sensitivity.load_variants(SPEC, studies)
 
 
@@ -54,7 +56,8 @@ def test_variants_are_valid_and_one_at_a_time(shaker):
     assert reference["name"] == "validation"
     for v in variants:
         for case in v.get("cases", study["cases"]):
-            text = rv.effective_config(shaker, case, v["overrides"])  # ValueError if refused
+            # ValueError if refused
+            text = effective_config(shaker, case_file(REPOSITORY, case), v["overrides"])
             assert text
         keys = [o.split("=")[0] for o in v["overrides"]]
         assert len(keys) == len(set(keys)), f"{v['name']}: a key set twice"
@@ -64,16 +67,16 @@ def test_pipeline_on_synthetic_runs(shaker, work_dir):
     studies, study, variants = load()
     chosen = [v for v in variants if v["name"] in ("validation", "plate_inelastic")]
     workdir = os.path.join(work_dir, "work")
-    runs = sensitivity.plan(shaker, studies, study, chosen, ["base", "depth_h4p5",
-                                                             "depth_h13p5"])
+    runs = sensitivity.plan(REPOSITORY, studies, study, chosen, ["base", "depth_h4p5",
+                                                                 "depth_h13p5"])
     synthetic_runs.write_plan(shaker, workdir, runs)
     report = os.path.join(work_dir, "continuum-sensitivity.md")
     result = subprocess.run(
-        [sys.executable, os.path.join(rv.HERE, "sensitivity.py"), "--shaker", shaker,
-         "--workdir", workdir, "--variants", "validation,plate_inelastic",
-         "--cases", "base,depth_h4p5,depth_h13p5", "--reuse-only", "--report", report,
-         "--archive", ""],
-        capture_output=True, text=True)
+        harness_command("validation.sensitivity", "--shaker", shaker,
+                        "--workdir", workdir, "--variants", "validation,plate_inelastic",
+                        "--cases", "base,depth_h4p5,depth_h13p5", "--reuse-only",
+                        "--report", report, "--archive", ""),
+        capture_output=True, text=True, env=package_environment())
     assert result.returncode == 0, result.stdout + result.stderr
     results = json.load(open(os.path.join(workdir, "sensitivity.json")))
     assert all(r["reused"] for r in results["runs"]), "every run reused"
@@ -83,7 +86,7 @@ def test_pipeline_on_synthetic_runs(shaker, work_dir):
     # each as `shaker compare CONTINUUM MD` gives it for the same files.
     by_case = {}
     for r in runs:
-        text, key = rv.run_key(shaker, r)
+        text, key = run_key(shaker, r)
         by_case.setdefault((r["case"], r["solver"], r["variant"]),
                            os.path.join(workdir, "runs", f"{r['solver']}-{key[:20]}.h5"))
     for name in judged:
@@ -118,18 +121,19 @@ def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
     chosen = [v for v in variants if v["name"] in ("validation", "plate_inelastic")]
     workdir = os.path.join(work_dir, "work")
     cases = ["base", "depth_h4p5", "depth_h13p5"]
-    runs = sensitivity.plan(shaker, studies, study, chosen, cases)
+    runs = sensitivity.plan(REPOSITORY, studies, study, chosen, cases)
     synthetic_runs.write_plan(shaker, workdir, runs)
     archive = os.path.join(work_dir, "judged.json")
 
     def study_call(claims_file=None):
-        command = [sys.executable, os.path.join(rv.HERE, "sensitivity.py"), "--shaker", shaker,
-                   "--workdir", workdir, "--variants", "validation,plate_inelastic",
-                   "--cases", ",".join(cases), "--reuse-only", "--archive", archive,
-                   "--report", os.path.join(work_dir, "continuum-sensitivity.md")]
+        command = harness_command("validation.sensitivity", "--shaker", shaker,
+                                  "--workdir", workdir, "--variants", "validation,plate_inelastic",
+                                  "--cases", ",".join(cases), "--reuse-only", "--archive", archive,
+                                  "--report", os.path.join(work_dir, "continuum-sensitivity.md"))
         if claims_file:
             command += ["--claims", claims_file]
-        result = subprocess.run(command, capture_output=True, text=True)
+        result = subprocess.run(command, capture_output=True, text=True,
+                                env=package_environment())
         assert result.returncode == 0, result.stdout + result.stderr
         return {v["name"]: v for v in
                 json.load(open(os.path.join(workdir, "sensitivity.json")))["variants"]}
@@ -140,16 +144,16 @@ def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
     for r in runs:
         if r["variant"] == "plate_inelastic":
             os.remove(os.path.join(workdir, "runs",
-                                   f"continuum-{rv.run_key(shaker, r)[1][:20]}.h5"))
+                                   f"continuum-{run_key(shaker, r)[1][:20]}.h5"))
     second = study_call()
     assert second["plate_inelastic"]["claims"] == first["plate_inelastic"]["claims"]
     assert second["plate_inelastic"]["mass_gap"] == first["plate_inelastic"]["mass_gap"]
-    assert second["plate_inelastic"]["archived_at"] == rv.git("rev-parse", "HEAD")
+    assert second["plate_inelastic"]["archived_at"] == git(REPOSITORY, "rev-parse", "HEAD")
     assert "archived_at" not in second["validation"], "a variant with its runs is judged anew"
     assert "from the study's archive" in open(os.path.join(work_dir,
                                                            "continuum-sensitivity.md")).read()
 
-    claims = open(os.path.join(rv.ROOT, "reference-data", "claims.toml")).read()
+    claims = open(os.path.join(REPOSITORY, "reference-data", "claims.toml")).read()
     changed = os.path.join(work_dir, "claims.toml")
     at = claims.index('id = "C10"')
     band = claims.index("band = [0.03]", at)

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from validation import quantities
+from granular_shaker.validation import quantities
 
 NAN = math.nan
 CASES = [

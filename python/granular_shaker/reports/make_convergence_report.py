@@ -1,9 +1,10 @@
-#!/usr/bin/python3
 """Writes reports/convergence.md (+ PNG plots beside it) from CSV error tables and summaries.
 
 Usage:
-    make_convergence_report.py --input DIR [--output reports/convergence.md]
-                               [--build-dir BUILD] [--build-type TYPE] [--commit SHA] [--strict]
+    shaker-convergence-report --input DIR [--output reports/convergence.md] [--repository DIR]
+                              [--build-dir BUILD] [--build-type TYPE] [--commit SHA] [--strict]
+
+(or `python3 -m granular_shaker.reports.make_convergence_report ...`).
 
 Every file under DIR (searched recursively) whose name ends in one of the suffixes below is
 read; verification/support/error_table.hpp and verification/sampling/md_sampling.cpp write
@@ -101,10 +102,8 @@ import matplotlib.ticker  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-if __package__:
-    from . import report_common as rc
-else:  # run as a script: its folder, reports/, is first on sys.path
-    import report_common as rc
+from ..repository import add_repository_option, repository_argument  # noqa: E402
+from . import report_common as rc  # noqa: E402
 
 ERRORS_HEADER = ["study", "field", "norm", "level", "h", "error"]
 ORDERS_HEADER = ["study", "field", "norm", "fit_points", "fitted_order", "order_std_error",
@@ -162,11 +161,10 @@ class InputProblem(Exception):
     pass
 
 
-REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # The order of grid convergence each real-problem quantity can reach, with its reason: one
-# table, read here and by verification/grid-studies/test_real_problem.cpp and rejudge_gci.
-THEORETICAL_ORDERS = os.path.join(REPOSITORY, "verification", "grid-studies",
-                                  "theoretical_orders.csv")
+# table of the repository, read here and by verification/grid-studies/test_real_problem.cpp
+# and rejudge_gci.
+THEORETICAL_ORDERS = os.path.join("verification", "grid-studies", "theoretical_orders.csv")
 THEORY_SECTION = "verification/README.md, \"What order the real problem's quantities can reach\""
 
 
@@ -209,7 +207,7 @@ def theory_of(row, orders):
         return row["design_order"], "design order"
     if row["quantity"] not in orders:
         raise InputProblem(f"GCI {row['study']} / {row['quantity']}: no theoretical order "
-                           f"declared in {rc.repository_path(THEORETICAL_ORDERS)}")
+                           f"declared in {THEORETICAL_ORDERS}")
     order, reason = orders[row["quantity"]]
     if row["design_order"] != order:
         raise InputProblem(f"GCI {row['study']} / {row['quantity']}: judged at order "
@@ -225,7 +223,7 @@ def units_of(name):
         return rc.units_of(QUANTITY_UNITS, PHASE_SUFFIX.sub("", name))
     except rc.UnknownUnits as unknown:
         raise InputProblem(f"{unknown}: declare them in QUANTITY_UNITS of "
-                           "reports/make_convergence_report.py") from None
+                           "granular_shaker/reports/make_convergence_report.py") from None
 
 
 def bin_size_value_units(row):
@@ -802,7 +800,7 @@ def gci_section(data, out_dir, failures, orders):
             "Each row is judged against its quantity's theoretical order (column "
             "'theoretical p'): for the real problem's grid triples the order theory allows that "
             f"quantity, declared with the short name of its reason in "
-            f"{rc.repository_path(THEORETICAL_ORDERS)} and explained in {THEORY_SECTION} "
+            f"{THEORETICAL_ORDERS} and explained in {THEORY_SECTION} "
             "(Engquist and Sjogreen 1998 and Casper and Carpenter 1998 on why a captured shock "
             "would limit it to first order, and why these grids resolve the shock instead); for "
             "a time-step study's own rows the integrator's temporal order. "
@@ -914,15 +912,20 @@ def error_tables(series):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--input", required=True, help="directory of *.errors/orders/gci.csv")
-    parser.add_argument("--output", default=os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                                         "convergence.md"))
+    parser.add_argument("--output", help="default: reports/convergence.md of the repository")
     parser.add_argument("--build-dir", help="build directory (its CMakeCache gives the build type)")
     parser.add_argument("--build-type", help="overrides the build type read from --build-dir")
     parser.add_argument("--commit", help="defaults to git rev-parse HEAD of this repository")
     parser.add_argument("--strict", action="store_true", help="exit 1 when any check fails")
-    parser.add_argument("--theoretical-orders", default=THEORETICAL_ORDERS,
-                        help="table quantity,order,reason of the real problem's quantities")
+    parser.add_argument("--theoretical-orders",
+                        help="table quantity,order,reason of the real problem's quantities "
+                        f"(default: {THEORETICAL_ORDERS} of the repository)")
+    add_repository_option(parser)
     args = parser.parse_args(argv)
+    repository = repository_argument(parser, args)
+    args.output = args.output or os.path.join(repository, "reports", "convergence.md")
+    args.theoretical_orders = (args.theoretical_orders
+                               or os.path.join(repository, THEORETICAL_ORDERS))
 
     if not os.path.isdir(args.input):
         print(f"make_convergence_report: --input {args.input} is not a directory", file=sys.stderr)
@@ -937,7 +940,6 @@ def main(argv=None):
         return 2
 
     out_dir = os.path.dirname(os.path.abspath(args.output))
-    repository = REPOSITORY
     commit = args.commit or rc.git_commit(repository)
     build_type = args.build_type or rc.build_type_of(args.build_dir)
 
@@ -961,7 +963,7 @@ def main(argv=None):
              f"- date: {rc.utc_now()}",
              f"- machine: {rc.machine_description()}",
              f"- build type: {build_type}",
-             f"- input: {rc.repository_path(args.input)} ({len(files)} files)", "",
+             f"- input: {rc.repository_path(args.input, repository)} ({len(files)} files)", "",
              "## Summary", "",
              f"{checks} checks: {checks - len(failures)} pass, {len(failures)} fail."]
     if not files:

@@ -5,16 +5,19 @@ cases; each file's case.name is its file name; and the study's defining values r
 effective configuration (particle numbers, ceilings, widths, e, protocol). A file with an
 unknown key must be rejected (exit status 2), so acceptance means something.
 
-    python3 -m pytest validation/tests/test_case_files.py --shaker SHAKER
+    python3 -m pytest python/tests/harness/validation/test_case_files.py --shaker SHAKER
 """
 import glob
 import os
 import subprocess
 import tomllib
 
-from validation import run_validation
+from granular_shaker.validation.plan import (case_file, effective_config, load_studies,
+                                             plan_runs, resampled_runs, run_key)
 
-VALIDATION = os.path.dirname(os.path.abspath(run_validation.__file__))
+from .. import REPOSITORY
+
+VALIDATION = os.path.join(REPOSITORY, "validation")
 
 # What each study of the validation must set (key path -> value) in the effective configuration.
 EXPECTED = {
@@ -49,7 +52,7 @@ def lookup(config, dotted):
     return config[section][key]
 
 
-STUDIES = run_validation.load_studies(os.path.join(VALIDATION, "studies.toml"))
+STUDIES = load_studies(os.path.join(VALIDATION, "studies.toml"))
 FILES = {os.path.splitext(os.path.basename(p))[0]
          for p in glob.glob(os.path.join(VALIDATION, "cases", "*.toml"))}
 LISTED = set(STUDIES["by_name"])
@@ -65,7 +68,7 @@ def test_effective_configurations(shaker):
     problems = []
     for name in sorted(FILES & LISTED):
         try:
-            config = tomllib.loads(run_validation.effective_config(shaker, name, []))
+            config = tomllib.loads(effective_config(shaker, case_file(REPOSITORY, name), []))
         except ValueError as error:
             problems.append(str(error))
             continue
@@ -89,15 +92,15 @@ def test_every_planned_run_is_accepted(shaker):
     """Every run the runner would start, full and quick, with pool and fallback overrides."""
     for quick in (False, True):
         names = sorted(LISTED) if not quick else STUDIES["quick"]["cases"]
-        plan = run_validation.plan_runs(shaker, STUDIES, names, quick)
+        plan = plan_runs(REPOSITORY, STUDIES, names, quick)
         if not quick:
-            plan += run_validation.resampled_runs(STUDIES, plan)
+            plan += resampled_runs(STUDIES, plan)
         assert plan
         for run in plan:
             runs = [run] + ([dict(run, overrides=run["overrides"] + run["fallback"])]
                             if run["fallback"] else [])
             for r in runs:
-                text, key = run_validation.run_key(shaker, r)
+                text, key = run_key(shaker, r)
                 assert len(key) == 64, key
                 # Every override is in the effective configuration, with its value.
                 config = tomllib.loads(text)
@@ -131,7 +134,7 @@ def test_an_empty_case_file_is_the_base_case(shaker, work_dir):
     result = subprocess.run([shaker, "config", empty], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     defaults = tomllib.loads(result.stdout)
-    base = tomllib.loads(run_validation.effective_config(shaker, "base", []))
+    base = tomllib.loads(effective_config(shaker, case_file(REPOSITORY, "base"), []))
     differences = sorted(f"{section}.{key}: default {defaults[section].get(key)!r}, base "
                          f"{value!r}" for section, values in base.items()
                          for key, value in values.items()
@@ -146,7 +149,8 @@ def test_every_case_uses_the_default_continuum_setting(shaker, work_dir):
                                             text=True, check=True).stdout)["continuum"]
     differences = []
     for name in sorted(FILES):
-        continuum = tomllib.loads(run_validation.effective_config(shaker, name, []))["continuum"]
+        text = effective_config(shaker, case_file(REPOSITORY, name), [])
+        continuum = tomllib.loads(text)["continuum"]
         differences += [f"{name}: continuum.{key} = {continuum[key]!r}, default "
                         f"{defaults[key]!r}" for key in CONTINUUM_SETTING
                         if continuum[key] != defaults[key]]

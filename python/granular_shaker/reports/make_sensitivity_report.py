@@ -1,9 +1,10 @@
-#!/usr/bin/python3
-"""Writes reports/continuum-sensitivity.md (markdown + PNG) from validation/sensitivity.py's
-results JSON.
+"""Writes reports/continuum-sensitivity.md (markdown + PNG) from the sensitivity study's
+(shaker-sensitivity, granular_shaker.validation.sensitivity) results JSON.
 
-    make_sensitivity_report.py --results WORKDIR/sensitivity.json
+    shaker-sensitivity-report --results WORKDIR/sensitivity.json
         --output reports/continuum-sensitivity.md
+
+(or `python3 -m granular_shaker.reports.make_sensitivity_report ...`).
 
 One row per variant of validation/sensitivity.toml, grouped by the choice it varies: the
 verdict and value of every claim the study evaluates (with MD's jackknife errors in the
@@ -24,10 +25,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-if __package__:
-    from . import report_common as rc
-else:  # run as a script: its folder, reports/, is first on sys.path
-    import report_common as rc
+from . import report_common as rc  # noqa: E402
 
 # What each claim's value is, with its units (reference-data/claims.toml).
 CLAIM_LABELS = {
@@ -311,11 +309,11 @@ def knudsen_section(results, out_dir, link):
     return lines
 
 
-def main():
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--results", required=True)
     parser.add_argument("--output", required=True)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     with open(args.results) as f:
         results = json.load(f)
     out_dir = os.path.splitext(args.output)[0]
@@ -323,7 +321,8 @@ def main():
     link = os.path.basename(out_dir)
     simulated = results.get("simulated_seconds", 0.0)
     lines = ["# Continuum sensitivity: the choices the paper leaves open", "",
-             "Written by reports/make_sensitivity_report.py from validation/sensitivity.py "
+             "Written by granular_shaker.reports.make_sensitivity_report from the study of "
+             "granular_shaker.validation.sensitivity (shaker-sensitivity) "
              "(variants: validation/sensitivity.toml). Every choice the paper leaves open or this "
              "project made is varied one at a time from the validation settings, and each variant "
              "is judged by the claims the continuum fails, against MD with MD's errors.", "",

@@ -2,8 +2,8 @@
 report, on values of known outcome."""
 import math
 
-from validation import phase_sampling
-from reports import make_validation_report as report
+from granular_shaker.reports import make_validation_report as report
+from granular_shaker.validation import phase_sampling
 
 
 def quantities(value, error):

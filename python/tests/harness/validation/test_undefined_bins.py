@@ -8,7 +8,7 @@ temperature is the n-weighted mean of the defined T (nothing undefined leaks int
 per-phase values reach the runner's view as numbers, and the profiles CSV writes `nan` where
 u_z, T and Ma are undefined and numbers everywhere else (read as the reports read it).
 
-    python3 -m pytest validation/tests/test_undefined_bins.py --shaker SHAKER
+    python3 -m pytest python/tests/harness/validation/test_undefined_bins.py --shaker SHAKER
 """
 import math
 import os
@@ -17,8 +17,8 @@ import subprocess
 import h5py
 import numpy as np
 
-from reports import report_common
-from validation import run_validation as runner
+from granular_shaker.reports import report_common
+from granular_shaker.validation import views as runner
 
 PLATE_Z = 2.3
 BINS = 40

@@ -1,8 +1,11 @@
-#!/usr/bin/python3
-"""Writes the validation report (markdown + PNG plots) from the results of
-validation/run_validation.py.
+"""Writes the validation report (markdown + PNG plots) from the results of the validation
+study (shaker-validation, granular_shaker.validation).
 
-    make_validation_report.py --results WORKDIR/results.json --output reports/validation.md
+    shaker-validation-report --results WORKDIR/results.json --output reports/validation.md
+        [--gci TABLE] [--repository DIR]
+
+(or `python3 -m granular_shaker.reports.make_validation_report ...`; the validation study calls
+it itself).
 
 Reads only files: results.json (runs, claim evaluations, agreement metrics, written by the
 runner), the HDF5 run files it names (docs/output-schema.md) and their `shaker analyze --csv`
@@ -27,29 +30,30 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..repository import add_repository_option, repository_argument  # noqa: E402
+from . import report_common as rc  # noqa: E402
 # One reader of the tables.
-if __package__:
-    from . import report_common as rc
-    from .make_convergence_report import GCI_HEADER, read_csv
-else:  # run as a script: its folder, reports/, is first on sys.path
-    import report_common as rc
-    from make_convergence_report import GCI_HEADER, read_csv
+from .make_convergence_report import GCI_HEADER, read_csv  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FIG1_PHASES = (0.0, 0.15, 0.22, 0.40)
 FIG2_CASES = (("single_shock_e0p99", "e = 0.99"), ("single_shock_e0p90", "e = 0.90"),
               ("single_shock_e0p85", "e = 0.85"))
 DEPTHS = (("depth_h4p5", "H = 4.5"), ("base", "H = 9"), ("depth_h13p5", "H = 13.5"))
+# The base case's GCI table in the repository, where the convergence report copies it.
+GCI_TABLE = os.path.join("reports", "convergence-tables", "real-1d-base.gci.csv")
 
 
 # ---- reading -------------------------------------------------------------------------------
 
 class Results:
-    def __init__(self, path, gci_path=None):
+    """results.json of the validation study, with the GCI table (`gci_path`) whose path the
+    report names relative to `repository`."""
+
+    def __init__(self, path, gci_path=None, repository=None):
         with open(path) as f:
             self.data = json.load(f)
         self.views = self.data["views"]
-        self.gci_path = gci_path
+        self.gci_path, self.repository = gci_path, repository
         self.gci_rows = []
         if gci_path and os.path.exists(gci_path):
             self.gci_rows = read_csv(gci_path, GCI_HEADER)
@@ -559,10 +563,10 @@ def band_text(check):
 
 def check_units(item, where):
     """The units of a claim's check or a diagnosis' evidence, as the runner wrote them from
-    validation/quantities.py (UNITS); an error, not a blank, if they are missing."""
+    granular_shaker.validation.quantities (UNITS); an error, not a blank, if they are missing."""
     if not item.get("units"):
         raise rc.UnknownUnits(f"{where}: no units for the quantity '{item.get('quantity')}' in "
-                              "the results (written by validation/run_validation.py)")
+                              "the results (written by the validation study)")
     return item["units"]
 
 
@@ -620,7 +624,8 @@ def solver_cell(results, claim, solver):
 
 
 def claims_section(results):
-    gci_source = os.path.relpath(results.gci_path, ROOT) if results.gci_rows else "none found"
+    gci_source = (os.path.relpath(results.gci_path, results.repository) if results.gci_rows
+                  else "none found")
     lines = ["## Claims C1 to C20", "",
              "Bands and claims from reference-data/claims.toml. MD uncertainty: one standard "
              "error, the jackknife over the independent samples (the sampled cycles of a "
@@ -772,12 +777,12 @@ def width_section(results):
 
 def sampling_section(results):
     """The shock quantities of each resampled MD case at its own and at the finer phase
-    sampling (validation/phase_sampling.py), with their jackknife errors."""
+    sampling (granular_shaker.validation.phase_sampling), with their jackknife errors."""
     entries = results.data.get("sampling", [])
     lines = ["## Shock quantities against the phase sampling (MD)", "",
              "The same MD runs (same seeds) stored at two phase samplings; a quantity agrees "
              "when |difference| is within the stated number of combined standard errors "
-             "(validation/phase_sampling.py). – where the run has no shock.", ""]
+             "(granular_shaker.validation.phase_sampling). – where the run has no shock.", ""]
     if not entries:
         return lines + ["Not run (a quick study, or no case of studies.toml [sampling]).", ""]
     lines += [f"Agreement within {entries[0]['agreement']:g} combined standard errors.", ""]
@@ -820,8 +825,8 @@ def header(results, counts):
     d = results.data
     lines = ["# Validation: MD against continuum against the paper", "",
              "Bougie, Moon, Swift and Swinney, Phys. Rev. E 66, 051301 (2002); its claims as data "
-             "in reference-data/claims.toml. Written by reports/make_validation_report.py from "
-             "validation/run_validation.py.", "",
+             "in reference-data/claims.toml. Written by granular_shaker.reports."
+             "make_validation_report from the validation study (shaker-validation).", "",
              f"- commit: {d['commit']}{' (with uncommitted changes)' if d['dirty'] else ''}",
              f"- date: {d['date']}", f"- program: {d['shaker_version']}",
              f"- mode: {'quick (reduced cycles and resolution)' if d['quick'] else 'full study'}"
@@ -846,16 +851,19 @@ def header(results, counts):
     return lines + [""]
 
 
-def main():
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--results", required=True)
     parser.add_argument("--output", required=True)
-    parser.add_argument("--gci", default=os.path.join(ROOT, "reports", "convergence-tables",
-                                                      "real-1d-base.gci.csv"),
-                        help="GCI table of the real-problem grid study (the convergence "
-                             "report copies it there)")
-    args = parser.parse_args()
-    results = Results(args.results, args.gci)
+    parser.add_argument("--gci",
+                        help="GCI table of the real-problem grid study (default: "
+                             f"{GCI_TABLE} of the repository, where the convergence report "
+                             "copies it)")
+    add_repository_option(parser)
+    args = parser.parse_args(argv)
+    repository = repository_argument(parser, args)
+    results = Results(args.results, args.gci or os.path.join(repository, GCI_TABLE),
+                      repository)
     out_dir = os.path.splitext(args.output)[0]
     link = os.path.basename(out_dir)
     body = []

@@ -1,20 +1,24 @@
-#!/usr/bin/python3
 """The continuum sensitivity study: every choice the paper leaves open, one at a time.
 
-    validation/sensitivity.py --shaker build/release/solvers/app/shaker [--workdir DIR]
+    shaker-sensitivity --shaker build/release/solvers/app/shaker [--workdir DIR]
         [--variants validation,plate_inelastic] [--cases base] [--jobs 2]
         [--results DIR/sensitivity.json] [--report reports/continuum-sensitivity.md]
         [--archive reports/continuum-sensitivity/judged.json] [--reuse-only] [--rerun]
+        [--repository DIR]
+
+(or `python3 -m granular_shaker.validation.sensitivity ...`). The study's data is read from the
+repository (--repository, default: the git top level of the current directory), and its
+default outputs go there: validation/work/, reports/continuum-sensitivity.md and the archive.
 
 Each variant of validation/sensitivity.toml appends its `--set` overrides to the continuum
 cases of the study; the MD runs of the study's md_cases are run once, as the validation study
 runs them (validation/studies.toml: ensembles for single shocks). Runs are keyed by their
-effective configuration exactly as run_validation.py keys them, so a workdir shared with the
-validation study reuses its runs, and an interrupted study resumes where it stopped. Every
-variant is then judged by the claims the continuum fails (evaluated as the validation study
-does, with MD's jackknife errors), the 1 % mass bottom above the plate at chosen phases, the
-single-shock speed at e = 0.99, and its cost per cycle. reports/make_sensitivity_report.py
-writes the report.
+effective configuration exactly as the validation study (shaker-validation) keys them, so a
+workdir shared with it reuses its runs, and an interrupted study resumes where it stopped.
+Every variant is then judged by the claims the continuum fails (evaluated as the validation
+study does, with MD's jackknife errors), the 1 % mass bottom above the plate at chosen phases,
+the single-shock speed at e = 0.99, and its cost per cycle.
+granular_shaker.reports.make_sensitivity_report writes the report.
 
 A work folder lives as long as its machine; the study outlives it through its archive, a JSON
 file kept with the report: every variant judged from finished runs is stored with a signature
@@ -35,20 +39,22 @@ import subprocess
 import sys
 import time
 
-if __package__:
-    from . import run_validation as rv
-else:  # run as a script: its folder, validation/, is first on sys.path
-    import run_validation as rv
+from ..reports import make_sensitivity_report
+from ..repository import add_repository_option, repository_argument
+from .claims import evaluate_claims, format_value, measure
+from .plan import case_file, load_studies, load_toml, plan_runs, run_key
+from .run import execute_all, log
+from .summary import git, write_json_atomically
+from .views import Comparer, build_view
 
-HERE = rv.HERE
-ROOT = rv.ROOT
-ARCHIVE = os.path.join(ROOT, "reports", "continuum-sensitivity", "judged.json")
+# Where the archive is kept, in the repository: beside the report's figures.
+ARCHIVE = os.path.join("reports", "continuum-sensitivity", "judged.json")
 REFERENCE = "validation"  # the variant without overrides: the validation settings
 
 
 def load_variants(path, studies):
     """The study's settings and variants; ValueError names what is wrong."""
-    spec = rv.load_toml(path)
+    spec = load_toml(path)
     study, variants = spec["study"], spec["variant"]
     known = set(studies["by_name"])
     names = set()
@@ -65,12 +71,12 @@ def load_variants(path, studies):
     return study, variants
 
 
-def plan(shaker, studies, study, variants, case_filter, archived=()):
-    """The solver runs: the MD references once, every variant's continuum cases except those
-    of `archived` variants (the reference variant's base case is always run: the Knudsen maps
-    are drawn from it)."""
+def plan(repository, studies, study, variants, case_filter, archived=()):
+    """The solver runs (cases of `repository`): the MD references once, every variant's
+    continuum cases except those of `archived` variants (the reference variant's base case is
+    always run: the Knudsen maps are drawn from it)."""
     md_cases = [c for c in study["md_cases"] if not case_filter or c in case_filter]
-    runs = [dict(r, variant=None) for r in rv.plan_runs(shaker, studies, md_cases, False)
+    runs = [dict(r, variant=None) for r in plan_runs(repository, studies, md_cases, False)
             if r["solver"] == "md"]
     for v in variants:
         for case in v.get("cases", study["cases"]):
@@ -78,7 +84,8 @@ def plan(shaker, studies, study, variants, case_filter, archived=()):
                 continue
             if v["name"] in archived and not (v["name"] == REFERENCE and case == "base"):
                 continue
-            runs.append(dict(case=case, solver="continuum", replicas=1,
+            runs.append(dict(case=case, case_file=case_file(repository, case),
+                             solver="continuum", replicas=1,
                              overrides=list(v["overrides"]), timeout=study["timeout"],
                              fallback=[], expect_failure=False, variant=v["name"]))
     return runs
@@ -89,7 +96,7 @@ def signatures(shaker, runs, variants, study, claims):
     keys, the MD runs' keys, the definitions of the claims it is judged by, the phases of the
     mass bottoms). Sets each run's "key"."""
     for r in runs:
-        r["key"] = rv.run_key(shaker, r)[1]
+        r["key"] = run_key(shaker, r)[1]
     md = sorted(r["key"] for r in runs if r["solver"] == "md")
     used = [c for c in claims if c["id"] in study["claims"]]
     out = {}
@@ -118,9 +125,7 @@ def write_archive(path, archive, judged, signature, commit):
         if not v.get("archived_at") and not v["failed"]:
             entries[signature[v["name"]]] = dict(variant=v["name"], commit=commit, judged=v)
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path + ".partial", "w") as f:
-        json.dump(rv.plain(dict(judged=dict(sorted(entries.items())))), f, indent=1)
-    os.replace(path + ".partial", path)
+    write_json_atomically(path, dict(judged=dict(sorted(entries.items()))))
 
 
 def cycles_of(config):
@@ -131,7 +136,7 @@ def cycles_of(config):
 def mass_gap(phase, solver, views, comparer):
     """The 1 % mass bottom above the plate at a stored phase of the base case, measured as the
     validation study measures it (with its error over MD's samples): (value, error)."""
-    m = rv.measure("mass_gap_at", {"phase": phase}, ["base"], solver, views, comparer, False)
+    m = measure("mass_gap_at", {"phase": phase}, ["base"], solver, views, comparer, False)
     return m.get("value"), m.get("error")
 
 
@@ -142,7 +147,7 @@ def judge_variant(variant, md_views, continuum_views, claims, study, comparer):
     cases = set(continuum_views)
     chosen = [c for c in claims if c["id"] in study["claims"]
               and all(case in cases or (case, "md") in md_views for case in c["cases"])]
-    results = rv.evaluate_claims(chosen, views, comparer, partial_cases_ok=False)
+    results = evaluate_claims(chosen, views, comparer, partial_cases_ok=False)
     verdicts = {}
     for claim in results:
         solver = "md_vs_continuum" if claim["solvers"] == "md_vs_continuum" else "continuum"
@@ -207,30 +212,50 @@ def knudsen_inputs(md_base, continuum_base):
     return out
 
 
-def main(argv=None):
+def argument_parser():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--shaker", required=True, help="path of the shaker program")
-    parser.add_argument("--workdir", default=os.path.join(HERE, "work"),
-                        help="runs and derived files (shared with run_validation.py: reused)")
-    parser.add_argument("--spec", default=os.path.join(HERE, "sensitivity.toml"))
-    parser.add_argument("--studies", default=os.path.join(HERE, "studies.toml"))
-    parser.add_argument("--claims", default=os.path.join(ROOT, "reference-data", "claims.toml"))
+    parser.add_argument("--workdir",
+                        help="runs and derived files (shared with the validation study: "
+                        "reused; default: validation/work of the repository)")
+    parser.add_argument("--spec", help="default: validation/sensitivity.toml of the repository")
+    parser.add_argument("--studies", help="default: validation/studies.toml of the repository")
+    parser.add_argument("--claims", help="default: reference-data/claims.toml of the repository")
     parser.add_argument("--variants", help="comma-separated subset of the variants")
     parser.add_argument("--cases", help="comma-separated subset of the study's cases")
     parser.add_argument("--jobs", type=int, default=2, help="solver runs at once")
     parser.add_argument("--results", help="results JSON (default WORKDIR/sensitivity.json)")
-    parser.add_argument("--report", default=os.path.join(ROOT, "reports",
-                                                         "continuum-sensitivity.md"))
-    parser.add_argument("--archive", default=ARCHIVE,
-                        help="judged variants kept across machines ('' for none)")
+    parser.add_argument("--report",
+                        help="default: reports/continuum-sensitivity.md of the repository")
+    parser.add_argument("--archive",
+                        help="judged variants kept across machines ('' for none; default: "
+                        f"{ARCHIVE} of the repository)")
     parser.add_argument("--rerun", action="store_true",
                         help="ignore finished runs and the archive")
     parser.add_argument("--reuse-only", action="store_true",
                         help="never start a solver; use finished runs in --workdir only")
-    args = parser.parse_args(argv)
+    add_repository_option(parser)
+    return parser
 
-    shaker, workdir = os.path.abspath(args.shaker), os.path.abspath(args.workdir)
-    studies = rv.load_studies(args.studies)
+
+def with_repository_defaults(args, repository):
+    """The arguments with every path left out taken from the repository."""
+    validation = os.path.join(repository, "validation")
+    defaults = dict(workdir=os.path.join(validation, "work"),
+                    spec=os.path.join(validation, "sensitivity.toml"),
+                    studies=os.path.join(validation, "studies.toml"),
+                    claims=os.path.join(repository, "reference-data", "claims.toml"),
+                    report=os.path.join(repository, "reports", "continuum-sensitivity.md"),
+                    archive=os.path.join(repository, ARCHIVE))
+    for name, path in defaults.items():
+        if getattr(args, name) is None:
+            setattr(args, name, path)
+    return args
+
+
+def chosen_variants_and_cases(parser, args, studies):
+    """The study, its variants (--variants, else all) and the case filter (--cases, else
+    None); an unknown variant or case is an argument error."""
     try:
         study, variants = load_variants(args.spec, studies)
     except (ValueError, KeyError) as error:
@@ -248,25 +273,18 @@ def main(argv=None):
         if unknown:
             parser.error(f"unknown case(s) {', '.join(unknown)}; study cases: "
                          + ", ".join(study["cases"]))
-    claims = rv.load_toml(args.claims)["claim"]
-    os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
-    archive_path = os.path.abspath(args.archive) if args.archive else None
-    archive = load_archive(archive_path)
-    signature = signatures(shaker, plan(shaker, studies, study, variants, case_filter),
-                           variants, study, claims)
-    archived = set() if args.rerun else {n for n in signature if signature[n] in archive}
-    commit = rv.git("rev-parse", "HEAD")
+    return study, variants, case_filter
 
-    started = time.monotonic()
-    runs = rv.execute_all(shaker, workdir, plan(shaker, studies, study, variants, case_filter,
-                                                archived),
-                          args.jobs, args.rerun, args.reuse_only)
-    md_views = {(r["case"], "md"): rv.build_view(shaker, r["case"], "md", r["record"], workdir)
+
+def judge_all(shaker, workdir, runs, variants, claims, study, archive, archived, signature):
+    """Every variant judged, from its runs or from the archive: (the judged variants, the MD
+    views, the reference variant's base-case view, the comparer)."""
+    md_views = {(r["case"], "md"): build_view(shaker, r["case"], "md", r["record"], workdir)
                 for r in runs if r["solver"] == "md"}
-    comparer = rv.Comparer(shaker, os.path.join(workdir, "derived"))
+    comparer = Comparer(shaker, os.path.join(workdir, "derived"))
     judged, reference_base = [], None
     for v in variants:
-        continuum = {r["case"]: rv.build_view(shaker, r["case"], "continuum", r["record"], workdir)
+        continuum = {r["case"]: build_view(shaker, r["case"], "continuum", r["record"], workdir)
                      for r in runs if r.get("variant") == v["name"]}
         if v["name"] == REFERENCE:
             reference_base = continuum.get("base")
@@ -275,9 +293,36 @@ def main(argv=None):
             judged.append(dict(entry["judged"], archived_at=entry["commit"]))
         else:
             judged.append(judge_variant(v, md_views, continuum, claims, study, comparer))
-        verdicts = [f"{k} {c['status']} {rv._format_value(c['value'])}"
+        verdicts = [f"{k} {c['status']} {format_value(c['value'])}"
                     for k, c in judged[-1]["claims"].items()]
-        rv.log(f"{v['name']}: " + ", ".join(verdicts))
+        log(f"{v['name']}: " + ", ".join(verdicts))
+    return judged, md_views, reference_base, comparer
+
+
+def main(argv=None):
+    parser = argument_parser()
+    args = parser.parse_args(argv)
+    repository = repository_argument(parser, args)
+    args = with_repository_defaults(args, repository)
+
+    shaker, workdir = os.path.abspath(args.shaker), os.path.abspath(args.workdir)
+    studies = load_studies(args.studies)
+    study, variants, case_filter = chosen_variants_and_cases(parser, args, studies)
+    claims = load_toml(args.claims)["claim"]
+    os.makedirs(os.path.join(workdir, "runs"), exist_ok=True)
+    archive_path = os.path.abspath(args.archive) if args.archive else None
+    archive = load_archive(archive_path)
+    signature = signatures(shaker, plan(repository, studies, study, variants, case_filter),
+                           variants, study, claims)
+    archived = set() if args.rerun else {n for n in signature if signature[n] in archive}
+    commit = git(repository, "rev-parse", "HEAD")
+
+    started = time.monotonic()
+    runs = execute_all(shaker, workdir, plan(repository, studies, study, variants, case_filter,
+                                             archived),
+                       args.jobs, args.rerun, args.reuse_only)
+    judged, md_views, reference_base, comparer = judge_all(
+        shaker, workdir, runs, variants, claims, study, archive, archived, signature)
     if archive_path:
         write_archive(archive_path, archive, judged, signature, commit)
     summary = dict(commit=commit,
@@ -293,16 +338,12 @@ def main(argv=None):
                               reused=r["record"].get("reused", False),
                               stderr=r["record"].get("stderr", "")[-400:]) for r in runs])
     results = os.path.abspath(args.results or os.path.join(workdir, "sensitivity.json"))
-    with open(results + ".partial", "w") as f:
-        json.dump(rv.plain(summary), f, indent=1)
-    os.replace(results + ".partial", results)
-    report = subprocess.run([sys.executable, os.path.join(ROOT, "reports",
-                                                          "make_sensitivity_report.py"),
-                             "--results", results, "--output", args.report])
+    write_json_atomically(results, summary)
+    report = make_sensitivity_report.main(["--results", results, "--output", args.report])
     failed = [r for r in runs if r["record"]["status"] not in ("ok",)]
     for r in failed:
-        rv.log(f"run failed: {r['case']} {r['solver']} {r.get('variant')}: {r['record']['status']}")
-    return 1 if report.returncode != 0 or failed else 0
+        log(f"run failed: {r['case']} {r['solver']} {r.get('variant')}: {r['record']['status']}")
+    return 1 if report != 0 or failed else 0
 
 
 if __name__ == "__main__":

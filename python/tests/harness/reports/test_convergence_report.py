@@ -1,5 +1,5 @@
-"""ctest reports.convergence_report: reports/make_convergence_report.py on a small synthetic
-study in a temporary directory.
+"""ctest reports.convergence_report: granular_shaker.reports.make_convergence_report on a small
+synthetic study in a temporary directory.
 
 Checks the provenance header, the order and GCI rows with
 their pass/fail marks, the failure summary with measured values, the units of every table
@@ -23,15 +23,14 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 
 import numpy as np
 
-from reports import make_convergence_report
+from granular_shaker.reports import make_convergence_report, report_common
 
-# The report is made as users make it: the script run by its path.
-SCRIPT = os.path.abspath(make_convergence_report.__file__)
-REPORTS = os.path.dirname(SCRIPT)
+from .. import REPOSITORY, harness_command, package_environment
+
+REPORTS = os.path.join(REPOSITORY, "reports")
 ORDERS_HEADER = ("study,field,norm,fit_points,fitted_order,order_std_error,pair_order_finest,"
                  "pair_order_next,design_order,tolerance,pass")
 GCI_HEADER = ("study,quantity,h1,h2,h3,phi1,phi2,phi3,order,phi_extrapolated,"
@@ -130,7 +129,9 @@ def is_png(path, min_size=5000):
 
 
 def run(*args):
-    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
+    """The report made as users make it: its command run in a process of its own."""
+    return subprocess.run(harness_command("reports.make_convergence_report", *args),
+                          capture_output=True, text=True, env=package_environment())
 
 
 def line_with(text, *fragments):
@@ -637,10 +638,8 @@ def test_a_failing_time_bound_says_what_step_would_meet_it(work_dir):
 def test_known_failures_are_listed_with_their_reasons(work_dir):
     """The report gives, beside the failing checks, every known-failure line of the
     repository's status files: its test pattern and its reason, one table row each."""
-    from reports import report_common
-    repository = os.path.dirname(REPORTS)
     known = [(pattern, reason) for _, _, pattern, labels, reason
-             in report_common.status_lines(repository) if labels and "known-failure" in labels]
+             in report_common.status_lines(REPOSITORY) if labels and "known-failure" in labels]
     assert known, "the repository declares no known failure: nothing to test"
     inputs = os.path.join(work_dir, "input")
     os.makedirs(inputs)
@@ -745,13 +744,13 @@ def test_the_theoretical_orders_cover_every_quantity_of_the_grid_studies():
     """The repository's table declares an order for every quantity the real problem's grid
     studies write: those of the stored tables and those test_real_problem.cpp names."""
     orders = make_convergence_report.read_theoretical_orders(
-        make_convergence_report.THEORETICAL_ORDERS)
+        os.path.join(REPOSITORY, make_convergence_report.THEORETICAL_ORDERS))
     tables = os.path.join(REPORTS, "convergence-tables")
     written = {row["quantity"] for kind in ("gci", "bounds")
                for path in glob.glob(os.path.join(tables, "**", f"real-*.{kind}.csv"),
                                      recursive=True)
                for row in csv_rows(path)}
-    source = os.path.join(os.path.dirname(REPORTS), "verification", "grid-studies",
+    source = os.path.join(REPOSITORY, "verification", "grid-studies",
                           "test_real_problem.cpp")
     named = set(re.findall(r'q\["([^"]+)"\]', open(source).read()))
     assert len(named) >= 7 and len(written) >= 11, (named, written)

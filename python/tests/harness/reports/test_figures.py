@@ -1,11 +1,11 @@
 """ctest reports.figures: every figure the report generators draw keeps the rules of
-reports/figure_rules.py, on small synthetic inputs (those of the other report tests, and
-validation/tests/synthetic_runs.py's cartoon run files).
+granular_shaker/reports/figure_rules.py, on small synthetic inputs (those of the other report
+tests, and harness/synthetic_runs.py's cartoon run files).
 
 The functions are enumerated, so that a new figure cannot be forgotten: a report generator
 draws a figure only in a function named figure_* that returns it (rc.write_figure writes it;
-nothing else in reports/ or validation/ calls savefig), and the figure functions tested here
-are exactly the figure_* functions of the generators.
+nothing else in granular_shaker/reports/ or granular_shaker/validation/ calls savefig), and the
+figure functions tested here are exactly the figure_* functions of the generators.
 """
 import ast
 import glob
@@ -17,14 +17,17 @@ import h5py
 import numpy as np
 import pytest
 
-from reports import (figure_rules, make_base_case_report as base, make_benchmark_report as bench,
-                     make_convergence_report as conv, make_sensitivity_report as sens,
-                     make_validation_report as val)
-from reports.tests import test_base_case_report, test_benchmark_report, test_convergence_report
-from validation.tests import synthetic_runs
+from granular_shaker.reports import (figure_rules, make_base_case_report as base,
+                                     make_benchmark_report as bench,
+                                     make_convergence_report as conv,
+                                     make_sensitivity_report as sens,
+                                     make_validation_report as val)
 
-REPORTS = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ROOT = os.path.dirname(REPORTS)
+from .. import REPOSITORY, synthetic_runs
+from . import test_base_case_report, test_benchmark_report, test_convergence_report
+
+PACKAGE = os.path.dirname(os.path.abspath(figure_rules.__file__))
+REPORTS = os.path.join(REPOSITORY, "reports")
 GENERATORS = (base, bench, conv, sens, val)
 FIGURE_PREFIX = "figure_"
 PYPLOT_DRAWING_CALLS = {"subplots", "figure", "subplot_mosaic", "subplot"}
@@ -254,8 +257,9 @@ def test_every_figure_function_is_tested():
 
 
 def python_sources():
-    return sorted(glob.glob(os.path.join(ROOT, "reports", "*.py"))
-                  + glob.glob(os.path.join(ROOT, "validation", "*.py")))
+    """The harness's modules: the report generators and the validation study."""
+    return sorted(glob.glob(os.path.join(PACKAGE, "*.py"))
+                  + glob.glob(os.path.join(os.path.dirname(PACKAGE), "validation", "*.py")))
 
 
 def test_figures_are_drawn_only_in_figure_functions():

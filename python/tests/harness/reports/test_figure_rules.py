@@ -9,7 +9,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from reports.figure_rules import figure_problems  # noqa: E402
+from granular_shaker.reports.figure_rules import figure_problems  # noqa: E402
 
 X = np.linspace(0.0, 1.0, 5)
 

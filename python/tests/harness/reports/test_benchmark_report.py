@@ -1,5 +1,5 @@
-"""ctest reports.benchmark_report: reports/make_benchmark_report.py on synthetic Google Benchmark
-JSON.
+"""ctest reports.benchmark_report: granular_shaker.reports.make_benchmark_report on synthetic
+Google Benchmark JSON.
 
 Two runs of three benchmarks with 9 repetitions each: one
 20% slower, one 20% faster, one unchanged (seeded noise). Checks the throughput rows per
@@ -13,15 +13,13 @@ import json
 import math
 import os
 import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from reports import make_benchmark_report as mbr
+from granular_shaker.reports import make_benchmark_report as mbr
 
-# The report is made as users make it: the script run by its path.
-SCRIPT = os.path.abspath(mbr.__file__)
+from .. import harness_command, package_environment
 
 
 def google_benchmark_json(commit, benchmarks, rng):
@@ -57,7 +55,9 @@ def write_run(history, run_id, commit, benchmarks, seed):
 
 
 def run(*args):
-    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
+    """The report made as users make it: its command run in a process of its own."""
+    return subprocess.run(harness_command("reports.make_benchmark_report", *args),
+                          capture_output=True, text=True, env=package_environment())
 
 
 def line_with(text, *fragments):

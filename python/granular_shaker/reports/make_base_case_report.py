@@ -1,5 +1,8 @@
-#!/usr/bin/python3
 """Writes the base-case report (markdown + PNG plots) from the run files of ci/base-case.sh.
+
+    shaker-base-case-report --runs DIR --output DIR/base-case.md [--status SOLVER=ok:MS ...]
+
+(or `python3 -m granular_shaker.reports.make_base_case_report ...`).
 
 Reads only files: <runs>/<solver>.h5 (the HDF5 run-file schema of docs/output-schema.md),
 <runs>/<solver>-analysis.csv (written by `shaker analyze --csv`, so the analysis is the
@@ -21,10 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-if __package__:
-    from . import report_common as rc
-else:  # run as a script: its folder, reports/, is first on sys.path
-    import report_common as rc
+from . import report_common as rc  # noqa: E402
 
 SOLVERS = ("md", "continuum")
 FIGURE_PHASES = (0.0, 0.15, 0.22, 0.40)  # the phases of the paper's Fig. 1
@@ -115,13 +115,13 @@ def fmt(x, digits=3):
     return "-" if not np.isfinite(x) else f"{x:.{digits}f}"
 
 
-def main():
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--runs", required=True)
     parser.add_argument("--output", required=True)
     parser.add_argument("--status", nargs="*", default=[],
                         help="solver=ok:milliseconds or solver=unavailable:0")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
 
     status = dict(s.split("=", 1) for s in args.status)
     runs, analyses = {}, {}
