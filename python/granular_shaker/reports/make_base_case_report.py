@@ -24,7 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from . import report_common as rc  # noqa: E402
+from granular_shaker.reports import report_common as rc  # noqa: E402
 
 SOLVERS = ("md", "continuum")
 FIGURE_PHASES = (0.0, 0.15, 0.22, 0.40)  # the phases of the paper's Fig. 1

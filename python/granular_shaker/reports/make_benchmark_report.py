@@ -43,8 +43,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..repository import add_repository_option, repository_argument  # noqa: E402
-from . import report_common as rc  # noqa: E402
+from granular_shaker.repository import add_repository_option, repository_argument  # noqa: E402
+from granular_shaker.reports import report_common as rc  # noqa: E402
 
 TIME_UNIT_NS = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}
 STANDARD_KEYS = {"name", "family_index", "per_family_instance_index", "run_name", "run_type",

@@ -102,8 +102,8 @@ import matplotlib.ticker  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..repository import add_repository_option, repository_argument  # noqa: E402
-from . import report_common as rc  # noqa: E402
+from granular_shaker.repository import add_repository_option, repository_argument  # noqa: E402
+from granular_shaker.reports import report_common as rc  # noqa: E402
 
 ERRORS_HEADER = ["study", "field", "norm", "level", "h", "error"]
 ORDERS_HEADER = ["study", "field", "norm", "fit_points", "fitted_order", "order_std_error",

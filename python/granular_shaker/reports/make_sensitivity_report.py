@@ -25,7 +25,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from . import report_common as rc  # noqa: E402
+from granular_shaker.reports import report_common as rc  # noqa: E402
 
 # What each claim's value is, with its units (reference-data/claims.toml).
 CLAIM_LABELS = {

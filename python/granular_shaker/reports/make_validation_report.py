@@ -30,10 +30,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..repository import add_repository_option, repository_argument  # noqa: E402
-from . import report_common as rc  # noqa: E402
+from granular_shaker.repository import add_repository_option, repository_argument  # noqa: E402
+from granular_shaker.reports import report_common as rc  # noqa: E402
 # One reader of the tables.
-from .make_convergence_report import GCI_HEADER, read_csv  # noqa: E402
+from granular_shaker.reports.make_convergence_report import GCI_HEADER, read_csv  # noqa: E402
 
 FIG1_PHASES = (0.0, 0.15, 0.22, 0.40)
 FIG2_CASES = (("single_shock_e0p99", "e = 0.99"), ("single_shock_e0p90", "e = 0.90"),

@@ -166,7 +166,7 @@ def write_figure(figure, out_dir, name):
     points, a label too long) is named on stderr; the figure is written all the same."""
     import matplotlib.pyplot as plt  # only the generators that draw need matplotlib
 
-    from . import figure_rules
+    from granular_shaker.reports import figure_rules
     for problem in figure_rules.figure_problems(figure):
         print(f"{name}: not fit to publish: {problem}", file=sys.stderr)
     save_figure_atomically(figure, os.path.join(out_dir, name))

@@ -5,8 +5,8 @@ import math
 
 import numpy as np
 
-from . import quantities
-from .plan import SOLVERS
+from granular_shaker.validation import quantities
+from granular_shaker.validation.plan import SOLVERS
 
 
 def _spread(kind, values):

@@ -36,15 +36,16 @@ import shlex
 import sys
 import time
 
-from ..reports import make_validation_report
-from ..repository import add_repository_option, repository_argument
-from . import quantities
-from .claims import evaluate_claims, format_value, required_not_passing
-from .diagnoses import diagnose, load_diagnoses
-from .plan import load_studies, load_toml, plan_runs, resampled_runs
-from .run import execute_all, log
-from .summary import phase_sampling_results, study_summary, write_json_atomically
-from .views import Comparer, build_view
+from granular_shaker.reports import make_validation_report
+from granular_shaker.repository import add_repository_option, repository_argument
+from granular_shaker.validation import quantities
+from granular_shaker.validation.claims import evaluate_claims, format_value, required_not_passing
+from granular_shaker.validation.diagnoses import diagnose, load_diagnoses
+from granular_shaker.validation.plan import load_studies, load_toml, plan_runs, resampled_runs
+from granular_shaker.validation.run import execute_all, log
+from granular_shaker.validation.summary import (phase_sampling_results, study_summary,
+                                                write_json_atomically)
+from granular_shaker.validation.views import Comparer, build_view
 
 
 def argument_parser():

@@ -1,8 +1,8 @@
 """Diagnoses of failing claims (validation/diagnoses.toml): each names its claim, a category
 and a reason, and the evidence the study measures for it."""
-from . import quantities
-from .claims import measure
-from .plan import SOLVERS, load_toml
+from granular_shaker.validation import quantities
+from granular_shaker.validation.claims import measure
+from granular_shaker.validation.plan import SOLVERS, load_toml
 
 
 CATEGORIES = {"a": "the continuum and MD really differ",

@@ -6,7 +6,7 @@ import os
 import subprocess
 import time
 
-from .plan import run_key
+from granular_shaker.validation.plan import run_key
 
 SOLVER_UNAVAILABLE = 3  # exit code of a solver that is not built yet (README)
 

@@ -39,13 +39,13 @@ import subprocess
 import sys
 import time
 
-from ..reports import make_sensitivity_report
-from ..repository import add_repository_option, repository_argument
-from .claims import evaluate_claims, format_value, measure
-from .plan import case_file, load_studies, load_toml, plan_runs, run_key
-from .run import execute_all, log
-from .summary import git, write_json_atomically
-from .views import Comparer, build_view
+from granular_shaker.reports import make_sensitivity_report
+from granular_shaker.repository import add_repository_option, repository_argument
+from granular_shaker.validation.claims import evaluate_claims, format_value, measure
+from granular_shaker.validation.plan import case_file, load_studies, load_toml, plan_runs, run_key
+from granular_shaker.validation.run import execute_all, log
+from granular_shaker.validation.summary import git, write_json_atomically
+from granular_shaker.validation.views import Comparer, build_view
 
 # Where the archive is kept, in the repository: beside the report's figures.
 ARCHIVE = os.path.join("reports", "continuum-sensitivity", "judged.json")

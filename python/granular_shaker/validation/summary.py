@@ -11,8 +11,8 @@ import time
 import h5py
 import numpy as np
 
-from . import phase_sampling
-from .views import build_view
+from granular_shaker.validation import phase_sampling
+from granular_shaker.validation.views import build_view
 
 
 def phase_sampling_results(shaker, plan, views, workdir):

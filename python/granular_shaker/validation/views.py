@@ -11,7 +11,7 @@ import tomllib
 import h5py
 import numpy as np
 
-from . import quantities
+from granular_shaker.validation import quantities
 
 
 class RunView:
