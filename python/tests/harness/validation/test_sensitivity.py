@@ -3,8 +3,8 @@
 - The variants of validation/sensitivity.toml cover every choice the study must vary, each is
   accepted by `shaker config` on every case it runs, and each differs from the reference by
   its own overrides only (one choice at a time).
-- On synthetic run files (synthetic_runs.py) of two variants, validation/sensitivity.py
-  --reuse-only judges each variant by the claims it names, with numbers equal to what
+- On synthetic run files (harness/synthetic_runs.py) of two variants, the study
+  (granular_shaker.validation.sensitivity) with --reuse-only judges each variant by the claims it names, with numbers equal to what
   `shaker compare` gives for the same files, and writes the report with its figure.
 
     python3 -m pytest python/tests/harness/validation/test_sensitivity.py --shaker SHAKER
