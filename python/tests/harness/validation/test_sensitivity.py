@@ -4,8 +4,9 @@
   accepted by `shaker config` on every case it runs, and each differs from the reference by
   its own overrides only (one choice at a time).
 - On synthetic run files (harness/synthetic_runs.py) of two variants, the study
-  (granular_shaker.validation.sensitivity) with --reuse-only judges each variant by the claims it names, with numbers equal to what
-  `shaker compare` gives for the same files, and writes the report with its figure.
+  (granular_shaker.validation.sensitivity) with --reuse-only judges each variant by the claims
+  it names, with numbers equal to what `shaker compare` gives for the same files, and writes
+  the report with its figure.
 
     python3 -m pytest python/tests/harness/validation/test_sensitivity.py --shaker SHAKER
 """
