@@ -123,7 +123,13 @@ def test_report_on_a_synthetic_history(work_dir):
             and "BM_unchanged" not in result.stderr and "BM_memory:" not in result.stderr
             and "BM_memory_grows: bytes_per_cell +23.9%" in result.stderr), \
         f"stderr must name the slow one and the grown one: {result.stderr}"
-    text = open(out).read() if os.path.exists(out) else ""
+    check_report(open(out).read() if os.path.exists(out) else "", work)
+    check_options_and_refusals(work, history, before)
+
+
+def check_report(text, work):
+    """The report of the two runs: throughputs per commit, units in the headers, the slowdown,
+    the faster and the unchanged benchmark, memory judged by its bytes, the history plot."""
     assert "### collisions per second" in text and "### cell updates per second" in text, \
         "throughput sections missing"
     # 2000 collisions per 2 ms = 1e6 /s before, 8.333e5 /s after (medians, 1% noise).
@@ -170,6 +176,10 @@ def test_report_on_a_synthetic_history(work_dir):
     png = os.path.join(work, "out", "benchmark-history.png")
     assert os.path.exists(png) and open(png, "rb").read(4) == b"\x89PNG", "history plot missing"
 
+
+def check_options_and_refusals(work, history, before):
+    """--threshold and --metric change the verdict; a single run has nothing to compare; a
+    counter without units and a history of bad JSON are refused (exit 2, nothing written)."""
     relaxed = run("--history", history, "--output", os.path.join(work, "relaxed.md"),
                   "--threshold", "0.25")
     assert relaxed.returncode == 0, \

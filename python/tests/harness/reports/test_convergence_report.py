@@ -278,6 +278,19 @@ def test_report_on_a_synthetic_study(work_dir):
     assert "13 checks: 8 pass, 5 fail." in text, "summary count line missing or wrong"
     check_marks_follow_the_judge(inputs, text, "synthetic")
 
+    check_order_rows(text)
+    check_gci_and_bound_rows(text)
+    check_units_in_tables(text)
+    check_files_beside_the_report(inputs, out_dir, report, text)
+
+    strict = run("--input", inputs, "--output", os.path.join(work, "strict", "c.md"), "--strict")
+    assert strict.returncode == 1 and "Traceback" not in strict.stderr, \
+        f"--strict with failures must exit 1, got {strict.returncode}: {strict.stderr}"
+
+
+def check_order_rows(text):
+    """The observed orders: rows in the band pass with their fitted order, and each row is
+    marked as its pass column says, against the band both ways."""
     judged_in_band = [(field, norm) for field in ("n", "uz") for norm in ("L1", "L2", "Linf")
                       if (field, norm) != ("uz", "Linf")]
     for field, norm in judged_in_band:
@@ -305,6 +318,10 @@ def test_report_on_a_synthetic_study(work_dir):
     assert line_with(text, "- order synthetic-1d-space / T / Linf: fitted 1") != "", \
         "failure list lacks the measured value of T Linf"
 
+
+def check_gci_and_bound_rows(text):
+    """GCI rows judged or shown as not checked (two grids, a time-step diagnostic); time-error
+    bounds judged against the grid uncertainty."""
     shock = line_with(text, "| base-1d | shock_location |")
     assert "PASS" in shock and "FAIL" not in shock, f"GCI row should pass: '{shock}'"
     mach = line_with(text, "| base-1d | max_mach |")
@@ -331,6 +348,11 @@ def test_report_on_a_synthetic_study(work_dir):
     no_bound = line_with(text, "| real-time-x | front_width_over_mfp_ft0.22 |")
     assert no_bound.endswith("| not checked |"), f"a row without a bound: '{no_bound}'"
 
+
+def check_units_in_tables(text):
+    """Units: a header that holds one quantity says them (the error table's pair orders, the
+    orders table); a table of different quantities has a units column, filled from the one
+    declaration per name (the error and GCI tables)."""
     errors_header = line_with(text, "| field | units | norm | h = 0.1 |")
     assert "p(0-1) [1]" in errors_header and "p(2-3) [1]" in errors_header, \
         f"error table lacks pair orders or their units: '{errors_header}'"
@@ -339,9 +361,6 @@ def test_report_on_a_synthetic_study(work_dir):
     for field, units in (("uz", "sqrt(g sigma)"), ("T", "g sigma")):
         assert line_with(text, f"| {field} | {units} | L2 |") != "", \
             f"error table row of {field} lacks its units {units}"
-
-    # Units: a header that holds one quantity says them; a table of different quantities
-    # has a units column, filled from the one declaration per name.
     orders_header = line_with(text, "| study | field | norm | fitted p")
     assert ("fitted p (± s.e., points) [1]" in orders_header and "| design [1] |" in orders_header
             and "| band [1] |" in orders_header), f"orders header without units: '{orders_header}'"
@@ -353,6 +372,11 @@ def test_report_on_a_synthetic_study(work_dir):
     assert line_with(text, "| base-1d | max_mach | 1 | 3.1 |") != "", \
         "GCI row of max_mach lacks its units 1"
 
+
+def check_files_beside_the_report(inputs, out_dir, report, text):
+    """The plot linked, no temporary file left, the input tables copied flat and byte for
+    byte; a second run replaces the tables and removes the plots of studies no longer in
+    the input."""
     png = os.path.join(out_dir, "convergence-synthetic-1d-space.png")
     assert is_png(png), "PNG plot missing or not a PNG"
     assert "![synthetic-1d-space](convergence-synthetic-1d-space.png)" in text, "plot not linked"
@@ -375,10 +399,6 @@ def test_report_on_a_synthetic_study(work_dir):
     assert not os.path.exists(os.path.join(out_dir, "convergence-removed-study.png")), \
         "the plot of a study no longer in the input survived the second run"
     assert os.path.exists(png), "the second run removed a plot the report links"
-
-    strict = run("--input", inputs, "--output", os.path.join(work, "strict", "c.md"), "--strict")
-    assert strict.returncode == 1 and "Traceback" not in strict.stderr, \
-        f"--strict with failures must exit 1, got {strict.returncode}: {strict.stderr}"
 
 
 def test_the_pass_column_not_the_band_decides_and_bad_input_is_refused(work_dir):

@@ -106,8 +106,31 @@ def test_report_pipeline(shaker, work_dir):
     assert claims["C14"]["per_solver"]["md"]["checks"][0].get("error") is not None, \
         "C14 has a jackknife error from the ensemble's replicas"
 
-    # The report's numbers are those `shaker analyze` prints: run it again, by hand, on the
-    # single-shock ensemble of e = 0.9 and on the base case, and compare.
+    check_numbers_are_shaker_analyze(shaker, results, value, tmp)
+    check_collision_rates(results)
+
+    # Columns of the claims table: id, claim, units, paper, MD, continuum, band, result.
+    c6, c5 = rows.get("C6", "").split(" | "), rows.get("C5", "").split(" | ")
+    c6_continuum = c6[5] if len(c6) > 5 else ""
+    shown = re.search(r"([0-9.eE+-]+) ± ([0-9.eE+-]+) \(grid 2 %", c6_continuum)
+    assert (shown is not None and abs(float(shown.group(2)) - 0.02 * abs(float(shown.group(1))))
+            <= 0.01 * abs(float(shown.group(1)))), \
+        f"C6 continuum value carries its grid uncertainty, 2 % of the value: '{c6_continuum}'"
+    assert len(c5) > 5 and "no shock_width_ft0.22 row" in c5[5], \
+        f"C5 says its GCI row is missing: '{c5[5] if len(c5) > 5 else ''}'"
+    assert "grid" not in (c6[4] if len(c6) > 4 else "grid"), \
+        "the MD value carries no grid uncertainty"
+    check_units(text, rows, claims, tmp)
+    check_missing_units_are_refused(os.path.join(workdir, "results.json"), tmp)
+
+    rc, _ = run_validation(shaker, workdir, report, "C3", gci)
+    assert rc == 1, f"--require C3 (failing on the cartoon) exits 1 (got {rc})"
+
+
+def check_numbers_are_shaker_analyze(shaker, results, value, tmp):
+    """The report's numbers are those `shaker analyze` prints: it runs again, by hand, on the
+    single-shock ensemble of e = 0.9 and on the base case (its JSON stays in `tmp`), and its
+    values are compared with the claims' (`value(claim, solver)`)."""
     for claim, solver, case, name in (("C4", "md", "base", "exit_phase"),
                                       ("C1", "md", "base", "formation_phase"),
                                       ("C14", "md", "single_shock_e0p90", None)):
@@ -126,6 +149,10 @@ def test_report_pipeline(shaker, work_dir):
                 f"{case}: report shock speed {view['shock_speed']} = shaker analyze "
                 f"{per_run['shock_speed']['value']}")
 
+
+def check_collision_rates(results):
+    """Every MD view's collisions per second: the run files' running totals over the runs'
+    seconds."""
     md_views = [v for v in results["views"].values() if v["solver"] == "md" and v["status"] == "ok"]
     for view in md_views:
         seconds = sum(r["seconds"] for r in results["runs"] if r["case"] == view["case"]
@@ -138,23 +165,6 @@ def test_report_pipeline(shaker, work_dir):
             f"{view['case']}: MD collisions per second from the run files' running totals "
             f"{rate} (cartoon: {expected})")
     assert len(md_views) > 0, f"MD views with a collision rate: {len(md_views)}"
-
-    # Columns of the claims table: id, claim, units, paper, MD, continuum, band, result.
-    c6, c5 = rows.get("C6", "").split(" | "), rows.get("C5", "").split(" | ")
-    c6_continuum = c6[5] if len(c6) > 5 else ""
-    shown = re.search(r"([0-9.eE+-]+) ± ([0-9.eE+-]+) \(grid 2 %", c6_continuum)
-    assert (shown is not None and abs(float(shown.group(2)) - 0.02 * abs(float(shown.group(1))))
-            <= 0.01 * abs(float(shown.group(1)))), \
-        f"C6 continuum value carries its grid uncertainty, 2 % of the value: '{c6_continuum}'"
-    assert len(c5) > 5 and "no shock_width_ft0.22 row" in c5[5], \
-        f"C5 says its GCI row is missing: '{c5[5] if len(c5) > 5 else ''}'"
-    assert "grid" not in (c6[4] if len(c6) > 4 else "grid"), \
-        "the MD value carries no grid uncertainty"
-    check_units(text, rows, claims, tmp)
-    check_missing_units_are_refused(os.path.join(workdir, "results.json"), tmp)
-
-    rc, _ = run_validation(shaker, workdir, report, "C3", gci)
-    assert rc == 1, f"--require C3 (failing on the cartoon) exits 1 (got {rc})"
 
 
 def check_units(text, rows, claims, tmp):
