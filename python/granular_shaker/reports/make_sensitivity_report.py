@@ -321,9 +321,8 @@ def main(argv=None):
     link = os.path.basename(out_dir)
     simulated = results.get("simulated_seconds", 0.0)
     lines = ["# Continuum sensitivity: the choices the paper leaves open", "",
-             "Written by granular_shaker.reports.make_sensitivity_report from the study of "
-             "granular_shaker.validation.sensitivity (shaker-sensitivity) "
-             "(variants: validation/sensitivity.toml). Every choice the paper leaves open or this "
+             "Written by granular_shaker.reports.make_sensitivity_report from the sensitivity "
+             "study (shaker-sensitivity; variants: validation/sensitivity.toml). Every choice the paper leaves open or this "
              "project made is varied one at a time from the validation settings, and each variant "
              "is judged by the claims the continuum fails, against MD with MD's errors.", "",
              f"- commit: {results['commit']}",
