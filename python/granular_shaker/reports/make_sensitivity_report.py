@@ -322,9 +322,10 @@ def main(argv=None):
     simulated = results.get("simulated_seconds", 0.0)
     lines = ["# Continuum sensitivity: the choices the paper leaves open", "",
              "Written by granular_shaker.reports.make_sensitivity_report from the sensitivity "
-             "study (shaker-sensitivity; variants: validation/sensitivity.toml). Every choice the paper leaves open or this "
-             "project made is varied one at a time from the validation settings, and each variant "
-             "is judged by the claims the continuum fails, against MD with MD's errors.", "",
+             "study (shaker-sensitivity; variants: validation/sensitivity.toml). Every choice the "
+             "paper leaves open or this project made is varied one at a time from the validation "
+             "settings, and each variant is judged by the claims the continuum fails, against MD "
+             "with MD's errors.", "",
              f"- commit: {results['commit']}",
              f"- program: {results['shaker_version']}",
              f"- wall time of this call: {results['wall_seconds']:.0f} s; solver time of the runs "
