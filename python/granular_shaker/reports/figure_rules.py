@@ -17,8 +17,8 @@ breaks these rules (empty when the figure is fine).
   the figure's title or legend), and none (nor a figure legend) is cut off at the figure's
   edge; measured on the text as drawn (Agg).
 
-The report tests (reports/tests/test_figures.py) hold every figure function of reports/ to
-these rules.
+The report tests (python/tests/harness/reports/test_figures.py) hold every figure function of
+the report generators to these rules.
 """
 import math
 import re

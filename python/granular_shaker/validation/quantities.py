@@ -324,7 +324,7 @@ QUANTITIES = {
 }
 
 # The units of each quantity's value (docs/units.md; definitions in docs/analysis.md), one entry
-# per key of QUANTITIES (validation/tests/test_claims_file.py fails on a missing one). The
+# per key of QUANTITIES (harness/validation/test_claims_file.py fails on a missing one). The
 # validation report gives them beside the claims' values and bands and the diagnoses' evidence.
 # Phases and phase spans are f t (a lifetime is in cycles), so dimensionless; so are d/xi, Mach
 # numbers, ratios, relative changes, counts per cycle and the 1/0 of a detection.

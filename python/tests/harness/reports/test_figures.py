@@ -61,7 +61,7 @@ ceiling = 60.0
 
 
 def cartoon_profiles(directory, solver, seed):
-    """The cartoon run file's profiles (validation/tests/synthetic_runs.py), as the reports
+    """The cartoon run file's profiles (harness/synthetic_runs.py), as the reports
     read them."""
     path = os.path.join(directory, f"{solver}.h5")
     synthetic_runs.write_run(path, SYNTHETIC_CONFIG, solver, seed)

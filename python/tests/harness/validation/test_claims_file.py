@@ -1,5 +1,5 @@
-"""ctest validation.claims_file: reference-data/claims.toml holds C1..C20, each once, with
-every field, a quantity the runner knows (validation/quantities.py) and the parameters it
+"""ctest validation.claims_file: reference-data/claims.toml holds C1..C20, each once, with every
+field, a quantity the runner knows (granular_shaker.validation.quantities) and the parameters it
 needs, a known comparison with a band of the right shape, cases that validation/studies.toml
 runs with the solvers the claim needs, and a provenance in the paper; and that
 validation/diagnoses.toml names known claims, categories, quantities and cases.

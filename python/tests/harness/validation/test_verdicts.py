@@ -1,7 +1,7 @@
 """ctest validation.verdicts: the verdict of a claim from its value and standard error
-(validation/quantities.py margin and verdict) on cases of known answer: a value well inside
-its band passes, one well outside fails, one within 2 standard errors of the band's edge is
-unresolved; a value without an error is judged on its value alone; an ordering is judged on
+(granular_shaker.validation.quantities: margin and verdict) on cases of known answer: a value
+well inside its band passes, one well outside fails, one within 2 standard errors of the band's
+edge is unresolved; a value without an error is judged on its value alone; an ordering is judged on
 its smallest step over that step's error; a per-phase list on the phases where it exists, if
 they are at least half."""
 import math
