@@ -1,6 +1,6 @@
 """ctest reports.figure_rules: the checker of granular_shaker.reports.figure_rules on figures
-made to break one rule each, and on a figure that keeps them all (shared and twin axes, a categorical axis,
-MD error bars, a colorbar shared by two meshes, a figure legend).
+made to break one rule each, and on a figure that keeps them all (shared and twin axes, a
+categorical axis, MD error bars, a colorbar shared by two meshes, a figure legend).
 """
 import matplotlib
 
