@@ -32,6 +32,6 @@ for solver in md continuum; do
     *) echo "shaker $solver failed with exit code $rc" >&2; exit "$rc" ;;
   esac
 done
-/usr/bin/python3 reports/make_base_case_report.py --runs "$runs" --output "$runs/base-case.md" \
-  --status "${status[@]}"
+PYTHONPATH=python /usr/bin/python3 -m granular_shaker.reports.make_base_case_report \
+  --runs "$runs" --output "$runs/base-case.md" --status "${status[@]}"
 echo "report: $runs/base-case.md"

@@ -17,7 +17,7 @@ packages=(
   libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-matplotlib python3-h5py python3-meshio
   python3-pytest python3-flake8 python3-ase
-  python3-pip python3-setuptools python3-wheel python3-gsd
+  python3-pip python3-setuptools python3-wheel python3-venv python3-gsd
   python3-nbclient python3-nbformat python3-ipykernel
 )
 case ${1:-} in

@@ -6,19 +6,23 @@
 #   shaker_add_test(NAME <Suite>.<Test> COMMAND <command>... [WORKING_DIRECTORY <dir>])
 #       a test that runs a script or program, named <folder>.<Suite>.<Test>
 #   shaker_add_pytest(NAME <name> PYTHON <python3> FILE <test file> [ARGS <pytest args>...])
-#       a test that runs one file of pytest tests from the repository root, where the packages
-#       validation and reports import by name and pytest reads setup.cfg and conftest.py
+#       a test that runs one file of pytest tests from the repository root, where pytest reads
+#       setup.cfg (the package granular_shaker and the tests' helpers import by name) and
+#       conftest.py
 #
 # <folder> is the name of the folder whose CMakeLists.txt calls the function. Which of its tests
 # are nightly or known failures, their time limits and environment come from the folder's
 # status.txt (format in verification/README.md), not from the CMake files: the first line whose
 # pattern matches a test's name gives its labels, timeout and environment. Time limits are
 # multiplied by SHAKER_TEST_TIMEOUT_SCALE (10 under the sanitizers, else 1). Script tests also
-# find the shared Python helpers of verification/support on PYTHONPATH.
+# find on PYTHONPATH the shared Python helpers of verification/support and the package
+# granular_shaker from its source (python/: the validation study, the report generators).
 include(GoogleTest)
 
 set(SHAKER_PYTHON_SUPPORT_DIR ${CMAKE_CURRENT_LIST_DIR}/../verification/support)
 cmake_path(NORMAL_PATH SHAKER_PYTHON_SUPPORT_DIR)
+set(SHAKER_PYTHON_PACKAGE_DIR ${CMAKE_CURRENT_LIST_DIR}/../python)
+cmake_path(NORMAL_PATH SHAKER_PYTHON_PACKAGE_DIR)
 
 # Reads the calling folder's status.txt once into directory properties: the number of lines
 # and, for each line i, SHAKER_STATUS_<i>_{PATTERN,LABELS,TIMEOUT,ENVIRONMENT}.
@@ -162,8 +166,9 @@ function(shaker_add_test)
   else()
     add_test(NAME ${name} COMMAND ${TEST_COMMAND})
   endif()
-  set_tests_properties(${name} PROPERTIES ENVIRONMENT_MODIFICATION
-                       "PYTHONPATH=path_list_prepend:${SHAKER_PYTHON_SUPPORT_DIR}")
+  set(python_path "PYTHONPATH=path_list_prepend:${SHAKER_PYTHON_SUPPORT_DIR}"
+                  "PYTHONPATH=path_list_prepend:${SHAKER_PYTHON_PACKAGE_DIR}")
+  set_tests_properties(${name} PROPERTIES ENVIRONMENT_MODIFICATION "${python_path}")
   get_directory_property(count SHAKER_STATUS_COUNT)
   if(count EQUAL 0)
     return()

@@ -117,9 +117,9 @@ def every_figure(runs):
 
 
 def test_every_helper_meets_the_reports_figure_rules(runs):
-    """The rules every report figure meets (reports/figure_rules.py: units in brackets, legends,
-    colorbars, MD errors, nothing overlapping), for every public helper."""
-    from reports.figure_rules import figure_problems
+    """The rules every report figure meets (granular_shaker.reports.figure_rules: units in
+    brackets, legends, colorbars, MD errors, nothing overlapping), for every public helper."""
+    from granular_shaker.reports.figure_rules import figure_problems
     figures = every_figure(runs)
     helpers = {name for name in dir(plotting) if name.startswith("plot_")}
     assert set(figures) == helpers

@@ -2,8 +2,8 @@
 
 Runs `shaker md CASE` at run.phases_per_cycle = 50 and 100 with the same seed (the same
 trajectory: the stored phases only add snapshots), analyses both with `shaker analyze --json`
-and checks that every per-run shock quantity agrees as validation/phase_sampling.py judges it
-(within two combined standard errors of the two runs). Prints the table. Usage:
+and checks that every per-run shock quantity agrees as granular_shaker.validation.phase_sampling
+judges it (within two combined standard errors of the two runs). Prints the table. Usage:
 
     check_phases_per_cycle.py SHAKER CASE.toml [--phases 50 100] [--keep DIR]
 """
@@ -14,7 +14,7 @@ import subprocess
 import sys
 
 import keep_on_failure
-from validation import phase_sampling
+from granular_shaker.validation import phase_sampling
 
 
 def analysed(shaker, case, phases, work):

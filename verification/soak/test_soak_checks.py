@@ -7,7 +7,7 @@ import h5py
 import numpy as np
 import pytest
 
-import soak  # beside this file: pytest puts a test's folder on sys.path (no __init__.py here)
+import soak  # beside this file: pytest imports from a test's folder (no __init__.py here)
 
 
 def write(path, columns, phases):

@@ -5,9 +5,10 @@ tests the build directory declares (`ctest --show-only=json-v1`) and checks that
 of every status.txt under the source tree matches at least one of them, and that the first
 matching line's labels are the labels the test carries.
 
-    PYTHONPATH=SOURCE_DIR check_status_files.py CTEST SOURCE_DIR BUILD_DIR
+    PYTHONPATH=SOURCE_DIR/python check_status_files.py CTEST SOURCE_DIR BUILD_DIR
 
-(ctest sets PYTHONPATH: it reads the status files with reports.report_common's reader.)
+(ctest sets PYTHONPATH: it reads the status files with the reader of
+granular_shaker.reports.report_common.)
 """
 import fnmatch
 import json
@@ -15,7 +16,7 @@ import os
 import subprocess
 import sys
 
-from reports.report_common import status_lines
+from granular_shaker.reports.report_common import status_lines
 
 
 def main():

@@ -1,1 +1,0 @@
-"""The report generators (make_*_report) and what they share (report_common)."""

@@ -1,1 +1,0 @@
-"""The validation study: run_validation (runner) and quantities (claims)."""
