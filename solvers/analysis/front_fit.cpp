@@ -113,19 +113,18 @@ std::array<double, kParameters> start_values(const Bins& bins) {
   return {0.5 * (high + low), 0.5 * (high - low), z0, w};
 }
 
-}  // namespace
-
-std::optional<FrontFit> fit_front(const std::vector<double>& z, const std::vector<double>& f,
-                                  const std::vector<double>& se, double z_lo, double z_hi) {
-  if (z.size() != f.size() || (!se.empty() && se.size() != z.size()))
-    throw std::invalid_argument("fit_front: z, f and se differ in length");
-  if (z.size() < 5) return std::nullopt;
-  for (std::size_t i = 0; i + 1 < z.size(); ++i)
-    if (!(z[i + 1] > z[i]) && std::isfinite(z[i]) && std::isfinite(z[i + 1]))
-      throw std::invalid_argument("fit_front: z is not strictly increasing");
-
+/// The profile's bins inside [z_lo, z_hi] and their standard errors; nullopt when fewer than
+/// five or any is not finite.
+struct Window {
   Bins bins;
   std::vector<double> sigma;
+  bool weighted = false;  ///< every bin has a finite positive standard error
+};
+
+std::optional<Window> window_of(const std::vector<double>& z, const std::vector<double>& f,
+                                const std::vector<double>& se, double z_lo, double z_hi) {
+  Window window;
+  Bins& bins = window.bins;
   for (std::size_t i = 0; i < z.size(); ++i) {
     if (!(z[i] >= z_lo && z[i] <= z_hi)) continue;
     // A bin reaches half-way to its neighbours; the outer bins of the profile symmetrically.
@@ -134,33 +133,39 @@ std::optional<FrontFit> fit_front(const std::vector<double>& z, const std::vecto
     bins.centre.push_back(z[i] + 0.25 * (above - below));
     bins.half_height.push_back(0.25 * (above + below));
     bins.value.push_back(f[i]);
-    if (!se.empty()) sigma.push_back(se[i]);
+    if (!se.empty()) window.sigma.push_back(se[i]);
   }
   const std::size_t m = bins.centre.size();
   if (m < 5) return std::nullopt;
   for (std::size_t i = 0; i < m; ++i)
     if (!std::isfinite(bins.value[i]) || !std::isfinite(bins.centre[i])) return std::nullopt;
-  const bool weighted = !sigma.empty() && std::all_of(sigma.begin(), sigma.end(), [](double s) {
+  window.weighted = !window.sigma.empty() && std::all_of(window.sigma.begin(), window.sigma.end(), [](double s) {
     return std::isfinite(s) && s > 0.0;
   });
+  return window;
+}
 
+using Workspace = std::unique_ptr<gsl_multifit_nlinear_workspace, WorkspaceDeleter>;
+
+/// The trust-region least-squares fit of the model to the window from start_values; nullptr if
+/// it does not converge.
+Workspace solve(Window& window) {
+  const std::size_t m = window.bins.centre.size();
   gsl_multifit_nlinear_fdf fdf{};
   fdf.f = residuals;
   fdf.df = jacobian;
   fdf.fvv = nullptr;
   fdf.n = m;
   fdf.p = kParameters;
-  fdf.params = &bins;
-
+  fdf.params = &window.bins;
   const gsl_multifit_nlinear_parameters parameters = gsl_multifit_nlinear_default_parameters();
-  std::unique_ptr<gsl_multifit_nlinear_workspace, WorkspaceDeleter> workspace(
-      gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &parameters, m, kParameters));
-  const auto start = start_values(bins);
+  Workspace workspace(gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &parameters, m, kParameters));
+  const auto start = start_values(window.bins);
   gsl_vector_const_view x0 = gsl_vector_const_view_array(start.data(), kParameters);
   VectorPtr weights;
-  if (weighted) {
+  if (window.weighted) {
     weights.reset(gsl_vector_alloc(m));
-    for (std::size_t i = 0; i < m; ++i) gsl_vector_set(weights.get(), i, 1.0 / (sigma[i] * sigma[i]));
+    for (std::size_t i = 0; i < m; ++i) gsl_vector_set(weights.get(), i, 1.0 / (window.sigma[i] * window.sigma[i]));
     gsl_multifit_nlinear_winit(&x0.vector, weights.get(), &fdf, workspace.get());
   } else {
     gsl_multifit_nlinear_init(&x0.vector, &fdf, workspace.get());
@@ -168,12 +173,18 @@ std::optional<FrontFit> fit_front(const std::vector<double>& z, const std::vecto
   // Tight tolerances: a noise-free front is to be recovered to 1e-6 and the trust region
   // converges quadratically near the minimum, so they cost a few iterations at most.
   int info = 0;
-  const int status =
-      gsl_multifit_nlinear_driver(200, 1e-12, 1e-12, 0.0, nullptr, nullptr, &info, workspace.get());
-  if (status != GSL_SUCCESS) return std::nullopt;
+  const int status = gsl_multifit_nlinear_driver(200, 1e-12, 1e-12, 0.0, nullptr, nullptr, &info, workspace.get());
+  if (status != GSL_SUCCESS) workspace.reset();
+  return workspace;
+}
 
-  const gsl_vector* p = gsl_multifit_nlinear_position(workspace.get());
-  const gsl_vector* r = gsl_multifit_nlinear_residual(workspace.get());
+/// The front of a converged fit with its standard errors; nullopt if a parameter is not
+/// determined by the data or the front lies outside [z_lo, z_hi].
+std::optional<FrontFit> front_of(gsl_multifit_nlinear_workspace* workspace, const Window& window, double z_lo,
+                                 double z_hi) {
+  const std::size_t m = window.bins.centre.size();
+  const gsl_vector* p = gsl_multifit_nlinear_position(workspace);
+  const gsl_vector* r = gsl_multifit_nlinear_residual(workspace);
   double chi2 = 0.0;
   gsl_blas_ddot(r, r, &chi2);  // the residuals are weighted already when weights are given
   const double reduced_chi2 = chi2 / static_cast<double>(m - kParameters);
@@ -181,11 +192,11 @@ std::optional<FrontFit> fit_front(const std::vector<double>& z, const std::vecto
   std::unique_ptr<gsl_matrix, MatrixDeleter> covariance(gsl_matrix_alloc(kParameters, kParameters));
   // A parameter the data do not determine gets a zero row here rather than a huge variance;
   // it is caught below.
-  gsl_multifit_nlinear_covar(gsl_multifit_nlinear_jac(workspace.get()), 1e-12, covariance.get());
+  gsl_multifit_nlinear_covar(gsl_multifit_nlinear_jac(workspace), 1e-12, covariance.get());
   // Given standard errors are trusted: scaling by chi^2 would hide a model that does not fit
   // (reported in reduced_chi2) and make the errors noisy themselves. Without them the scatter
   // about the fit is the only estimate of the noise.
-  const double scale = weighted ? 1.0 : reduced_chi2;
+  const double scale = window.weighted ? 1.0 : reduced_chi2;
   const double var_z0 = scale * gsl_matrix_get(covariance.get(), kZ0, kZ0);
   const double var_w = scale * gsl_matrix_get(covariance.get(), kW, kW);
   const double var_b = scale * gsl_matrix_get(covariance.get(), kB, kB);
@@ -208,6 +219,23 @@ std::optional<FrontFit> fit_front(const std::vector<double>& z, const std::vecto
   fit.reduced_chi2 = reduced_chi2;
   fit.points = static_cast<int>(m);
   return fit;
+}
+
+}  // namespace
+
+std::optional<FrontFit> fit_front(const std::vector<double>& z, const std::vector<double>& f,
+                                  const std::vector<double>& se, double z_lo, double z_hi) {
+  if (z.size() != f.size() || (!se.empty() && se.size() != z.size()))
+    throw std::invalid_argument("fit_front: z, f and se differ in length");
+  if (z.size() < 5) return std::nullopt;
+  for (std::size_t i = 0; i + 1 < z.size(); ++i)
+    if (!(z[i + 1] > z[i]) && std::isfinite(z[i]) && std::isfinite(z[i + 1]))
+      throw std::invalid_argument("fit_front: z is not strictly increasing");
+  std::optional<Window> window = window_of(z, f, se, z_lo, z_hi);
+  if (!window) return std::nullopt;
+  const Workspace workspace = solve(*window);
+  if (!workspace) return std::nullopt;
+  return front_of(workspace.get(), *window, z_lo, z_hi);
 }
 
 }  // namespace shaker::analysis

@@ -9,9 +9,11 @@
 
 #include "analysis/run_analysis.hpp"
 #include "app/commands.hpp"
+#include "common/atomic_output.hpp"
 #include "common/config.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/output_paths.hpp"
 #include "common/run_file.hpp"
 #include "common/version.hpp"
 #include "md/particle_file.hpp"

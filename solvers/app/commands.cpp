@@ -9,10 +9,12 @@
 
 #include "analysis/analysis.hpp"
 #include "analysis/run_analysis.hpp"
+#include "common/atomic_output.hpp"
 #include "common/config.hpp"
-#include "common/errors.hpp"
 #include "common/describe.hpp"
+#include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/output_paths.hpp"
 #include "common/ranks.hpp"
 #include "common/run_file.hpp"
 #include "continuum/run_continuum.hpp"
@@ -82,6 +84,64 @@ CLI::App* add_solver_subcommand(CLI::App& app, const std::string& name, const st
       ->check(finite_between(progress_interval_range.lo, progress_interval_range.hi))
       ->capture_default_str();
   return sub;
+}
+
+CLI::App* add_config_subcommand(CLI::App& app, ConfigOptions& options) {
+  auto* config = add_run_subcommand(
+      app, "config", "Print the effective configuration (defaults, file, --set overrides)",
+      options.run);
+  config->get_option("CONFIG")->required(false);
+  auto* describe = config->add_flag(
+      "--describe", options.describe,
+      "instead: every key with its type, default, allowed values, units and meaning");
+  config->add_flag("--markdown", options.markdown,
+                   "with --describe: as Markdown (docs/configuration.md)")
+      ->needs(describe);
+  return config;
+}
+
+CLI::App* add_analyze_subcommand(CLI::App& app, AnalyzeOptions& options) {
+  auto* analyze = app.add_subcommand(
+      "analyze", "The analysis of docs/analysis.md: per stored phase (layer, centre of mass, "
+                 "shock location and width, d/xi, maximum Ma, layer temperature) and per run "
+                 "(shock formation, exit, lifetime, speed; crossings per cycle), with jackknife "
+                 "errors over the samples of MD runs; several runs of one configuration are pooled");
+  analyze->add_option("RUN", options.run_files, "HDF5 run file(s)")->required();
+  analyze->add_option("--csv", options.csv_file, "also write the per-phase table as CSV");
+  analyze->add_option("--json", options.json_file,
+                      "also write every quantity with its unit, error and jackknife replicates");
+  analyze->add_option("--profiles-csv", options.profiles_csv,
+                      "also write every profile with its Mach and Knudsen numbers (phase,z,n,nu,uz,T,mach,kn_n,kn_T)");
+  analyze->add_option("--pooled", options.pooled_file,
+                      "also write the pooled run (profiles and samples of all RUNs) to this file");
+  auto* patterns = analyze->add_option("--patterns", options.patterns_csv,
+                      "also write the pattern quantities of the run's particle file (RUN.particles.h5), "
+                      "one row per frame, as CSV (one RUN only)");
+  analyze->add_option("--pattern-cell", options.pattern_cell,
+                      "with --patterns: width of the cells the particles are binned on (sigma)")
+      ->check(finite_between(0.01, 1e6))->capture_default_str()->needs(patterns);
+  analyze->add_flag("--quiet", options.quiet, "print nothing (with --csv, --json, --profiles-csv, --pooled or --patterns)");
+  analyze->add_option("--relative-drop", options.criteria.relative_drop,
+                      "shock rule: minimum (T_max - T_min) / T_max")
+      ->check(finite_between(0.0, 1.0))->capture_default_str();
+  analyze->add_option("--standard-errors", options.criteria.standard_errors,
+                      "shock rule: minimum drop in combined standard errors")
+      ->check(finite_between(0.0, 100.0))->capture_default_str();
+  analyze->add_option("--deceleration", options.criteria.deceleration,
+                      "shock rule: minimum fraction of the incoming velocity lost")
+      ->check(finite_between(0.0, 1.0))->capture_default_str();
+  return analyze;
+}
+
+CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& options) {
+  auto* compare = app.add_subcommand(
+      "compare", "Agreement metrics between two runs (docs/analysis.md): fractional RMS of shock "
+                 "location and centre of mass, profile norms of nu and T");
+  compare->add_option("A", options.first, "HDF5 run file")->required();
+  compare->add_option("B", options.second, "HDF5 run file (the reference)")->required();
+  compare->add_option("--csv", options.csv_file,
+                      "also write the metrics as CSV (metric,value,error,units,replicates)");
+  return compare;
 }
 
 int command_md(const RunOptions& options) {
@@ -186,8 +246,8 @@ void require_same_phases(const RunRecord& a, const RunRecord& b, const std::stri
 }
 }  // namespace
 
-int command_compare(const std::string& first, const std::string& second,
-                    const std::string& csv_file) {
+int command_compare(const CompareOptions& options) {
+  const auto& [first, second, csv_file] = options;
   check_csv_outputs({{"--csv", csv_file}}, {{"run file A", first}, {"run file B", second}});
   const RunRecord a = read_run_file(first), b = read_run_file(second);
   require_comparable_profiles(a, first);

@@ -27,6 +27,13 @@ CLI::App* add_run_subcommand(CLI::App& app, const std::string& name, const std::
 CLI::App* add_solver_subcommand(CLI::App& app, const std::string& name, const std::string& help,
                                 RunOptions& options);
 
+/// `config`: CONFIG optional, with --describe [--markdown].
+struct ConfigOptions {
+  RunOptions run;
+  bool describe = false, markdown = false;
+};
+CLI::App* add_config_subcommand(CLI::App& app, ConfigOptions& options);
+
 int command_md(const RunOptions& options);
 int command_continuum(const RunOptions& options);
 int command_config(const RunOptions& options);
@@ -39,6 +46,7 @@ struct AnalyzeOptions {
   analysis::ShockCriteria criteria;
   bool quiet = false;
 };
+CLI::App* add_analyze_subcommand(CLI::App& app, AnalyzeOptions& options);
 int command_analyze(const AnalyzeOptions& options);
 /// The pattern quantities (docs/analysis.md, "Patterns") of every frame of the MD particle
 /// file `particles` on cells about `cell` wide: a CSV row per frame, and summary lines (means
@@ -48,7 +56,10 @@ struct PatternTables {
 };
 PatternTables pattern_tables(const std::filesystem::path& particles, double cell);
 int command_describe(bool markdown);  ///< shaker config --describe [--markdown]
-int command_compare(const std::string& first, const std::string& second,
-                    const std::string& csv_file);
+struct CompareOptions {
+  std::string first, second, csv_file;
+};
+CLI::App* add_compare_subcommand(CLI::App& app, CompareOptions& options);
+int command_compare(const CompareOptions& options);
 
 }  // namespace shaker

@@ -6,7 +6,10 @@
 #include <csignal>
 #include <utility>
 
+#include "common/atomic_output.hpp"
 #include "common/errors.hpp"
+#include "common/output_paths.hpp"
+#include "common/signals.hpp"
 
 namespace shaker {
 

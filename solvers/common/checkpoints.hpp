@@ -11,13 +11,14 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "common/config.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/output_paths.hpp"
 #include "common/run_loop.hpp"
+#include "common/signals.hpp"
 
 namespace shaker {
 
@@ -56,17 +57,6 @@ void write_checkpoint_header(hid_t file, const std::string& kind, const Schedule
 h5::Handle open_checkpoint(const std::filesystem::path& path, const std::string& kind);
 /// The position a checkpoint records; InputError if absent or out of range.
 SchedulePosition read_schedule_position(hid_t file);
-
-/// A run stopped by SIGTERM or SIGINT after writing its checkpoint: the program exits with
-/// 128 + signal.
-class StopRequested : public std::runtime_error {
- public:
-  StopRequested(int signal, const std::string& message) : std::runtime_error(message), signal_(signal) {}
-  int exit_code() const { return 128 + signal_; }
-
- private:
-  int signal_;
-};
 
 /// Writes the solver's checkpoint of `position` to a file (atomically).
 using CheckpointWriter = std::function<void(const std::filesystem::path&, const SchedulePosition&)>;

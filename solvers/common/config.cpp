@@ -15,6 +15,7 @@
 
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
+#include "common/output_paths.hpp"
 
 namespace shaker::config {
 
@@ -512,21 +513,24 @@ std::string Config::hash() const {
   return fmt::format("{:016x}", h);
 }
 
-void require_same_keys(const Config& now, const std::string& saved_toml,
-                       const std::vector<std::string>& keys, const std::string& checkpoint) {
+void require_same_keys(const Config& now, const std::string& saved_toml, RestartSolvers solver,
+                       const std::string& checkpoint) {
   Config saved;
   try {
     saved = Config::from_toml(saved_toml, "its stored configuration");
   } catch (const InputError& error) {
     throw InputError(fmt::format("{} is not a valid checkpoint: {}", checkpoint, error.what()));
   }
-  for (const auto& key : keys)
+  for (const ParameterSpec& spec : schema()) {
+    if (!(spec.restart_solvers & solver)) continue;
+    const std::string& key = spec.key;
     if (now.value_text(key) != saved.value_text(key))
       throw InputError(fmt::format(
           "{} = {} but the checkpoint {} was written with {} = {}; a restart keeps the checkpoint's "
           "{}: allowed: {} = {} (or start a new run without the checkpoint)", key,
           now.value_text(key), checkpoint, key, saved.value_text(key), key, key,
           saved.value_text(key)));
+  }
 }
 
 }  // namespace shaker::config

@@ -29,6 +29,9 @@ Range closed(double lo, double hi);
 Range positive(double hi = 1e308);      ///< (0, hi]
 Range at_least(double lo, double hi = 1e308);
 
+/// The solvers whose restart from a checkpoint keeps a key (ParameterSpec::kept_on_restart).
+enum RestartSolvers : unsigned { restart_md = 1u, restart_continuum = 2u };
+
 struct ParameterSpec {
   std::string key;  ///< "section.name"
   Kind kind;
@@ -37,9 +40,16 @@ struct ParameterSpec {
   std::vector<std::string> choices;  ///< text: allowed values (empty: any text)
   std::string meaning;               ///< what it controls
   std::string units = {};  ///< docs/units.md: "sigma", "g sigma", ...; "1" dimensionless; "-" no quantity
+  /// RestartSolvers whose run continued from a checkpoint must state the checkpoint's value.
+  unsigned restart_solvers = 0;
   /// Declares the units: real("md.tc", ...).in("sqrt(sigma/g)"); every key has them.
   ParameterSpec in(std::string u) && {
     units = std::move(u);
+    return std::move(*this);
+  }
+  /// Declares that a restart of these solvers keeps the key: .kept_on_restart(restart_md).
+  ParameterSpec kept_on_restart(unsigned solvers) && {
+    restart_solvers = solvers;
     return std::move(*this);
   }
 };
@@ -93,11 +103,12 @@ class Config {
   std::map<std::string, Value> values_;
 };
 
-/// The restart rule (docs/output-schema.md): a run continued from a checkpoint must state the
-/// values of `keys` that the checkpoint's run had (its stored configuration, `saved_toml`);
-/// a difference is refused with InputError naming the key and both values.
-void require_same_keys(const Config& now, const std::string& saved_toml,
-                       const std::vector<std::string>& keys, const std::string& checkpoint);
+/// The restart rule (docs/output-schema.md): a run of `solver` (RestartSolvers) continued from
+/// a checkpoint must state the values that the checkpoint's run had (its stored configuration,
+/// `saved_toml`) of every key the schema declares kept on its restart; a difference is refused
+/// with InputError naming the key and both values.
+void require_same_keys(const Config& now, const std::string& saved_toml, RestartSolvers solver,
+                       const std::string& checkpoint);
 
 const ParameterSpec& find_spec(const std::string& key);  ///< throws InputError if unknown
 

@@ -42,6 +42,14 @@ std::string allowed(const ParameterSpec& spec, bool markdown) {
   return "?";
 }
 
+/// What a restart from a checkpoint requires of the key, if anything.
+std::string restart_note(const ParameterSpec& spec) {
+  const bool md = spec.restart_solvers & restart_md, continuum = spec.restart_solvers & restart_continuum;
+  if (!md && !continuum) return "";
+  return fmt::format("; a run continued from a checkpoint{} must keep the checkpoint's value",
+                     md && continuum ? "" : md ? " of the MD" : " of the continuum");
+}
+
 std::string units_of(const ParameterSpec& spec) {
   if (spec.units.empty())
     throw std::logic_error("configuration key " + spec.key + " declares no units");
@@ -85,6 +93,7 @@ std::string describe_schema(bool markdown) {
   std::string section;
   for (const auto& spec : schema()) {
     const std::string units = units_of(spec);
+    const std::string meaning = spec.meaning + restart_note(spec);
     const std::string dflt = format_value(spec.default_value);
     if (section_of(spec.key) != section) {
       section = section_of(spec.key);
@@ -98,10 +107,10 @@ std::string describe_schema(bool markdown) {
     if (markdown) {
       out += fmt::format("| `{}` | {} | `{}` | {} | {} | {} |\n", spec.key, type_name(spec.kind),
                          escape_cell(dflt), escape_cell(allowed(spec, true)), escape_cell(units),
-                         escape_cell(spec.meaning));
+                         escape_cell(meaning));
     } else {
       out += fmt::format("{}\n  type: {}; default: {}; allowed: {}; units: {}\n  {}\n", spec.key,
-                         type_name(spec.kind), dflt, allowed(spec, false), units, spec.meaning);
+                         type_name(spec.kind), dflt, allowed(spec, false), units, meaning);
     }
   }
   return out;

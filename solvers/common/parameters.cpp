@@ -8,16 +8,21 @@ std::vector<ParameterSpec> common_parameters() {
   return {
       text("case.name", "base", {}, "label of the case, carried into reports").in("-"),
       real("shaker.gamma", 3.0, positive(100.0),
-           "Gamma = 4 pi^2 f^2 A / g, peak plate acceleration in units of g").in("1"),
+           "Gamma = 4 pi^2 f^2 A / g, peak plate acceleration in units of g").in("1")
+          .kept_on_restart(restart_md),  // the MD's saved cell grid starts at the plate's lowest point
       real("shaker.frequency", 0.095, positive(10.0),
-           "plate frequency f in units of sqrt(g/sigma); omega = 2 pi f").in("sqrt(g/sigma)"),
+           "plate frequency f in units of sqrt(g/sigma); omega = 2 pi f").in("sqrt(g/sigma)")
+          .kept_on_restart(restart_md | restart_continuum),  // the schedule counts its cycles
       text("material.restitution", "constant", {"constant", "velocity_dependent"},
-           "restitution model for pair and wall collisions (docs/models.md)").in("-"),
+           "restitution model for pair and wall collisions (docs/models.md)").in("-")
+          .kept_on_restart(restart_md | restart_continuum),
       real("material.e", 0.9, closed(0.0, 1.0),
-           "coefficient of restitution (the constant model's e; the continuum's e)").in("1"),
+           "coefficient of restitution (the constant model's e; the continuum's e)").in("1")
+          .kept_on_restart(restart_md | restart_continuum),
       integer("layer.particles", 3937, closed(1, 1e8),
               "number of particles in the MD box; the continuum holds the same mass per unit "
-              "area, layer.particles / md.box_width^2").in("1"),
+              "area, layer.particles / md.box_width^2").in("1")
+          .kept_on_restart(restart_continuum),  // the MD checks its particles' count itself
       text("run.protocol", "periodic", {"periodic", "single_shock"},
            "periodic: transient then sampled cycles; single_shock: switch restitution at "
            "run.switch_phase after the transient and record the next cycle").in("-"),

@@ -12,6 +12,7 @@
 #include <utility>
 #include <sstream>
 
+#include "common/atomic_output.hpp"
 #include "common/config.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"

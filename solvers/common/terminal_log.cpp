@@ -9,6 +9,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "common/atomic_output.hpp"
+#include "common/output_paths.hpp"
 #include "common/run_file.hpp"
 #include "common/version.hpp"
 

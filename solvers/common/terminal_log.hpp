@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/case_parameters.hpp"
-#include "common/hdf5_file.hpp"
+#include "common/output_paths.hpp"
 
 namespace shaker::terminal_log {
 

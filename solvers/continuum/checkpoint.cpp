@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/atomic_output.hpp"
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"

@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "common/atomic_output.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
 

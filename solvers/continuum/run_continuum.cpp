@@ -22,9 +22,12 @@
 #include <string>
 #include <utility>
 
+#include "common/atomic_output.hpp"
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/memory.hpp"
+#include "common/output_paths.hpp"
+#include "common/packed_fields.hpp"
 #include "common/progress.hpp"
 #include "common/ranks.hpp"
 #include "common/run_file.hpp"
@@ -358,22 +361,23 @@ SchedulePosition read_decomposed_checkpoint(const std::filesystem::path& path, c
     }
   }
   if (!halo.agree(failure)) throw InputError(failure);
-  const Counters& k = scalars.counters;
-  const EnergyBudget& b = scalars.budget;
-  // Counts travel as doubles, exact below 2^53.
-  std::vector<double> values{scalars.time, scalars.e, static_cast<double>(k.steps),
-                             static_cast<double>(k.rejected_steps), static_cast<double>(k.diffusion_stages),
-                             position.start_time, static_cast<double>(position.cycle),
-                             static_cast<double>(position.phase), static_cast<double>(position.phases)};
-  halo.broadcast(values);
-  halo.scatter(box, solver.state());
-  solver.set_time(values[0]);
-  solver.op().settings().e = values[1];
-  const auto count = [&](std::size_t m) { return static_cast<std::int64_t>(values[m]); };
   // The root carries the whole box's budget and floor count; the other ranks' shares start at 0.
-  solver.counters() = Counters{count(2), count(3), halo.root() ? k.temperature_floor_uses : 0, count(4)};
-  solver.budget() = halo.root() ? b : EnergyBudget{};
-  return SchedulePosition{values[5], count(6), count(7), count(8)};
+  Counters counters = scalars.counters;
+  if (!halo.root()) counters.temperature_floor_uses = 0;
+  const auto shared = std::tie(scalars.time, scalars.e, counters.steps, counters.rejected_steps,
+                               counters.diffusion_stages, position.start_time, position.cycle, position.phase,
+                               position.phases);
+  std::vector<double> values;
+  pack_fields(values, shared);
+  halo.broadcast(values);
+  const double* at = values.data();
+  unpack_fields(at, shared);
+  halo.scatter(box, solver.state());
+  solver.set_time(scalars.time);
+  solver.op().settings().e = scalars.e;
+  solver.counters() = counters;
+  solver.budget() = halo.root() ? scalars.budget : EnergyBudget{};
+  return position;
 }
 
 /// The continuum's schedule: a new one from t = 0, or the checkpoint's, continued with the
@@ -384,9 +388,7 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
   if (restart_from.empty()) return PhaseSchedule::from_start(run, c.parameters.shaker, solver.time());
   const std::string source = restart_source(restart_from);
   const std::string saved = checkpoint_configuration(restart_from);
-  config::require_same_keys(config, saved,
-                            {"material.restitution", "material.e", "layer.particles", "md.box_width", "shaker.frequency"},
-                            source);
+  config::require_same_keys(config, saved, config::restart_continuum, source);
   const Halo* halo = solver.op().halo();
   const SchedulePosition position = halo ? read_decomposed_checkpoint(restart_from, *halo, solver)
                                          : read_checkpoint(restart_from, solver);
@@ -394,6 +396,22 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
   schedule.resume_at(position, solver.time(), source);
   schedule.check_switch(CaseParameters::from(config::Config::from_toml(saved, source)).run, solver.time(), source);
   return schedule;
+}
+
+/// The summary on stdout (and in the log), the warnings on stderr.
+void report_run(std::int64_t cycles, double t, double wall_seconds, const Counters& counters, const Recorder& recorder,
+                const std::vector<std::string>& warnings, const std::filesystem::path& output) {
+  terminal_log::say(stdout, "shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
+             "temperature floor used {} times; mass drift {:.3e}; periodicity (centre of mass, last "
+             "two cycles) {:.3e} (series column periodicity_last_two_cycles); energy budget residual "
+             "{:.3e} of the accumulated loss {:.6g}\nwrote {}\n",
+             cycles, t, duration_text(wall_seconds), counters.steps,
+             counters.rejected_steps, counters.temperature_floor_uses,
+             (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
+             recorder.periodicity(), recorder.budget_residual.back(),
+             recorder.collisional_loss.back() - recorder.initial_loss, output.string());
+  for (const std::string& doubt : warnings)
+    terminal_log::say(stderr, "shaker continuum: warning: {} (kept in the run file's attribute warnings)\n", doubt);
 }
 
 int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
@@ -464,17 +482,7 @@ int execute(const config::Config& config, const std::vector<NamedPath>& inputs,
     write_fields(derived_name(output, ".fields.h5"), c.grid, fields.snapshots, record);
   }
   write_run_file(output, record);
-  terminal_log::say(stdout, "shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
-             "temperature floor used {} times; mass drift {:.3e}; periodicity (centre of mass, last "
-             "two cycles) {:.3e} (series column periodicity_last_two_cycles); energy budget residual "
-             "{:.3e} of the accumulated loss {:.6g}\nwrote {}\n",
-             schedule.cycles(), solver.time(), duration_text(wall.seconds()), counters.steps,
-             counters.rejected_steps, counters.temperature_floor_uses,
-             (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
-             recorder.periodicity(), recorder.budget_residual.back(),
-             recorder.collisional_loss.back() - recorder.initial_loss, output.string());
-  for (const std::string& doubt : record.warnings)
-    terminal_log::say(stderr, "shaker continuum: warning: {} (kept in the run file's attribute warnings)\n", doubt);
+  report_run(schedule.cycles(), solver.time(), wall.seconds(), counters, recorder, record.warnings, output);
   return 0;
 }
 

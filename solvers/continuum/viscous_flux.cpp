@@ -113,48 +113,75 @@ void column_diffusive_fluxes(const Grid& g, const std::array<std::vector<double>
 }  // namespace
 
 namespace {
-/// The faces normal to direction d (a template parameter: the gradient's index logic is
-/// resolved at compile time).
-/// Faces of the planes k0 .. k1 - 1 (slab_sweep).
+/// The viscous and heat fluxes through faces normal to direction d (a template parameter: the
+/// gradient's index logic is resolved at compile time), added to dU/dt.
 template <int d>
-void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
-                            const Operator::Closure& closure, WallStress wall_stress, State& dUdt,
-                            int k0, int k1) {
-  const double inv_h = 1.0 / g.h;
-  const bool three_d = g.dimension == 3;
-  const double* u[3] = {w[1].data(), w[2].data(), w[3].data()};
-  const double* T = w[4].data();
-  const double* mu = closure.mu.data();
-  const double* lambda = closure.lambda.data();
-  const double* kappa = closure.kappa.data();
-  const std::ptrdiff_t strides[3] = {g.stride(0), g.stride(1), g.stride(2)};
-  const std::ptrdiff_t s = strides[d];
-  const int n_a = d == 0 ? g.ny : g.nx;
-  const int length = d == 0 ? g.nx : d == 1 ? g.ny : g.nz;
-  const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
-  // The face whose high-side cell is cR (S = double), or the faces of cells cR, cR + 1, ...
-  // (S a vector: x-neighbours, either pencils side by side or faces of an x pencil), every
-  // lane doing the scalar arithmetic. `add` / `subtract`: the face adds to its high
-  // cell / subtracts from its low cell (not both at the ends of a pencil).
-  const auto face = [&](std::ptrdiff_t cR, bool add, bool subtract, bool wall, auto lanes) {
-    using S = decltype(lanes);
-    const auto at = [](const double* x) { return load_lanes<S>(x); };
-    const std::ptrdiff_t cL = cR - s;
-    S grad[3][3] = {};  // grad[i][j] = d u_i / d x_j at the face
-    // Tangential derivatives enter only through d u_d / d x_t and the divergence
-    // (d u_t / d x_t); the other two are not needed.
+struct ViscousFaces {
+  ViscousFaces(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
+               const Operator::Closure& closure, WallStress stress, State& change)
+      : inv_h(1.0 / g.h), three_d(g.dimension == 3), u{w[1].data(), w[2].data(), w[3].data()}, n(w[0].data()),
+        T(w[4].data()), mu(closure.mu.data()), lambda(closure.lambda.data()), kappa(closure.kappa.data()),
+        strides{g.stride(0), g.stride(1), g.stride(2)}, s(strides[d]), wall_stress(stress), dUdt(change) {}
+
+  double inv_h;
+  bool three_d;
+  const double* u[3];
+  const double *n, *T, *mu, *lambda, *kappa;
+  std::ptrdiff_t strides[3];
+  std::ptrdiff_t s;
+  WallStress wall_stress;
+  State& dUdt;
+
+  template <class S> static S at(const double* x) { return load_lanes<S>(x); }
+
+  /// grad[i][j] = d u_i / d x_j at the face between cL and cR. Tangential derivatives enter
+  /// only through d u_d / d x_t and the divergence (d u_t / d x_t); the other two are not
+  /// needed.
+  template <class S> void velocity_gradient(std::ptrdiff_t cL, std::ptrdiff_t cR, S (&grad)[3][3]) const {
     for (int i = 0; i < 3; ++i) {
-      grad[i][d] = (at(u[i] + cR) - at(u[i] + cL)) * inv_h;
+      grad[i][d] = (at<S>(u[i] + cR) - at<S>(u[i] + cL)) * inv_h;
       if (!three_d) continue;
       for (int t = 0; t < 3; ++t) {
         if (t == d || (i != d && i != t)) continue;
         const std::ptrdiff_t st = strides[t];
-        grad[i][t] = 0.25 * inv_h * (at(u[i] + cL + st) - at(u[i] + cL - st) + at(u[i] + cR + st) - at(u[i] + cR - st));
+        grad[i][t] = 0.25 * inv_h * (at<S>(u[i] + cL + st) - at<S>(u[i] + cL - st) + at<S>(u[i] + cR + st) -
+                                     at<S>(u[i] + cR - st));
       }
     }
-    const S mu_f = harmonic_mean(at(mu + cL), at(mu + cR));
-    const S lambda_f = harmonic_mean(at(lambda + cL), at(lambda + cR));
-    const S kappa_f = harmonic_mean(at(kappa + cL), at(kappa + cR));
+  }
+
+  /// d u_x / dx + d u_y / dy at cell c (0 in a column).
+  template <class S> S tangential_divergence(std::ptrdiff_t c) const {
+    if (!three_d) return S{};
+    return 0.5 * inv_h * (at<S>(u[0] + c + strides[0]) - at<S>(u[0] + c - strides[0])) +
+           0.5 * inv_h * (at<S>(u[1] + c + strides[1]) - at<S>(u[1] + c - strides[1]));
+  }
+
+  /// A wall face: no heat, energy or tangential momentum flux; the normal stress as the
+  /// settings say (`bottom`: the bottom wall, whose wall cell is cR; else the top wall's, cL).
+  template <class S> void wall_flux(std::ptrdiff_t cL, std::ptrdiff_t cR, bool bottom, S (&flux)[variable_count]) const {
+    flux[energy] = S{};
+    for (int i = 0; i < 3; ++i)
+      if (i != d) flux[momentum_x + i] = S{};
+    if (wall_stress != WallStress::second_order) return;
+    const std::ptrdiff_t c0 = bottom ? cR : cL, c1 = bottom ? cR + s : cL - s;
+    flux[momentum_z] = -wall_normal_stress(at<S>(n + c0), at<S>(n + c1), at<S>(mu + c0), at<S>(mu + c1),
+                                           at<S>(lambda + c0), at<S>(lambda + c1), at<S>(u[2] + c0),
+                                           at<S>(u[2] + c1), tangential_divergence<S>(c0),
+                                           tangential_divergence<S>(c1), bottom ? 1.0 : -1.0, inv_h);
+  }
+
+  /// The face whose high-side cell is cR (S = double), or the faces of cells cR, cR + 1, ...
+  /// (S a vector: x-neighbours, either pencils side by side or faces of an x pencil), every
+  /// lane doing the scalar arithmetic. `add` / `subtract`: the face adds to its high
+  /// cell / subtracts from its low cell (not both at the ends of a pencil).
+  template <class S> void operator()(std::ptrdiff_t cR, bool add, bool subtract, bool wall, S) const {
+    const std::ptrdiff_t cL = cR - s;
+    S grad[3][3] = {};
+    velocity_gradient(cL, cR, grad);
+    const S mu_f = harmonic_mean(at<S>(mu + cL), at<S>(mu + cR));
+    const S lambda_f = harmonic_mean(at<S>(lambda + cL), at<S>(lambda + cR));
+    const S kappa_f = harmonic_mean(at<S>(kappa + cL), at<S>(kappa + cR));
     const S divergence = grad[0][0] + grad[1][1] + grad[2][2];
     S flux[variable_count] = {};
     S work = S{};
@@ -162,35 +189,29 @@ void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>,
       S tau = mu_f * (grad[i][d] + grad[d][i]);
       if (i == d) tau += (lambda_f - 2.0 / 3.0 * mu_f) * divergence;
       flux[momentum_x + i] = -tau;
-      work += tau * 0.5 * (at(u[i] + cL) + at(u[i] + cR));
+      work += tau * 0.5 * (at<S>(u[i] + cL) + at<S>(u[i] + cR));
     }
-    flux[energy] = -work - kappa_f * (at(T + cR) - at(T + cL)) * inv_h;
-    if (wall) {
-      flux[energy] = S{};
-      for (int i = 0; i < 3; ++i)
-        if (i != d) flux[momentum_x + i] = S{};
-      if (wall_stress == WallStress::second_order) {
-        // `add`: the bottom wall, whose wall cell is cR; else the top wall's, cL.
-        const std::ptrdiff_t c0 = add ? cR : cL, c1 = add ? cR + s : cL - s;
-        const auto tangential_divergence = [&](std::ptrdiff_t c) {
-          if (!three_d) return S{};
-          return 0.5 * inv_h * (at(u[0] + c + strides[0]) - at(u[0] + c - strides[0])) +
-                 0.5 * inv_h * (at(u[1] + c + strides[1]) - at(u[1] + c - strides[1]));
-        };
-        const double* n = w[0].data();
-        flux[momentum_z] = -wall_normal_stress(at(n + c0), at(n + c1), at(mu + c0), at(mu + c1),
-                                               at(lambda + c0), at(lambda + c1),
-                                               at(u[2] + c0), at(u[2] + c1), tangential_divergence(c0),
-                                               tangential_divergence(c1), add ? 1.0 : -1.0, inv_h);
-      }
-    }
+    flux[energy] = -work - kappa_f * (at<S>(T + cR) - at<S>(T + cL)) * inv_h;
+    if (wall) wall_flux(cL, cR, add, flux);
     for (int v = momentum_x; v < variable_count; ++v) {
       const S change = flux[v] * inv_h;
       double* dU = dUdt.q[v].data();
-      if (add) store_lanes(dU + cR, at(dU + cR) + change);
-      if (subtract) store_lanes(dU + cL, at(dU + cL) - change);
+      if (add) store_lanes(dU + cR, at<S>(dU + cR) + change);
+      if (subtract) store_lanes(dU + cL, at<S>(dU + cL) - change);
     }
-  };
+  }
+};
+
+/// Faces normal to d of the planes k0 .. k1 - 1 (slab_sweep).
+template <int d>
+void diffusive_fluxes_along(const Grid& g, const std::array<std::vector<double>, variable_count>& w,
+                            const Operator::Closure& closure, WallStress wall_stress, State& dUdt,
+                            int k0, int k1) {
+  const ViscousFaces<d> face(g, w, closure, wall_stress, dUdt);
+  const std::ptrdiff_t s = face.s;
+  const int n_a = d == 0 ? g.ny : g.nx;
+  const int length = d == 0 ? g.nx : d == 1 ? g.ny : g.nz;
+  const bool walls = d == 2 && g.z_boundary == ZBoundary::walls;
   // y and z faces: a vector's width of pencils side by side (a row's last ones narrower); x
   // faces: a vector's width of faces at a time between the pencil's end faces. Either way each
   // cell receives its low face before its high face, as in the face-by-face loop, so the sums

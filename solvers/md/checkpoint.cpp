@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "common/atomic_output.hpp"
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"

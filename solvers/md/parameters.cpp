@@ -6,7 +6,8 @@ namespace shaker::config {
 std::vector<ParameterSpec> md_parameters() {
   return {
       real("md.box_width", 20.0, Range{1.0, 1e4, true, false},
-           "periodic box edge in x and y (units sigma); must exceed one diameter").in("sigma"),
+           "periodic box edge in x and y (units sigma); must exceed one diameter").in("sigma")
+          .kept_on_restart(restart_continuum),  // the continuum's mass per area; the MD may change its box
       real("md.ceiling", 200.0, positive(1e6),
            "height of the fixed ceiling in the lab frame; must lie above the plate's top 2A + 1").in("sigma"),
       real("md.bin_height", 1.0, at_least(1e-3, 10.0),

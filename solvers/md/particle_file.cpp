@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "common/atomic_output.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"

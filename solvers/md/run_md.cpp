@@ -15,6 +15,8 @@
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/memory.hpp"
+#include "common/output_paths.hpp"
+#include "common/packed_fields.hpp"
 #include "common/progress.hpp"
 #include "common/ranks.hpp"
 #include "common/run_file.hpp"
@@ -23,24 +25,10 @@
 #include "md/initial_states.hpp"
 #include "md/particle_file.hpp"
 #include "md/protocol.hpp"
+#include "md/setup.hpp"
 
 namespace shaker::md {
 namespace {
-
-Geometry geometry_of(const CaseParameters& c, const MdSettings& s) {
-  Geometry g;
-  g.width = c.md_box_width;
-  g.height = s.ceiling;
-  g.gravity = gravity;
-  g.plate = c.shaker;
-  // The ceiling must leave room for a particle above the plate at its highest point.
-  if (!(s.ceiling > g.plate_top() + 1.0))
-    throw InputError(fmt::format(
-        "md.ceiling = {} is below the plate's top: it must exceed 2A + 1 = {:.6g} (A = {:.6g} "
-        "for shaker.gamma = {} and shaker.frequency = {})",
-        s.ceiling, g.plate_top() + 1.0, g.plate.amplitude(), c.shaker.gamma(), c.shaker.frequency()));
-  return g;
-}
 
 std::string variant_name(const Restitution& r, const MdSettings& s) {
   const std::string model = r.kind == Restitution::Kind::constant
@@ -110,8 +98,7 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
   // The restart rule (README); another box is allowed (see below). The schedule's times
   // are counted in the checkpoint's cycles; the plate's amplitude (shaker.gamma) sets the
   // saved cell grid's lowest row.
-  config::require_same_keys(config, saved.configuration,
-                            {"material.restitution", "material.e", "shaker.frequency", "shaker.gamma"}, source);
+  config::require_same_keys(config, saved.configuration, config::restart_md, source);
   try {
     validate_state(g, saved.data);
   } catch (const InputError& error) {
@@ -133,80 +120,6 @@ PhaseSchedule schedule_of(const CaseParameters& c, const Simulation& simulation,
   schedule.resume_at(resume->position, simulation.time(), restart_source(restart_from));
   schedule.check_switch(resume->written_by, simulation.time(), restart_source(restart_from));
   return schedule;
-}
-
-/// The memory of the particles, the cell list and the phase sampler, before any is allocated.
-void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometry& g) {
-  const double n = static_cast<double>(c.particles);
-  // Per particle: its state, event, last collision, cell links, queue node, sampled r and v,
-  // the flat layer's site list, and the last cycle counted at each crossing height; per cell a
-  // list head; per sampling bin and phase the pooled sums (13 doubles) and the profile's
-  // fields written out (2 x 9 doubles).
-  const double per_particle = sizeof(Particle) + sizeof(Event) + 8.0 + 16.0 + 64.0 + 2.0 * sizeof(Vec3) + 16.0 +
-                              4.0 * static_cast<double>(s.crossing_heights.size());
-  const double rows = std::min(std::floor(g.height), g.plate_top() + 8.0 * n / (g.width * g.width) + 3.0);
-  const double cells = std::floor(g.width) * std::floor(g.width) * std::max(rows, 3.0);
-  const double bins = std::ceil(s.ceiling / s.bin_height);
-  const double phases = static_cast<double>(c.run.phases_per_cycle);
-  // Each particle snapshot: r and v kept until the end, and its lines of the XYZ text.
-  const double frames = static_cast<double>(s.snapshot_phases.size() * s.snapshot_cycles.size());
-  check_memory(n * per_particle + 4.0 * cells + bins * phases * (13.0 + 18.0) * 8.0 + frames * n * (48.0 + 160.0),
-               fmt::format("the MD run ({} particles, {:.3g} cells, {:.3g} sampling bins x {} phases, {} "
-                           "particle snapshots)", c.particles, cells, bins, c.run.phases_per_cycle, frames),
-               "allowed: fewer layer.particles, a larger md.bin_height, a lower md.ceiling, fewer "
-               "run.phases_per_cycle or fewer particle snapshots (md.snapshot_phases x md.snapshot_cycles)");
-}
-
-/// Every file the run may write, none equal to an input (md.initial_file among them) or to
-/// another (checked before work).
-void check_paths(const CaseParameters& c, const MdSettings& s, const CheckpointSettings& checkpoints,
-                 std::vector<NamedPath> inputs) {
-  const std::filesystem::path output = c.run.output;
-  std::vector<NamedPath> outputs{{"run.output", output}};
-  terminal_log::add_output(outputs, c.run);
-  if (!s.snapshot_phases.empty() && !output.empty()) {
-    outputs.push_back({"run.output's particle file", particle_h5_path(output)});
-    outputs.push_back({"run.output's particle XYZ file", particle_xyz_path(output)});
-  }
-  if (s.initial_state == "file" && checkpoints.restart_from.empty()) {
-    inputs.push_back({"md.initial_file", s.initial_file});
-    check_input_file(inputs.back());
-  }
-  checkpoints.check_paths(outputs, inputs);
-}
-
-/// Replica r of the case (md.replicas): the periodic protocol takes seed run.seed + r, the
-/// single shock starts r cycles later from run.seed, as repeats of one single shock are pooled.
-const char* replica_key(const config::Config& config) {
-  return config.text("run.protocol") == "single_shock" ? "run.transient_cycles" : "run.seed";
-}
-
-config::Config replica_configuration(const config::Config& config, std::int64_t r) {
-  config::Config replica = config;
-  replica.set_value("md.replicas", std::int64_t{1});
-  replica.set_value(replica_key(config), config.integer(replica_key(config)) + r);
-  return replica;
-}
-
-void check_replicas(const config::Config& config, const CheckpointSettings& checkpoints) {
-  const std::int64_t replicas = config.integer("md.replicas");
-  if (replicas == 1) return;
-  if (!checkpoints.restart_from.empty() || !checkpoints.file.empty())
-    throw InputError(fmt::format("md.replicas = {} with a checkpoint (run.restart_from = \"{}\", "
-                                 "run.checkpoint = \"{}\"): a checkpoint holds one replica; "
-                                 "allowed: md.replicas = 1 with run.restart_from or run.checkpoint",
-                                 replicas, checkpoints.restart_from.string(), checkpoints.file.string()));
-  if (config.text("md.initial_state") == "file" && config.text("run.protocol") == "periodic")
-    throw InputError(fmt::format("md.replicas = {} with md.initial_state = \"file\" and run.protocol = "
-                                 "\"periodic\": every replica would start from the same particles and run "
-                                 "the same trajectory; allowed: md.replicas = 1 with md.initial_state = \"file\" "
-                                 "(or the single shock, whose replicas differ in their transient)", replicas));
-  const auto& spec = config::find_spec(replica_key(config));
-  const double last = static_cast<double>(config.integer(spec.key) + replicas - 1);
-  if (!spec.range.contains(last))
-    throw InputError(fmt::format("md.replicas = {}: replica {} would need {} = {}; allowed: {} "
-                                 "{}", replicas, replicas - 1, spec.key, last, spec.key,
-                                 spec.range.describe()));
 }
 
 /// Collisions counted over one span of simulated time.
@@ -233,13 +146,18 @@ struct ReplicaSummary {
   EnergyBudget budget;
   bool queue_consistent = false;
 
+  /// The numbers of the summary, in the order they travel.
+  template <class Self> static auto scalars(Self& s) {
+    return std::tie(s.time, s.seconds, s.events, s.overlaps, s.this_run.pair, s.this_run.plate, s.this_run.ceiling,
+                    s.this_run.guard_activations, s.since_first_start.pair, s.since_first_start.plate,
+                    s.since_first_start.ceiling, s.since_first_start.guard_activations, s.budget.plate_work,
+                    s.budget.collisional_loss, s.budget.energy_change, s.budget.relative_closure,
+                    s.queue_consistent);
+  }
+
   void pack(std::vector<double>& out) const {
-    out.insert(out.end(), {time, seconds, events, overlaps});
-    for (const CollisionCounts& c : {this_run, since_first_start})
-      out.insert(out.end(), {c.pair, c.plate, c.ceiling, c.guard_activations});
-    out.insert(out.end(), {budget.plate_work, budget.collisional_loss, budget.energy_change,
-                           budget.relative_closure, queue_consistent ? 1.0 : 0.0,
-                           static_cast<double>(samples.phases()), static_cast<double>(samples.bins()),
+    pack_fields(out, scalars(*this));
+    out.insert(out.end(), {static_cast<double>(samples.phases()), static_cast<double>(samples.bins()),
                            samples.bin_volume()});
     for (std::size_t k = 0; k < samples.phases(); ++k) {
       out.push_back(static_cast<double>(samples.samples(k)));
@@ -254,14 +172,7 @@ struct ReplicaSummary {
   /// The summary packed at `at`, its series' columns named `names` (replica 0's).
   static ReplicaSummary unpack(const double*& at, const std::vector<std::string>& names) {
     ReplicaSummary r;
-    for (double* x : {&r.time, &r.seconds, &r.events, &r.overlaps})
-      *x = *at++;
-    for (CollisionCounts* c : {&r.this_run, &r.since_first_start})
-      for (double* x : {&c->pair, &c->plate, &c->ceiling, &c->guard_activations}) *x = *at++;
-    for (double* x : {&r.budget.plate_work, &r.budget.collisional_loss, &r.budget.energy_change,
-                      &r.budget.relative_closure})
-      *x = *at++;
-    r.queue_consistent = *at++ != 0.0;
+    unpack_fields(at, scalars(r));
     const auto phases = static_cast<std::size_t>(*at++), bins = static_cast<std::size_t>(*at++);
     const double bin_volume = *at++;
     std::vector<std::vector<double>> cycles(phases);
@@ -329,137 +240,148 @@ ReplicaSummary combined(const std::vector<ReplicaSummary>& replicas) {
   return all;
 }
 
+
+/// What this rank's replicas leave: their summaries packed for the root, and replica 0's
+/// profiles, series and particle snapshots (the run file's own).
+struct RankRuns {
+  std::vector<double> packed;
+  RunRecord first;
+  std::vector<ParticleFrame> frames;
+};
+
+/// Runs replica r (on its own configuration) and adds its results to `runs`.
+void run_replica(const config::Config& config, const MdCase& c, std::int64_t r,
+                 const ProgressSettings& progress_settings, RankRuns& runs) {
+  const config::Config replica = replica_configuration(config, r);
+  const CaseParameters parameters = CaseParameters::from(replica);
+  const std::filesystem::path& restart_from = c.checkpoints.restart_from;
+  std::optional<Resumed> resume;
+  Simulation simulation = make_simulation(replica, parameters, c.settings, c.geometry, c.rules, restart_from, resume);
+  const PhaseSchedule schedule = schedule_of(parameters, simulation, resume, restart_from);
+  PhaseSampler sampler = make_sampler(simulation, schedule, c.settings);
+  if (resume) take_up_samples(sampler, resume->sampled, resume->position, schedule, restart_source(restart_from));
+  ProgressReport progress(c.replicas == 1 ? "shaker md" : fmt::format("shaker md replica {}", r), "collisions/s",
+                          [&] { return static_cast<double>(simulation.tally().collisions()); }, progress_settings);
+  std::vector<RunObserver*> also{&progress};
+  // A checkpoint holds one replica (md_case checks it): a signal stops an ensemble at once.
+  std::optional<CheckpointObserver> checkpointing;
+  if (c.replicas == 1) {
+    checkpointing.emplace(
+        c.checkpoints, schedule,
+        [&](const std::filesystem::path& path, const SchedulePosition& position) {
+          write_checkpoint(path, simulation.save(), c.geometry, position, c.configuration,
+                           SampledCycles{sampler.store(), schedule.transient_cycles()});
+        },
+        "shaker md");
+    also.push_back(&*checkpointing);
+  }
+  if (r == 0) terminal_log::start(c.parameters.run, c.configuration);  // the inputs are accepted
+  // Replica 0 alone takes particle snapshots (the files hold one run's frames).
+  MdSettings settings = c.settings;
+  if (r != 0) settings.snapshot_phases.clear(), settings.snapshot_cycles.clear();
+  const RunOutcome outcome = run_protocol(simulation, schedule, sampler, parameters, settings, also);
+  summary_of(simulation, outcome).pack(runs.packed);
+  if (r == 0) {
+    runs.first.profiles = outcome.profiles;
+    runs.first.series = outcome.series;
+    runs.frames = outcome.frames;
+  }
+}
+
+/// The replicas' summaries in replica order (replica r ran on rank r mod P).
+std::vector<ReplicaSummary> replica_summaries(const std::vector<std::vector<double>>& gathered,
+                                              std::int64_t replicas, const std::vector<std::string>& names) {
+  std::vector<ReplicaSummary> summaries(static_cast<std::size_t>(replicas));
+  for (std::size_t rank = 0; rank < gathered.size(); ++rank) {
+    const double* at = gathered[rank].data();
+    for (std::size_t r = rank; r < summaries.size(); r += gathered.size())
+      summaries[r] = ReplicaSummary::unpack(at, names);
+  }
+  return summaries;
+}
+
+/// The run file's record: the replicas pooled, labelled with the model that produced them.
+RunRecord pooled_record(const MdCase& c, const RunRecord& first, std::vector<ReplicaSummary>& summaries) {
+  std::vector<RunRecord> pooled(summaries.size(), first);
+  for (std::size_t r = 0; r < summaries.size(); ++r) pooled[r].samples = summaries[r].samples;
+  RunRecord record = pool_runs(pooled);
+  // Replica 0's series stays where a single run's is; the others follow in replica order.
+  for (std::size_t r = 1; r < summaries.size(); ++r) record.replica_series.push_back(std::move(summaries[r].series));
+  record.solver = "md";
+  const RunProtocol& run = c.parameters.run;
+  const bool switched = run.kind == RunProtocol::Kind::single_shock;
+  const Restitution& final_restitution = switched ? run.after_switch : c.parameters.restitution;
+  record.model_variant = variant_name(final_restitution, c.settings);
+  if (switched)
+    record.model_variant += fmt::format(" (switched from {} at f t = {})", variant_name(c.parameters.restitution, c.settings),
+                                        run.switch_phase);
+  if (c.replicas > 1) record.model_variant += fmt::format(" (pooled over {} replicas)", c.replicas);
+  record.configuration = c.configuration;
+  record.e = final_restitution.e;
+  return record;
+}
+
+/// The summary on stdout (and in the log); returns the exit code of the end-of-run check.
+int report_run(const MdCase& c, const ReplicaSummary& all, std::size_t frames, double wall_seconds) {
+  const RunProtocol& run = c.parameters.run;
+  const bool switched = run.kind == RunProtocol::Kind::single_shock;
+  terminal_log::say(stdout, "shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", c.parameters.particles,
+                    run.transient_cycles + (switched ? 1 : run.sampled_cycles), all.time, duration_text(wall_seconds));
+  if (c.replicas > 1)
+    terminal_log::say(stdout, "  {} replicas on {} rank(s); counts below are summed over replicas, the closure "
+                      "is the worst\n", c.replicas, Ranks::world().size());
+  // A continued run's tally holds the running totals of the runs before it: each count is
+  // printed once over this run and once over all, labelled, so that no total mixes the two.
+  const bool continued = !c.checkpoints.restart_from.empty();
+  const std::string here = continued ? " in this continuation" : "";
+  const auto print_counts = [](const std::string& span, const CollisionCounts& n) {
+    terminal_log::say(stdout, "  collisions{}: {} (pair {}, plate {}, ceiling {}), collapse guard activations {}\n",
+                      span, count(n.total()), count(n.pair), count(n.plate), count(n.ceiling),
+                      count(n.guard_activations));
+  };
+  print_counts(here, all.this_run);
+  if (continued) print_counts(" since the start of the run that wrote the first checkpoint", all.since_first_start);
+  terminal_log::say(stdout, "  rates{}: {:.4g} collisions/s, {:.4g} events/s\n", here,
+                    all.this_run.total() / all.seconds, all.events / all.seconds);
+  terminal_log::say(stdout, "  energy budget{}: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
+                    "relative closure {:.3g}\n", here, all.budget.plate_work, all.budget.collisional_loss,
+                    all.budget.energy_change, all.budget.relative_closure);
+  terminal_log::say(stdout, "  overlaps at end: {}; event queue consistent: {}\n", count(all.overlaps),
+                    all.queue_consistent ? "yes" : "NO");
+  terminal_log::say(stdout, "  output: {}\n", run.output);
+  if (frames > 0)
+    terminal_log::say(stdout, "  particle snapshots: {} frames in {} and {}\n", frames,
+                      particle_h5_path(run.output).string(), particle_xyz_path(run.output).string());
+  const bool ok = all.overlaps == 0 && all.queue_consistent && all.budget.relative_closure <= 1e-9;
+  if (!ok) terminal_log::say(stderr, "shaker md: end-of-run invariant check FAILED (see summary)\n");
+  return ok ? 0 : 1;
+}
+
 }  // namespace
 
 int run(const config::Config& config, const std::vector<NamedPath>& inputs,
         const ProgressSettings& progress_settings) {
   const Stopwatch wall;
-  const CaseParameters parameters = CaseParameters::from(config);
-  const MdSettings settings = MdSettings::from(config);
-  const Geometry geometry = geometry_of(parameters, settings);
-  const CheckpointSettings checkpoints = CheckpointSettings::from(config);
-  check_paths(parameters, settings, checkpoints, inputs);
-  check_replicas(config, checkpoints);
-  check_md_memory(parameters, settings, geometry);
-  CollisionRules rules;
-  rules.restitution = parameters.restitution;
-  rules.tc_guard = settings.tc_guard;
-  rules.tc = settings.tc;
-
+  const MdCase c = md_case(config, inputs);
   // Replica r runs on rank r mod P, and the root pools them in replica order, so the file does
   // not depend on P.
   const Ranks& ranks = Ranks::world();
-  const std::int64_t replicas = config.integer("md.replicas");
   ProgressSettings progress_of_rank = progress_settings;
   progress_of_rank.quiet = progress_settings.quiet || !ranks.root();
-  std::vector<double> mine;
-  RunRecord record;
-  std::vector<ParticleFrame> frames;  // replica 0's
-  const std::string configuration = config.to_toml();
-  for (std::int64_t r = ranks.rank(); r < replicas; r += ranks.size()) {
-    const config::Config replica = replica_configuration(config, r);
-    const CaseParameters replica_parameters = CaseParameters::from(replica);
-    std::optional<Resumed> resume;
-    Simulation simulation =
-        make_simulation(replica, replica_parameters, settings, geometry, rules, checkpoints.restart_from, resume);
-    const PhaseSchedule schedule = schedule_of(replica_parameters, simulation, resume, checkpoints.restart_from);
-    PhaseSampler sampler = make_sampler(simulation, schedule, settings);
-    if (resume)
-      take_up_samples(sampler, resume->sampled, resume->position, schedule, restart_source(checkpoints.restart_from));
-    ProgressReport progress(replicas == 1 ? "shaker md" : fmt::format("shaker md replica {}", r),
-                            "collisions/s",
-                            [&] { return static_cast<double>(simulation.tally().collisions()); },
-                            progress_of_rank);
-    std::vector<RunObserver*> also{&progress};
-    // A checkpoint holds one replica (check_replicas): a signal stops an ensemble at once.
-    std::optional<CheckpointObserver> checkpointing;
-    if (replicas == 1) {
-      checkpointing.emplace(
-          checkpoints, schedule,
-          [&](const std::filesystem::path& path, const SchedulePosition& position) {
-            write_checkpoint(path, simulation.save(), geometry, position, configuration,
-                             SampledCycles{sampler.store(), schedule.transient_cycles()});
-          },
-          "shaker md");
-      also.push_back(&*checkpointing);
-    }
-    if (r == 0) terminal_log::start(parameters.run, configuration);  // the inputs are accepted
-    // Replica 0 alone takes particle snapshots (the files hold one run's frames).
-    MdSettings replica_settings = settings;
-    if (r != 0) {
-      replica_settings.snapshot_phases.clear();
-      replica_settings.snapshot_cycles.clear();
-    }
-    const RunOutcome outcome = run_protocol(simulation, schedule, sampler, replica_parameters, replica_settings, also);
-    summary_of(simulation, outcome).pack(mine);
-    if (r == 0) {
-      record.profiles = outcome.profiles;
-      record.series = outcome.series;
-      frames = outcome.frames;
-    }
-  }
-  const std::vector<std::vector<double>> gathered = ranks.gather(mine);
+  RankRuns mine;
+  for (std::int64_t r = ranks.rank(); r < c.replicas; r += ranks.size())
+    run_replica(config, c, r, progress_of_rank, mine);
+  const std::vector<std::vector<double>> gathered = ranks.gather(mine.packed);
   if (!ranks.root()) return 0;
 
-  std::vector<ReplicaSummary> summaries(static_cast<std::size_t>(replicas));
-  for (std::size_t rank = 0; rank < gathered.size(); ++rank) {
-    const double* at = gathered[rank].data();
-    for (std::size_t r = rank; r < summaries.size(); r += gathered.size())
-      summaries[r] = ReplicaSummary::unpack(at, record.series.names);
-  }
-  std::vector<RunRecord> pooled(summaries.size(), record);
-  for (std::size_t r = 0; r < summaries.size(); ++r) pooled[r].samples = summaries[r].samples;
-  record = pool_runs(pooled);
-  // Replica 0's series stays where a single run's is; the others follow in replica order.
-  for (std::size_t r = 1; r < summaries.size(); ++r)
-    record.replica_series.push_back(std::move(summaries[r].series));
+  std::vector<ReplicaSummary> summaries = replica_summaries(gathered, c.replicas, mine.first.series.names);
   const ReplicaSummary all = combined(summaries);
-
-  record.solver = "md";
-  const bool switched = parameters.run.kind == RunProtocol::Kind::single_shock;
-  const Restitution& final_restitution = switched ? parameters.run.after_switch : parameters.restitution;
-  record.model_variant = variant_name(final_restitution, settings);
-  if (switched) record.model_variant += fmt::format(" (switched from {} at f t = {})",
-                                                    variant_name(parameters.restitution, settings),
-                                                    parameters.run.switch_phase);
-  if (replicas > 1) record.model_variant += fmt::format(" (pooled over {} replicas)", replicas);
-  record.configuration = configuration;
-  record.e = final_restitution.e;
-  if (!frames.empty())
-    write_particle_files(parameters.run.output, frames, ParticleBox{geometry.width, geometry.height}, record);
-  write_run_file(parameters.run.output, record);
-
-  terminal_log::say(stdout, "shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", parameters.particles,
-             parameters.run.transient_cycles + (switched ? 1 : parameters.run.sampled_cycles),
-             all.time, duration_text(wall.seconds()));
-  if (replicas > 1)
-    terminal_log::say(stdout, "  {} replicas on {} rank(s); counts below are summed over replicas, the closure "
-               "is the worst\n", replicas, ranks.size());
-  // A continued run's tally holds the running totals of the runs before it: each count is
-  // printed once over this run and once over all, labelled, so that no total mixes the two.
-  const bool continued = !checkpoints.restart_from.empty();
-  const std::string here = continued ? " in this continuation" : "";
-  const auto print_counts = [](const std::string& span, const CollisionCounts& c) {
-    terminal_log::say(stdout, "  collisions{}: {} (pair {}, plate {}, ceiling {}), collapse guard activations {}\n",
-               span, count(c.total()), count(c.pair), count(c.plate), count(c.ceiling),
-               count(c.guard_activations));
-  };
-  print_counts(here, all.this_run);
-  if (continued) print_counts(" since the start of the run that wrote the first checkpoint", all.since_first_start);
-  terminal_log::say(stdout, "  rates{}: {:.4g} collisions/s, {:.4g} events/s\n", here, all.this_run.total() / all.seconds,
-             all.events / all.seconds);
-  terminal_log::say(stdout, "  energy budget{}: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
-             "relative closure {:.3g}\n", here, all.budget.plate_work, all.budget.collisional_loss,
-             all.budget.energy_change, all.budget.relative_closure);
-  terminal_log::say(stdout, "  overlaps at end: {}; event queue consistent: {}\n", count(all.overlaps),
-             all.queue_consistent ? "yes" : "NO");
-  terminal_log::say(stdout, "  output: {}\n", parameters.run.output);
-  if (!frames.empty())
-    terminal_log::say(stdout, "  particle snapshots: {} frames in {} and {}\n", frames.size(),
-               particle_h5_path(parameters.run.output).string(), particle_xyz_path(parameters.run.output).string());
-  const bool ok = all.overlaps == 0 && all.queue_consistent && all.budget.relative_closure <= 1e-9;
-  if (!ok) terminal_log::say(stderr, "shaker md: end-of-run invariant check FAILED (see summary)\n");
-  return ok ? 0 : 1;
+  const RunRecord record = pooled_record(c, mine.first, summaries);
+  if (!mine.frames.empty())
+    write_particle_files(c.parameters.run.output, mine.frames, ParticleBox{c.geometry.width, c.geometry.height},
+                         record);
+  write_run_file(c.parameters.run.output, record);
+  return report_run(c, all, mine.frames.size(), wall.seconds());
 }
 
 }  // namespace shaker::md

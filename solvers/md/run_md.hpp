@@ -2,7 +2,7 @@
 #include <vector>
 
 #include "common/config.hpp"
-#include "common/hdf5_file.hpp"
+#include "common/output_paths.hpp"
 #include "common/progress.hpp"
 
 namespace shaker::md {

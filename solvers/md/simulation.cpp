@@ -108,96 +108,102 @@ void Simulation::prefetch_members(int c, int axis, int step) const {
   else cells_.for_each_cell_in_new_face(c, axis, step, touch);
 }
 
+void Simulation::prefetch_ahead(const Event& event) {
+  // Events k + 1 and k + 2 are (most likely) the next two in the queue, the partner's entry
+  // aside (it usually holds this same collision and is about to move); the calendar's cursor
+  // meets later ones a few events ahead.
+  const std::int32_t partner = event.cell_time < event.time || event.kind != EventKind::pair ? -1 : event.partner;
+  std::int32_t ahead[3];
+  if (use_calendar_) {
+    std::int32_t later[2];
+    const int reached = calendar_.walk_ahead(later);
+    for (int k = 0; k < reached; ++k) prefetch_stage1(later[k]);
+    calendar_.peek_after_top(partner, ahead);
+    // Each stage reads only what an earlier step prefetched (if the guesses hold).
+    if (ahead[2] >= 0) prefetch_stage1(ahead[2]);
+    if (ahead[1] >= 0) prefetch_stage2(ahead[1]);
+    if (ahead[0] >= 0 && lookahead_members_) prefetch_stage3(ahead[0]);
+  } else {
+    heap_.peek_after_top(partner, ahead);
+    if (ahead[1] >= 0) prefetch_stage1(ahead[1]);
+    if (ahead[0] >= 0) prefetch_stage2(ahead[0]);
+  }
+}
+
+bool Simulation::pair_event(std::int32_t i, const Event& event, double before_i) {
+  const double now = data_.time;
+  Tally& tally = data_.tally;
+  const std::int32_t j = event.partner;
+  Particle& p = data_.particles[i];
+  Particle& q = data_.particles[j];
+  if (q.counter != event.partner_counter) {
+    ++tally.stale;
+    return false;
+  }
+  if (lookahead_members_) prefetch_members(cells_.cell(j));
+  const double before_j = q.t;
+  update(j, now);
+  Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
+  r.x -= geometry_.width * std::round(r.x / geometry_.width);
+  r.y -= geometry_.width * std::round(r.y / geometry_.width);
+  if (geometry_.periodic_z) r.z -= geometry_.height * std::round(r.z / geometry_.height);
+  const bool tc = rules_.tc_guard;
+  const PairCollision c = collide_pair(p, q, r, now, tc ? last_collision(i, before_i, rules_.tc) : no_collision_yet,
+                                       tc ? last_collision(j, before_j, rules_.tc) : no_collision_yet, rules_);
+  ++tally.pair;
+  if (c.happened) {
+    tally.pair_loss += c.loss;
+    tally.virial += c.virial;
+    tally.guard_activations += c.elastic_by_guard ? 1 : 0;
+    note_collision(i, j, before_i);
+    note_collision(j, i, before_j);
+  }
+  // i first: its cells were prefetched longer ago (the order does not change the result:
+  // each prediction writes only its own event, and the queue's order is total).
+  predict(i);
+  predict(j);
+  // Deterministic in the run's own history (a restart sorts at the same collisions).
+  if (data_.tally.pair % (sort_interval * data_.particles.size()) == 0) sort_by_cell();
+  return true;
+}
+
+void Simulation::wall_event(std::int32_t i, EventKind kind, double before_i) {
+  const double now = data_.time;
+  Tally& tally = data_.tally;
+  Particle& p = data_.particles[i];
+  const bool plate = kind == EventKind::plate;
+  const double last = rules_.tc_guard ? last_collision(i, before_i, rules_.tc) : no_collision_yet;
+  const WallCollision c = plate ? collide_wall(p, geometry_.plate.velocity(now), 1.0, now, last, rules_)
+                                : collide_wall(p, 0.0, -1.0, now, last, rules_);
+  ++(plate ? tally.plate : tally.ceiling);
+  if (c.changed) {
+    tally.plate_work += c.work;
+    tally.wall_loss += c.loss;
+    tally.guard_activations += c.elastic_by_guard ? 1 : 0;
+    note_collision(i, -1, before_i);
+  } else {
+    ++tally.grazes;
+  }
+}
+
 void Simulation::step() {
   const std::int32_t i = use_calendar_ ? calendar_.top() : heap_.top();
   const Event event = data_.events[i];
-  if (lookahead_) {
-    // Events k + 1 and k + 2 are (most likely) the next two in the queue, the partner's entry
-    // aside (it usually holds this same collision and is about to move); the calendar's cursor
-    // meets later ones a few events ahead.
-    const std::int32_t partner = event.cell_time < event.time || event.kind != EventKind::pair ? -1 : event.partner;
-    std::int32_t ahead[3];
-    if (use_calendar_) {
-      std::int32_t later[2];
-      const int reached = calendar_.walk_ahead(later);
-      for (int k = 0; k < reached; ++k) prefetch_stage1(later[k]);
-      calendar_.peek_after_top(partner, ahead);
-      // Each stage reads only what an earlier step prefetched (if the guesses hold).
-      if (ahead[2] >= 0) prefetch_stage1(ahead[2]);
-      if (ahead[1] >= 0) prefetch_stage2(ahead[1]);
-      if (ahead[0] >= 0 && lookahead_members_) prefetch_stage3(ahead[0]);
-    } else {
-      heap_.peek_after_top(partner, ahead);
-      if (ahead[1] >= 0) prefetch_stage1(ahead[1]);
-      if (ahead[0] >= 0) prefetch_stage2(ahead[0]);
-    }
-  }
+  if (lookahead_) prefetch_ahead(event);
   const bool crossing = event.cell_time < event.time;
   data_.time = crossing ? event.cell_time : event.time;
-  const double now = data_.time;
-  Particle& p = data_.particles[i];
-  const double before_i = p.t;
-  update(i, now);
-  Tally& tally = data_.tally;
+  const double before_i = data_.particles[i].t;
+  update(i, data_.time);
   if (crossing) {
-    ++tally.cell;
+    ++data_.tally.cell;
     cross_cell(i, event.cell_direction);
     predict_after_crossing(i, event.cell_direction);
     return;
   }
-  switch (event.kind) {
-    case EventKind::pair: {
-      const std::int32_t j = event.partner;
-      Particle& q = data_.particles[j];
-      if (q.counter != event.partner_counter) {
-        ++tally.stale;
-        break;
-      }
-      if (lookahead_members_) prefetch_members(cells_.cell(j));
-      const double before_j = q.t;
-      update(j, now);
-      Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
-      r.x -= geometry_.width * std::round(r.x / geometry_.width);
-      r.y -= geometry_.width * std::round(r.y / geometry_.width);
-      if (geometry_.periodic_z) r.z -= geometry_.height * std::round(r.z / geometry_.height);
-      const bool tc = rules_.tc_guard;
-      const PairCollision c = collide_pair(p, q, r, now, tc ? last_collision(i, before_i, rules_.tc) : no_collision_yet,
-                                           tc ? last_collision(j, before_j, rules_.tc) : no_collision_yet, rules_);
-      ++tally.pair;
-      if (c.happened) {
-        tally.pair_loss += c.loss;
-        tally.virial += c.virial;
-        tally.guard_activations += c.elastic_by_guard ? 1 : 0;
-        note_collision(i, j, before_i);
-        note_collision(j, i, before_j);
-      }
-      // i first: its cells were prefetched longer ago (the order does not change the result:
-      // each prediction writes only its own event, and the queue's order is total).
-      predict(i);
-      predict(j);
-      // Deterministic in the run's own history (a restart sorts at the same collisions).
-      if (data_.tally.pair % (sort_interval * data_.particles.size()) == 0) sort_by_cell();
-      return;
-    }
-    case EventKind::plate:
-    case EventKind::ceiling: {
-      const bool plate = event.kind == EventKind::plate;
-      const double last = rules_.tc_guard ? last_collision(i, before_i, rules_.tc) : no_collision_yet;
-      const WallCollision c = plate ? collide_wall(p, geometry_.plate.velocity(now), 1.0, now, last, rules_)
-                                    : collide_wall(p, 0.0, -1.0, now, last, rules_);
-      ++(plate ? tally.plate : tally.ceiling);
-      if (c.changed) {
-        tally.plate_work += c.work;
-        tally.wall_loss += c.loss;
-        tally.guard_activations += c.elastic_by_guard ? 1 : 0;
-        note_collision(i, -1, before_i);
-      } else {
-        ++tally.grazes;
-      }
-      break;
-    }
-    case EventKind::cell:
-      break;
+  if (event.kind == EventKind::pair) {
+    if (pair_event(i, event, before_i)) return;  // both predicted
+  } else if (event.kind != EventKind::cell) {
+    wall_event(i, event.kind, before_i);
   }
   predict(i);
 }

@@ -7,10 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "common/errors.hpp"
+#include "md/calendar_queue.hpp"
 #include "md/cell_list.hpp"
 #include "md/collision_rules.hpp"
 #include "md/event_prediction.hpp"
-#include "md/calendar_queue.hpp"
 #include "md/event_queue.hpp"
 #include "md/geometry.hpp"
 #include "md/height_counts.hpp"
@@ -62,12 +63,6 @@ inline constexpr std::uint32_t collapse_streak = 100;
 /// while the time advances by less than collapse_interval.
 inline constexpr std::uint64_t stalled_events_per_particle = 100;
 inline constexpr std::uint64_t stalled_events_floor = 10000;
-
-/// Thrown when inelastic collapse starts and no guard is on (exit code 1, not bad input).
-class CollapseError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// Which future-event list to use: the calendar queue (the default: faster than the heap at
 /// every N measured, docs/performance.md) or the indexed binary heap (the simple reference). Both pop events in the
@@ -160,6 +155,13 @@ class Simulation {
   static constexpr std::uint64_t sort_interval = 2;
   /// Brings particle i to now, counting what its free flight reached on the way.
   void update(std::int32_t i, double now);
+  /// Prefetches what the next events will read (lookahead_).
+  void prefetch_ahead(const Event& event);
+  /// The pair collision of `event` at the current time (i already advanced): false if the
+  /// partner has moved since it was predicted (a stale event; nothing is predicted).
+  bool pair_event(std::int32_t i, const Event& event, double before_i);
+  /// The plate or ceiling collision of particle i at the current time (i already advanced).
+  void wall_event(std::int32_t i, EventKind kind, double before_i);
 
   /// Software pipelining across events (large N, where every event waits for memory): while
   /// event k is processed, what the next events will read is prefetched in stages, each stage

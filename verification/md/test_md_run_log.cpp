@@ -59,13 +59,14 @@ TEST(MdRunLog, HoldsTheConfigurationAndEveryLineTheTerminalShowed) {
   EXPECT_GE(shown, 20u + 6u);  // a progress line per stored phase of two cycles, the summary
 }
 
-TEST(MdRunLog, ARunThatFailsLeavesItsLogWithTheMessage) {
+TEST(MdRunLog, ARunStoppedByCollapseExitsWithItsCodeAndLeavesItsLogWithTheMessage) {
   const auto dir = testing::test_directory();
-  // Perfectly inelastic grains collapse at once without the guard: exit 1, no run file.
-  ASSERT_EQ(run_small_case(dir, "--quiet --set material.e=0.0"), 1) << text_of(dir / "stderr.txt");
+  // Perfectly inelastic grains collapse at once without the guard: exit 3, no run file.
+  ASSERT_EQ(run_small_case(dir, "--quiet --set material.e=0.0"), 3) << text_of(dir / "stderr.txt");
   EXPECT_FALSE(std::filesystem::exists(dir / "run.h5"));
   const std::string message = text_of(dir / "stderr.txt");
   ASSERT_FALSE(message.empty());
+  EXPECT_NE(message.find("inelastic collapse"), std::string::npos) << message;
   EXPECT_NE(text_of(dir / "run.log").find(message), std::string::npos) << message;
 }
 

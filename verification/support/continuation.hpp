@@ -23,6 +23,7 @@
 #include "common/config.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/progress.hpp"
+#include "common/signals.hpp"
 #include "gtest/gtest.h"
 
 namespace shaker::testing {

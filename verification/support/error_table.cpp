@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/atomic_output.hpp"
 #include "common/hdf5_file.hpp"
 
 namespace shaker::convergence {

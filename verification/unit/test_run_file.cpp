@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/atomic_output.hpp"
 #include "common/config.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"

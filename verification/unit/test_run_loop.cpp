@@ -19,10 +19,12 @@
 #include <utility>
 #include <vector>
 
+#include "common/atomic_output.hpp"
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
 #include "common/progress.hpp"
 #include "common/run_loop.hpp"
+#include "common/signals.hpp"
 #include "test_support.hpp"
 
 namespace {

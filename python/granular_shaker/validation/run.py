@@ -8,7 +8,7 @@ import time
 
 from granular_shaker.validation.plan import run_key
 
-SOLVER_UNAVAILABLE = 3  # exit code of a solver that is not built yet (README)
+COLLAPSE_EXIT_CODE = 3  # an MD run stopped by inelastic collapse (README, exit codes)
 
 
 def log(message):
@@ -65,9 +65,7 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None, launcher=()):
         status = "ok"
     elif rc is None:
         status = f"timed out after {run['timeout']:.0f} s"
-    elif rc == SOLVER_UNAVAILABLE:
-        status = "unavailable"
-    elif rc == 1 and "collapse" in stderr.lower():
+    elif rc == COLLAPSE_EXIT_CODE:
         status = "collapse"
     else:
         status = "failed"
