@@ -162,9 +162,9 @@ std::pair<double, double> robust_slope(const std::vector<double>& x, const std::
   return fitted_slope(xi.size() >= 3 ? xi : x, xi.size() >= 3 ? yi : y);
 }
 
-/// 2 c of the least-squares parabola a + b x + c x^2.
+/// 2 c of the least-squares parabola a + b x + c x^2 (through the points, if three).
 double fitted_curvature(const std::vector<double>& x, const std::vector<double>& y) {
-  if (x.size() < 4) return nan;
+  if (x.size() < 3) return nan;
   const double x0 = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
   double s[5] = {0, 0, 0, 0, 0}, r[3] = {0, 0, 0};
   for (std::size_t k = 0; k < x.size(); ++k) {
@@ -250,10 +250,13 @@ std::optional<ShockLife> shock_life(const std::vector<PhaseQuantities>& q,
     }
   s.width_mean = mean(width);
   s.width_over_mfp_mean = mean(width_over_mfp);
-  if (t_resolved.size() >= 3) std::tie(s.speed, s.speed_fit_error) = robust_slope(t_resolved, height_resolved, 2.0 * bin_height);
-  else if (t.size() >= 2) std::tie(s.speed, s.speed_fit_error) = robust_slope(t, height, 2.0 * bin_height);
+  const bool resolved = t_resolved.size() >= 3;
+  const auto& t_fitted = resolved ? t_resolved : t;
+  const auto& height_fitted = resolved ? height_resolved : height;
+  if (t_fitted.size() >= 2) std::tie(s.speed, s.speed_fit_error) = robust_slope(t_fitted, height_fitted, 2.0 * bin_height);
   else s.speed = s.speed_fit_error = nan;
-  s.curvature = fitted_curvature(t, location);
+  s.speed_resolution = std::abs(fitted_curvature(t_fitted, height_fitted)) * spacing / o.frequency / std::sqrt(2.0);
+  s.curvature = t.size() >= 4 ? fitted_curvature(t, location) : nan;
   return s;
 }
 
@@ -370,7 +373,7 @@ std::vector<NamedValues> run_values(const RunQuantities& r) {
       {"formation_phase", "1", {life(&ShockLife::formation_phase)}, {spacing}},
       {"exit_phase", "1", {life(&ShockLife::exit_phase)}},
       {"lifetime", "1/f", {life(&ShockLife::lifetime)}, {spacing}},
-      {"shock_speed", "sqrt(g sigma)", {life(&ShockLife::speed)}},
+      {"shock_speed", "sqrt(g sigma)", {life(&ShockLife::speed)}, {life(&ShockLife::speed_resolution)}},
       {"shock_speed_fit_error", "sqrt(g sigma)", {life(&ShockLife::speed_fit_error)}},
       {"shock_curvature", "g", {life(&ShockLife::curvature)}},
       {"shock_phases", "1", {r.shock ? static_cast<double>(r.shock->phases.size()) : 0.0}, {1.0}},

@@ -44,6 +44,13 @@ struct ShockLife {
   double lifetime = 0.0;            ///< exit - formation, in cycles
   double speed = 0.0;               ///< slope of location - plate_z against t, plate frame
   double speed_fit_error = 0.0;     ///< standard error of that slope from the fit residuals
+  /// The speed's rounding step (NaN if fewer than 3 phases): the fit's window starts and ends
+  /// at stored phases, and on a curved path the slope of a line is the speed at the window's
+  /// centre (exactly, for a parabola), so the phase grid rounds the speed as it rounds the
+  /// window: |2 c| s / sqrt(2), c the t^2 coefficient of the fitted heights, s the spacing in
+  /// time (the centre, the mean of two ends each rounded by one spacing, has the variance of a
+  /// value rounded to s / sqrt(2)).
+  double speed_resolution = 0.0;
   double curvature = 0.0;           ///< 2 x the t^2 coefficient of location(t); NaN if < 4 points
   /// Means over the phases of the life with the front clear of the plate (NaN without one).
   double width_mean = 0.0, width_over_mfp_mean = 0.0;

@@ -88,7 +88,8 @@ constexpr double kDenseBelow = 0.1;  ///< nu from which a bin has the layer's no
 /// flight: a uniform cold layer, gap above the plate, with no front in T.
 struct Truth {
   double formation_phase = 0.107;
-  double speed = 6.0;              ///< plate frame, sqrt(g sigma)
+  double speed = 6.0;              ///< plate frame at formation, sqrt(g sigma)
+  double deceleration = 0.0;       ///< of the shock in the plate frame, g (0: a straight path)
   double top_height = 14.0;        ///< layer top (nu = layer threshold) above the plate
   double front_half_width = 1.0;   ///< w of the shock's tanh fronts
   double edge_half_width = 0.5;    ///< w of the layer's top and bottom edges
@@ -100,11 +101,20 @@ struct Truth {
   double fall_speed = 8.0;         ///< of the undisturbed material, relative to the plate
   double flight_gap = 1.5, flight_depth = 12.0;
 
-  double lifetime() const { return top_height / speed * kFrequency; }  ///< in cycles
+  /// In cycles: the time at which the shock's height reaches top_height (which a decelerating
+  /// shock must reach before it stops: speed^2 > 2 deceleration top_height).
+  double lifetime() const {
+    if (deceleration == 0.0) return top_height / speed * kFrequency;
+    const double time = (speed - std::sqrt(speed * speed - 2.0 * deceleration * top_height)) / deceleration;
+    return time * kFrequency;
+  }
   double exit_phase() const { return formation_phase + lifetime(); }
   bool has_shock(double phase) const { return phase >= formation_phase && phase < exit_phase(); }
   /// Shock height above the plate.
-  double shock_height(double phase) const { return speed * (phase - formation_phase) / kFrequency; }
+  double shock_height(double phase) const {
+    const double time = (phase - formation_phase) / kFrequency;
+    return speed * time - 0.5 * deceleration * time * time;
+  }
   double shock_location(double phase) const { return kPlate.position(phase / kFrequency) + shock_height(phase); }
   /// Centre of the nu step at the layer's top, placed so that nu crosses the layer threshold
   /// (find_layer) exactly at top_height.
