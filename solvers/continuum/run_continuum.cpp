@@ -324,7 +324,7 @@ void check_memory_of_run(const ContinuumCase& c, const Halo* halo) {
   const auto [machine, ranks_here] = halo ? halo->sum_on_machine(mine) : std::pair<double, int>{mine, 1};
   const std::string grid = fmt::format(
       "a {}D grid of {:.3g} cells (continuum.cell_size = {}, continuum.ceiling = {}{})", g.dimension,
-      box_cells, g.h, g.height(), g.dimension == 3 ? fmt::format(", continuum.box_width = {}", g.nx * g.h) : "");
+      box_cells, g.h, g.height(), g.dimension == 3 ? fmt::format(", continuum.box_width = {}, continuum.box_depth = {}", g.nx * g.h, g.ny * g.h) : "");
   std::string failure;
   try {
     if (halo)
@@ -385,7 +385,8 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
   const std::string source = restart_source(restart_from);
   const std::string saved = checkpoint_configuration(restart_from);
   config::require_same_keys(config, saved,
-                            {"material.restitution", "material.e", "layer.particles", "md.box_width", "shaker.frequency"},
+                            {"material.restitution", "material.e", "layer.particles", "md.box_width", "md.box_depth",
+                             "shaker.frequency"},
                             source);
   const Halo* halo = solver.op().halo();
   const SchedulePosition position = halo ? read_decomposed_checkpoint(restart_from, *halo, solver)

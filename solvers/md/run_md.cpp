@@ -30,6 +30,7 @@ namespace {
 Geometry geometry_of(const CaseParameters& c, const MdSettings& s) {
   Geometry g;
   g.width = c.md_box_width;
+  g.depth = c.md_box_depth;
   g.height = s.ceiling;
   g.gravity = gravity;
   g.plate = c.shaker;
@@ -71,12 +72,12 @@ State state_from_file(const CaseParameters& c, const MdSettings& s, const Geomet
   if (frame.r.size() != static_cast<std::size_t>(c.particles))
     throw InputError(fmt::format("layer.particles = {} but {} holds {} particles; allowed: layer.particles = {}",
                                  c.particles, which, frame.r.size(), frame.r.size()));
-  const auto same_width = [&](double edge) { return std::fabs(edge - g.width) <= 1e-12 * g.width; };
-  if (!same_width(stored.edges[0]) || !same_width(stored.edges[1]))
-    throw InputError(fmt::format("md.box_width = {} but {} was written in a box of {} x {} "
-                                 "(particles/all/box/edges); allowed: md.box_width = {}, the periodic box "
-                                 "of the file's particles", g.width, which, stored.edges[0], stored.edges[1],
-                                 stored.edges[0]));
+  const auto same = [](double edge, double length) { return std::fabs(edge - length) <= 1e-12 * length; };
+  if (!same(stored.edges[0], g.width) || !same(stored.edges[1], g.depth))
+    throw InputError(fmt::format("md.box_width = {} and md.box_depth = {} but {} was written in a box of {} x {} "
+                                 "(particles/all/box/edges); allowed: md.box_width = {} and md.box_depth = {}, "
+                                 "the periodic box of the file's particles", g.width, g.depth, which, stored.edges[0],
+                                 stored.edges[1], stored.edges[0], stored.edges[1]));
   SimulationData data;
   data.time = frame.time;
   for (std::size_t i = 0; i < frame.r.size(); ++i) data.particles.push_back(Particle{frame.r[i], frame.v[i], frame.time});
@@ -99,7 +100,7 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
     if (s.initial_state == "gas")
       return Simulation(g, rules, homogeneous_gas(g, n, s.gas_volume_fraction, s.gas_temperature, c.run.seed),
                         s.queue);
-    return Simulation(g, rules, flat_layer(g, n, c.run.seed), s.queue);
+    return Simulation(g, rules, flat_layer(g, n, c.run.seed, s.initial_perturbation), s.queue);
   }
   Checkpoint saved = read_checkpoint(restart_from);
   const std::string source = restart_source(restart_from);
@@ -119,7 +120,7 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
   }
   resumed = Resumed{saved.position, std::move(saved.sampled),
                     CaseParameters::from(config::Config::from_toml(saved.configuration, source)).run};
-  if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
+  if (saved.width == g.width && saved.depth == g.depth && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
   State state{saved.data.time, std::move(saved.data.particles), std::move(saved.data.last_collision)};
   return Simulation(g, rules, state, s.queue);
@@ -144,8 +145,8 @@ void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometr
   // fields written out (2 x 9 doubles).
   const double per_particle = sizeof(Particle) + sizeof(Event) + 8.0 + 16.0 + 64.0 + 2.0 * sizeof(Vec3) + 16.0 +
                               4.0 * static_cast<double>(s.crossing_heights.size());
-  const double rows = std::min(std::floor(g.height), g.plate_top() + 8.0 * n / (g.width * g.width) + 3.0);
-  const double cells = std::floor(g.width) * std::floor(g.width) * std::max(rows, 3.0);
+  const double rows = std::min(std::floor(g.height), g.plate_top() + 8.0 * n / (g.width * g.depth) + 3.0);
+  const double cells = std::floor(g.width) * std::floor(g.depth) * std::max(rows, 3.0);
   const double bins = std::ceil(s.ceiling / s.bin_height);
   const double phases = static_cast<double>(c.run.phases_per_cycle);
   // Each particle snapshot: r and v kept until the end, and its lines of the XYZ text.
@@ -426,7 +427,7 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   record.configuration = configuration;
   record.e = final_restitution.e;
   if (!frames.empty())
-    write_particle_files(parameters.run.output, frames, ParticleBox{geometry.width, geometry.height}, record);
+    write_particle_files(parameters.run.output, frames, ParticleBox{geometry.width, geometry.depth, geometry.height}, record);
   write_run_file(parameters.run.output, record);
 
   terminal_log::say(stdout, "shaker md: {} particles, {} cycles, t = {:.6g}, wall time {}\n", parameters.particles,

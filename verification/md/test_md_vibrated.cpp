@@ -129,7 +129,7 @@ constexpr double base_frequency = 0.095;  // the base case's shaker.frequency
 /// A plate of the base case's frequency shaken at peak acceleration gamma g, width x width.
 Geometry shaken_plate(double gamma, double width) {
   Geometry g;
-  g.width = width;
+  g.width = g.depth = width;
   g.plate = ShakerKinematics{gamma, base_frequency};
   return g;
 }
@@ -584,7 +584,7 @@ TEST(MdEnsemble, EveryReplicasTimeSeriesIsThatOfItsSingleRun) {
 
 TEST(MdHydrostatic, ElasticGasUnderGravityIsIsothermalAndHydrostatic) {
   Geometry g;
-  g.width = 10.0;
+  g.width = g.depth = 10.0;
   g.height = 100.0;  // the gas never reaches the ceiling
   g.plate = ShakerKinematics::fixed_plate();
   CollisionRules rules;
