@@ -2,6 +2,7 @@
 // 1D run, restart continues identically, and the base-case smoke test (H = 9, e = 0.9, 1D).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -9,13 +10,16 @@
 #include <fstream>
 #include <iterator>
 #include <utility>
+#include <vector>
 
 #include "analysis/analysis.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
+#include "common/units.hpp"
 #include "common/version.hpp"
 #include "continuum/checkpoint.hpp"
+#include "continuum/initial_state.hpp"
 #include "continuum/output.hpp"
 #include "continuum/run_continuum.hpp"
 #include "continuum/setup.hpp"
@@ -474,6 +478,52 @@ TEST(Output3D, ProfilesFieldsAndXdmf) {
   EXPECT_EQ(grids, 2u);
   EXPECT_NE(text.find("run3d.fields.h5:/snapshot_001/T"), std::string::npos);
   if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
+/// The densities of the cells the initial layer fills completely, in a 3D box 4 x 6 (cell
+/// 0.5) holding the base case's mass per area, at perturbation p and seed `seed`.
+std::vector<double> filled_layer_densities(double p, std::uint64_t seed, double* mass_per_area = nullptr) {
+  const Grid g = make_grid(3, 4.0, 6.0, 20.0, 0.5);
+  LayerSpecification layer;
+  layer.perturbation = p;
+  layer.seed = seed;
+  State state;
+  state.resize(g.size());
+  const double top = flat_layer(g, layer, state);
+  std::vector<double> n;
+  double mass = 0.0;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const double cell = state.q[density][g.index(i, j, k)];
+        mass += cell * g.cell_volume();
+        if ((k + 1) * g.h <= top) n.push_back(cell);
+      }
+  if (mass_per_area) *mass_per_area = mass / (g.nx * g.h * g.ny * g.h);
+  return n;
+}
+
+TEST(InitialPerturbation, HasTheAskedAmplitudeAndIsReproducibleFromTheSeed) {
+  // continuum.perturbation: each cell of the layer drawn at (1 + p u) times the layer's
+  // density, u uniform in [-1, 1], then all scaled to restore the mass per area; the seed is
+  // run.seed. The spread max / min of the filled cells is then at most (1 + p) / (1 - p), and
+  // over 20 rows of 8 x 12 cells it comes within 1 % of that.
+  const double p = 0.05;
+  double mass = 0.0;
+  const std::vector<double> a = filled_layer_densities(p, 3, &mass), again = filled_layer_densities(p, 3);
+  const std::vector<double> other = filled_layer_densities(p, 4), flat = filled_layer_densities(0.0, 3);
+  const auto [lo, hi] = std::minmax_element(a.begin(), a.end());
+  const double spread = *hi / *lo, bound = (1 + p) / (1 - p);
+  std::printf("%zu filled cells: spread %.6f of the bound %.6f; mass per area %.15g\n", a.size(), spread, bound, mass);
+  ASSERT_GT(a.size(), 1000u);
+  EXPECT_LE(spread, bound);
+  EXPECT_GT(spread, 0.99 * bound);
+  EXPECT_NEAR(mass, LayerSpecification{}.mass_per_area, 1e-12 * mass);
+  EXPECT_EQ(a, again);
+  EXPECT_NE(a, other);
+  const auto [flat_lo, flat_hi] = std::minmax_element(flat.begin(), flat.end());
+  EXPECT_EQ(*flat_lo, *flat_hi);  // 0: the flat layer, every filled cell alike
+  EXPECT_EQ(*flat_lo, number_density(LayerSpecification{}.volume_fraction));
 }
 
 }  // namespace
