@@ -18,6 +18,7 @@ CaseParameters CaseParameters::from(const config::Config& c) {
                               c.real("material.e")};
   p.particles = c.integer("layer.particles");
   p.md_box_width = c.real("md.box_width");
+  p.md_box_depth = c.real("md.box_depth") > 0.0 ? c.real("md.box_depth") : p.md_box_width;
   p.run.kind = c.text("run.protocol") == "single_shock" ? RunProtocol::Kind::single_shock
                                                         : RunProtocol::Kind::periodic;
   p.run.transient_cycles = c.integer("run.transient_cycles");

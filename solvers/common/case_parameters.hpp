@@ -30,10 +30,11 @@ struct CaseParameters {
   ShakerKinematics shaker{3.0, 0.095};
   Restitution restitution;
   std::int64_t particles = 3937;
-  double md_box_width = 20.0;  ///< sets the mass per unit area of both solvers
+  double md_box_width = 20.0;  ///< with the depth, sets the mass per unit area of both solvers
+  double md_box_depth = 20.0;  ///< md.box_depth, or md.box_width where that is 0 (a square box)
   RunProtocol run;
 
-  double mass_per_area() const { return static_cast<double>(particles) / (md_box_width * md_box_width); }
+  double mass_per_area() const { return static_cast<double>(particles) / (md_box_width * md_box_depth); }
   static CaseParameters from(const config::Config& config);
 };
 

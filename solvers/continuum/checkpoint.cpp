@@ -142,7 +142,7 @@ namespace {
 /// column of the box takes the checkpoint's column (a horizontally uniform state).
 void load_extruded(hid_t file, const std::filesystem::path& path, const Grid& box, State& state,
                    RunScalars& scalars) {
-  const Grid column = make_grid(1, 1.0, box.height(), box.h);
+  const Grid column = make_grid(1, 1.0, 1.0, box.height(), box.h);
   const auto found = h5::read_integer_attribute(file, "nz");
   if (found != column.nz)
     throw InputError(fmt::format(

@@ -22,16 +22,16 @@ int cells_fitting(double length, double h, const char* key) {
 }
 }  // namespace
 
-Grid make_grid(int dimension, double width, double height, double h, int processes) {
+Grid make_grid(int dimension, double width, double depth, double height, double h, int processes) {
   if (dimension != 1 && dimension != 3)
     throw InputError(fmt::format("continuum.dimension = {}: allowed values are 1 and 3", dimension));
   // A grid that cannot fit even when split evenly over the processes is refused before its
   // cell counts (ints) are formed; the run checks its exact need per machine later.
-  const double cells = (height / h) * (dimension == 3 ? (width / h) * (width / h) : 1.0);
+  const double cells = (height / h) * (dimension == 3 ? (width / h) * (depth / h) : 1.0);
   check_memory(cells * solver_bytes_per_cell / processes,
                fmt::format("a {}D grid of {:.3g} cells (continuum.cell_size = {}, continuum.ceiling "
                            "= {}{}){}", dimension, cells, h, height,
-                           dimension == 3 ? fmt::format(", continuum.box_width = {}", width) : "",
+                           dimension == 3 ? fmt::format(", continuum.box_width = {}, continuum.box_depth = {}", width, depth) : "",
                            processes > 1 ? fmt::format(", split evenly over {} processes,", processes) : ""),
                "allowed: a larger continuum.cell_size or a smaller box");
   Grid g;
@@ -40,7 +40,7 @@ Grid make_grid(int dimension, double width, double height, double h, int process
   g.nz = cells_fitting(height, h, "continuum.ceiling");
   if (dimension == 3) {
     g.nx = cells_fitting(width, h, "continuum.box_width");
-    g.ny = g.nx;
+    g.ny = cells_fitting(depth, h, "continuum.box_depth");
   }
   return g;
 }

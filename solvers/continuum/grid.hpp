@@ -53,9 +53,9 @@ struct Grid {
 /// (run_continuum.cpp), per machine when decomposed.
 inline constexpr double solver_bytes_per_cell = 600.0;
 
-/// A grid of cell size h over [0, width]^2 x [0, height]; throws InputError naming the key
-/// when the cell size does not divide the box, or when the grid split evenly over `processes`
-/// would not fit the available memory.
-Grid make_grid(int dimension, double width, double height, double h, int processes = 1);
+/// A grid of cell size h over [0, width] x [0, depth] x [0, height] (width and depth unused
+/// in 1D); throws InputError naming the key when the cell size does not divide the box, or
+/// when the grid split evenly over `processes` would not fit the available memory.
+Grid make_grid(int dimension, double width, double depth, double height, double h, int processes = 1);
 
 }  // namespace shaker::continuum

@@ -73,7 +73,7 @@ Halo::Halo(const Grid& box, int ranks, HaloTransport transport) : box_(box), loc
   const int fewest_x = box.nx / dims_[0], fewest_y = box.ny / dims_[1];
   if (fewest_x < min_cells_per_rank || fewest_y < min_cells_per_rank)
     throw InputError(fmt::format(
-        "the 3D box of {} x {} cells (continuum.box_width / continuum.cell_size) cannot be split "
+        "the 3D box of {} x {} cells (continuum.box_width and continuum.box_depth / continuum.cell_size) cannot be split "
         "over {} ranks: split as {} x {} ranks (x by y), {} x {} cells or fewer each; allowed: "
         "at least {} cells per rank in x and in y, so at most {} ranks in x and {} in y (fewer "
         "ranks, or a wider box)",

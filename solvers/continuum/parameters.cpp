@@ -8,7 +8,10 @@ std::vector<ParameterSpec> continuum_parameters() {
       integer("continuum.dimension", 1, closed(1, 3), "1: vertical column; 3: periodic x, y").in("-"),
       real("continuum.cell_size", 0.1, positive(10.0), "grid spacing in every direction").in("sigma"),
       real("continuum.box_width", 11.0, Range{1.0, 1e4, true, false},
-           "periodic box edge in x and y (3D)").in("sigma"),
+           "periodic box edge in x (3D)").in("sigma"),
+      real("continuum.box_depth", 0.0, closed(0.0, 1e4),
+           "periodic box edge in y (3D); 0 (the default): equal to continuum.box_width, a square "
+           "box. Otherwise a whole number (at least 4) of continuum.cell_size").in("sigma"),
       real("continuum.ceiling", 80.0, positive(1e5), "height of the ceiling above the plate").in("sigma"),
       real("continuum.initial_volume_fraction", 0.5, Range{0.0, 0.65, true, true},
            "volume fraction of the initial flat layer (below nu_max = 0.65)").in("1"),

@@ -327,7 +327,8 @@ void check_memory_of_run(const ContinuumCase& c, const Halo* halo) {
   const auto [machine, ranks_here] = halo ? halo->sum_on_machine(mine) : std::pair<double, int>{mine, 1};
   const std::string grid = fmt::format(
       "a {}D grid of {:.3g} cells (continuum.cell_size = {}, continuum.ceiling = {}{})", g.dimension,
-      box_cells, g.h, g.height(), g.dimension == 3 ? fmt::format(", continuum.box_width = {}", g.nx * g.h) : "");
+      box_cells, g.h, g.height(),
+      g.dimension == 3 ? fmt::format(", continuum.box_width = {}, continuum.box_depth = {}", g.nx * g.h, g.ny * g.h) : "");
   std::string failure;
   try {
     if (halo)

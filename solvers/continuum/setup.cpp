@@ -35,6 +35,12 @@ std::vector<std::int64_t> field_cycle_indices(const config::Config& config, cons
   return cycle_indices(config, key, c.parameters.run);
 }
 
+/// The 3D box's edge in y: continuum.box_depth, or continuum.box_width where that is 0.
+double box_depth(const config::Config& config) {
+  const double depth = config.real("continuum.box_depth");
+  return depth > 0.0 ? depth : config.real("continuum.box_width");
+}
+
 /// A 3D layer's cells are drawn up to (1 + p) times the layer's density and then all scaled
 /// by the mass correction, at most 1 / (1 - p): both keys together must keep every cell below
 /// the clamp at 0.999 nu_max, where the constitutive functions end.
@@ -56,7 +62,7 @@ ContinuumCase continuum_case(const config::Config& config) {
   ContinuumCase c;
   c.parameters = CaseParameters::from(config);
   c.grid = make_grid(static_cast<int>(config.integer("continuum.dimension")),
-                     config.real("continuum.box_width"), config.real("continuum.ceiling"),
+                     config.real("continuum.box_width"), box_depth(config), config.real("continuum.ceiling"),
                      config.real("continuum.cell_size"), launched_by_mpi() ? Ranks::world().size() : 1);
   PhysicsSettings& p = c.physics;
   p.eos = EquationOfState::granular;

@@ -11,9 +11,11 @@ namespace shaker::md {
 
 void CellList::build(const Geometry& g, std::size_t n) {
   width_ = g.width;
+  depth_ = g.depth;
   height_ = g.height;
   periodic_z_ = g.periodic_z;
-  nx_ = ny_ = static_cast<int>(std::floor(g.width));
+  nx_ = static_cast<int>(std::floor(g.width));
+  ny_ = static_cast<int>(std::floor(g.depth));
   const int rows = std::max(1, static_cast<int>(std::floor(g.height)));
   nz_ = rows;
   if (!periodic_z_ && g.gravity > 0.0) {
@@ -22,16 +24,16 @@ void CellList::build(const Geometry& g, std::size_t n) {
     // height that holds every particle eight times over (plus the plate's stroke) one open row
     // reaches to the ceiling; its edge is still >= sigma, so the 27-cell stencil stays exact
     // (only slower if many particles fly that high).
-    const double column = static_cast<double>(n) / (static_cast<double>(nx_) * nx_);
+    const double column = static_cast<double>(n) / (static_cast<double>(nx_) * ny_);
     const double enough = g.plate_top() + 8.0 * column + 3.0;
     if (enough < rows) nz_ = std::max(3, static_cast<int>(std::ceil(enough)));
   }
-  if (nx_ < 3 || (periodic_z_ && nz_ < 3))
+  if (nx_ < 3 || ny_ < 3 || (periodic_z_ && nz_ < 3))
     throw InputError(fmt::format(
-        "md.box_width = {} (and the periodic height {}) must be at least 3 sigma: the cell "
-        "list needs three cells across the periodic box", g.width, g.height));
+        "md.box_width = {}, md.box_depth = {} (and the periodic height {}) must be at least 3 "
+        "sigma: the cell list needs three cells across the periodic box", g.width, g.depth, g.height));
   ex_ = g.width / nx_;
-  ey_ = g.width / ny_;
+  ey_ = g.depth / ny_;
   ez_ = g.height / rows;  // the open top row (if any) spans [(nz_ - 1) ez_, height]
   head_.assign(static_cast<std::size_t>(nx_) * ny_ * nz_, -1);
   next_.assign(n, -1);

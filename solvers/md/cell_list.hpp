@@ -117,7 +117,7 @@ class CellList {
  private:
   int nx_ = 0, ny_ = 0, nz_ = 0;
   double ex_ = 1.0, ey_ = 1.0, ez_ = 1.0;
-  double width_ = 0.0, height_ = 0.0;
+  double width_ = 0.0, depth_ = 0.0, height_ = 0.0;
   bool periodic_z_ = false;
 };
 
@@ -135,8 +135,8 @@ void CellList::for_each_cell_in_block(int c, int x0, int x1, int y0, int y1, int
     for (int dy = y0; dy <= y1; ++dy) {
       int y = cy + dy;
       double sy = 0.0;
-      if (y < 0) { y += ny_; sy = -width_; }
-      else if (y >= ny_) { y -= ny_; sy = width_; }
+      if (y < 0) { y += ny_; sy = -depth_; }
+      else if (y >= ny_) { y -= ny_; sy = depth_; }
       for (int dx = x0; dx <= x1; ++dx) {
         int x = cx + dx;
         double sx = 0.0;

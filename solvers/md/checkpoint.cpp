@@ -106,6 +106,7 @@ void write_checkpoint(const std::filesystem::path& path, const SimulationData& d
     write_checkpoint_header(f, checkpoint_kind, position, configuration);
     h5::write_attribute(f, "time", d.time);
     h5::write_attribute(f, "box_width", geometry.width);
+    h5::write_attribute(f, "box_depth", geometry.depth);
     h5::write_attribute(f, "box_height", geometry.height);
     const std::size_t n = d.particles.size();
     std::vector<double> table;
@@ -165,7 +166,10 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     d.time = h5::read_double_attribute(f, "time");
     c.width = h5::read_double_attribute(f, "box_width");
     c.height = h5::read_double_attribute(f, "box_height");
-    for (const auto& [name, x] : {std::pair{"time", d.time}, {"box_width", c.width}, {"box_height", c.height}})
+    // Checkpoints of square boxes written before the depth was stored have none.
+    c.depth = h5::has_attribute(f, "box_depth") ? h5::read_double_attribute(f, "box_depth") : c.width;
+    for (const auto& [name, x] :
+         {std::pair{"time", d.time}, {"box_width", c.width}, {"box_depth", c.depth}, {"box_height", c.height}})
       if (!std::isfinite(x))
         throw InputError(fmt::format("attribute '{}' = {}; allowed: a finite number", name, x));
     c.configuration = h5::read_string_attribute(f, "configuration");
@@ -255,7 +259,7 @@ void take_up_samples(PhaseSampler& sampler, const SampledCycles& sampled, const 
   const CycleSamples& mine = sampler.store();
   if (saved.bins() != mine.bins() || saved.bin_volume() != mine.bin_volume())
     throw InputError(fmt::format(
-        "md.bin_height, md.ceiling and md.box_width give {} sampling bins of volume {}, but {} holds "
+        "md.bin_height, md.ceiling, md.box_width and md.box_depth give {} sampling bins of volume {}, but {} holds "
         "profile sums in {} bins of volume {}; allowed: the checkpoint's md.bin_height, md.ceiling "
         "and md.box_width, {}", mine.bins(), mine.bin_volume(), source, saved.bins(), saved.bin_volume(),
         sample_anew));
@@ -283,14 +287,14 @@ void validate_state(const Geometry& g, const SimulationData& d, double tolerance
     state_at(d.particles[i], d.time, g.gravity, r[i], v[i]);
     const double x = r[i].x, y = r[i].y, z = r[i].z;
     const bool inside_xy = x >= -tolerance && x <= g.width + tolerance && y >= -tolerance &&
-                           y <= g.width + tolerance;
+                           y <= g.depth + tolerance;
     const double z_lo = g.periodic_z ? -tolerance : g.plate.position(d.time) + 0.5 - tolerance;
     const double z_hi = g.periodic_z ? g.height + tolerance : g.height - 0.5 + tolerance;
     const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
     if (!finite || !inside_xy || z < z_lo || z > z_hi || !std::isfinite(dot(v[i], v[i])))
       throw InputError(fmt::format(
-          "particle {} at ({}, {}, {}) is outside the box: allowed 0 <= x, y <= {} "
-          "and {} <= z <= {} at t = {}", i, x, y, z, g.width, z_lo + tolerance, z_hi - tolerance,
+          "particle {} at ({}, {}, {}) is outside the box: allowed 0 <= x <= {}, 0 <= y <= {} "
+          "and {} <= z <= {} at t = {}", i, x, y, z, g.width, g.depth, z_lo + tolerance, z_hi - tolerance,
           d.time));
   }
   check_tally_scale(d.tally, system_energy(g, r, v));

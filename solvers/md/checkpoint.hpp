@@ -24,7 +24,7 @@ struct SampledCycles {
 struct Checkpoint {
   SimulationData data;
   std::string configuration;  ///< effective configuration of the run that wrote it
-  double width = 0.0, height = 0.0;  ///< geometry the cell lists belong to
+  double width = 0.0, depth = 0.0, height = 0.0;  ///< geometry the cell lists belong to
   SchedulePosition position;         ///< where in its run's schedule it was written
   SampledCycles sampled;             ///< no sums before the first sampled cycle
 };

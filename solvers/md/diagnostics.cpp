@@ -14,7 +14,7 @@ void Simulation::positions_at(double t, std::vector<Vec3>& r, std::vector<Vec3>&
   for (std::size_t i = 0; i < n; ++i) {
     state_at(data_.particles[i], t, geometry_.gravity, r[i], v[i]);
     r[i].x -= geometry_.width * std::floor(r[i].x / geometry_.width);
-    r[i].y -= geometry_.width * std::floor(r[i].y / geometry_.width);
+    r[i].y -= geometry_.depth * std::floor(r[i].y / geometry_.depth);
     if (geometry_.periodic_z) r[i].z -= geometry_.height * std::floor(r[i].z / geometry_.height);
   }
 }
@@ -54,7 +54,7 @@ std::size_t Simulation::count_overlaps(const std::vector<Vec3>& r, double tolera
       if (j <= self) return;
       Vec3 d = r[i] - r[static_cast<std::size_t>(j)];
       d.x -= geometry_.width * std::round(d.x / geometry_.width);
-      d.y -= geometry_.width * std::round(d.y / geometry_.width);
+      d.y -= geometry_.depth * std::round(d.y / geometry_.depth);
       if (geometry_.periodic_z) d.z -= geometry_.height * std::round(d.z / geometry_.height);
       if (dot(d, d) < limit) ++overlaps;
     });

@@ -6,7 +6,8 @@
 namespace shaker::md {
 
 struct Geometry {
-  double width = 20.0;     ///< periodic box edge in x and y
+  double width = 20.0;     ///< periodic box edge in x
+  double depth = 20.0;     ///< periodic box edge in y
   double height = 200.0;   ///< ceiling (walls) or periodic length (periodic_z)
   bool periodic_z = false; ///< true: no plate and no ceiling, z periodic
   double gravity = 1.0;    ///< acceleration -gravity along z

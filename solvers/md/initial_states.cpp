@@ -61,18 +61,26 @@ void set_temperature(std::vector<Particle>& particles, double T, Random& random)
 
 }  // namespace
 
-State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed) {
+namespace {
+/// A seed for the column lifts that differs from the layer's own seed, so that lifting the
+/// columns leaves the layer's sites and displacements as they are without it.
+constexpr std::uint64_t column_lift_stream = 0x9e3779b97f4a7c15ULL;
+}  // namespace
+
+State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed, double column_lift) {
   constexpr double spacing = 1.05;  // leaves room for the random displacements
-  if (!(geometry.width >= spacing))
-    throw InputError(fmt::format("md.box_width = {} is narrower than one site of the flat layer; "
-                                 "allowed: md.box_width >= {} (and >= 3 for the cell list)",
-                                 geometry.width, spacing));
+  if (!(geometry.width >= spacing && geometry.depth >= spacing))
+    throw InputError(fmt::format("md.box_width = {} or md.box_depth = {} is narrower than one site of the "
+                                 "flat layer; allowed: both >= {} (and >= 3 for the cell list)",
+                                 geometry.width, geometry.depth, spacing));
   const auto per_row = static_cast<std::size_t>(std::floor(geometry.width / spacing));
+  const auto rows = static_cast<std::size_t>(std::floor(geometry.depth / spacing));
   const double pitch = geometry.width / static_cast<double>(per_row);
-  const std::size_t per_layer = per_row * per_row;
+  const double pitch_y = geometry.depth / static_cast<double>(rows);
+  const std::size_t per_layer = per_row * rows;
   const std::size_t layers = (n + per_layer - 1) / per_layer;
   const double bottom = 0.5 + 0.02;
-  const double top = bottom + static_cast<double>(layers - 1) * spacing + 0.02;
+  const double top = bottom + static_cast<double>(layers - 1) * spacing + 0.02 + column_lift;
   if (geometry.periodic_z || top > geometry.height - 0.5)
     throw InputError(fmt::format(
         "layer.particles = {} does not fit: a flat layer of {} per layer reaches z = {:.4g}, above "
@@ -89,17 +97,24 @@ State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed) {
         geometry.height, n, layers, geometry.plate_top(), needed));
   Random random(seed);
   const std::vector<std::size_t> sites = choose_sites(per_layer * layers, n, random);
-  const double jitter = 0.45 * (pitch - 1.0);
+  const double jitter = 0.45 * (std::min(pitch, pitch_y) - 1.0);
+  // Every column of sites rises as one by its own lift in [0, column_lift): horizontal
+  // neighbours stay more than a diameter apart whatever their heights, so no pair overlaps.
+  std::vector<double> lift(per_layer, 0.0);
+  if (column_lift > 0.0) {
+    Random lifts(seed ^ column_lift_stream);
+    for (double& l : lift) l = lifts.uniform(0.0, column_lift);
+  }
   State state;
   state.particles.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t s = sites[k];
     Particle& p = state.particles[k];
-    const double ix = static_cast<double>(s % per_row), iy = static_cast<double>((s / per_row) % per_row);
+    const double ix = static_cast<double>(s % per_row), iy = static_cast<double>((s / per_row) % rows);
     const double iz = static_cast<double>(s / per_layer);
     p.r = {(ix + 0.5) * pitch + random.uniform(-jitter, jitter),
-           (iy + 0.5) * pitch + random.uniform(-jitter, jitter),
-           bottom + iz * spacing + random.uniform(-0.02, 0.02)};
+           (iy + 0.5) * pitch_y + random.uniform(-jitter, jitter),
+           bottom + iz * spacing + random.uniform(-0.02, 0.02) + lift[s % per_layer]};
   }
   return state;
 }
@@ -132,18 +147,20 @@ State homogeneous_gas(const Geometry& geometry, std::size_t n, double nu, double
           "md.gas_volume_fraction = {} is too dense for the lattice start; allowed: at most {:.4f}",
           nu, pi / 6.0));
     const auto per_row = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(geometry.width / a)));
+    const auto rows = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(geometry.depth / a)));
     const double pitch = geometry.width / static_cast<double>(per_row);
-    const std::size_t layers = (n + per_row * per_row - 1) / (per_row * per_row);
+    const double pitch_y = geometry.depth / static_cast<double>(rows);
+    const std::size_t layers = (n + per_row * rows - 1) / (per_row * rows);
     const double bottom = geometry.plate_top() + 0.5 + 0.01;
     const double top = bottom + static_cast<double>(layers - 1) * a;
     if (top > geometry.height - 0.5)
       throw InputError(fmt::format(
           "layer.particles = {} does not fit: a gas at nu = {} above the plate's top reaches "
           "z = {:.4g}, above md.ceiling - 1/2 = {:.4g}", n, nu, top, geometry.height - 0.5));
-    for (std::size_t k = 0; k < per_row * per_row * layers; ++k)
+    for (std::size_t k = 0; k < per_row * rows * layers; ++k)
       sites.push_back({(static_cast<double>(k % per_row) + 0.5) * pitch,
-                       (static_cast<double>((k / per_row) % per_row) + 0.5) * pitch,
-                       bottom + static_cast<double>(k / (per_row * per_row)) * a});
+                       (static_cast<double>((k / per_row) % rows) + 0.5) * pitch_y,
+                       bottom + static_cast<double>(k / (per_row * rows)) * a});
   }
   const std::vector<std::size_t> chosen = choose_sites(sites.size(), n, random);
   for (std::size_t k = 0; k < n; ++k) state.particles[k].r = sites[chosen[k]];
@@ -155,7 +172,7 @@ Geometry periodic_box(std::size_t n, double nu) {
   Geometry g;
   g.periodic_z = true;
   g.gravity = 0.0;
-  g.width = g.height = std::cbrt(static_cast<double>(n) * pi / (6.0 * nu));
+  g.width = g.depth = g.height = std::cbrt(static_cast<double>(n) * pi / (6.0 * nu));
   return g;
 }
 

@@ -25,8 +25,11 @@ class Random {
 };
 
 /// The paper's start: a slightly randomised stack of horizontal layers at rest just above the
-/// plate at its lowest point (t = 0). Throws InputError if n does not fit below the ceiling.
-State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed);
+/// plate at its lowest point (t = 0). With column_lift > 0 each vertical column of sites is
+/// raised by its own uniform random height in [0, column_lift) (md.initial_perturbation, a
+/// seed of patterns); 0 leaves the layer exactly as without it. Throws InputError if n does
+/// not fit below the ceiling.
+State flat_layer(const Geometry& geometry, std::size_t n, std::uint64_t seed, double column_lift = 0.0);
 
 /// A homogeneous gas at volume fraction nu and temperature T, without overlaps, zero total
 /// momentum and exactly temperature T. Periodic geometry: fills the box (nu is then implied by

@@ -6,8 +6,12 @@ namespace shaker::config {
 std::vector<ParameterSpec> md_parameters() {
   return {
       real("md.box_width", 20.0, Range{1.0, 1e4, true, false},
-           "periodic box edge in x and y (units sigma); must exceed one diameter").in("sigma")
+           "periodic box edge in x (units sigma); must exceed one diameter").in("sigma")
           .kept_on_restart(restart_continuum),  // the continuum's mass per area; the MD may change its box
+      real("md.box_depth", 0.0, closed(0.0, 1e4),
+           "periodic box edge in y; 0 (the default): equal to md.box_width, a square box. "
+           "Otherwise at least 3 (three cells of the cell list across the box)").in("sigma")
+          .kept_on_restart(restart_continuum),
       real("md.ceiling", 200.0, positive(1e6),
            "height of the fixed ceiling in the lab frame; must lie above the plate's top 2A + 1").in("sigma"),
       real("md.bin_height", 1.0, at_least(1e-3, 10.0),
@@ -25,6 +29,10 @@ std::vector<ParameterSpec> md_parameters() {
       integer("md.initial_frame", -1, closed(-1e9, 1e9),
               "md.initial_state = \"file\": the frame of md.initial_file to start from, counted "
               "from 0; negative counts from the end (-1, the default, is the last)").in("1"),
+      real("md.initial_perturbation", 0.0, closed(0.0, 10.0),
+           "flat_layer: each vertical column of the layer's sites is raised by its own uniform "
+           "random height in [0, this) drawn from run.seed, a seed of horizontal patterns; 0 (the "
+           "default): the flat layer without it").in("sigma"),
       real("md.gas_volume_fraction", 0.1, Range{0.0, 0.55, true, false},
            "gas initial state: volume fraction").in("1"),
       real("md.gas_temperature", 1.0, positive(1e6), "gas initial state: temperature").in("g sigma"),

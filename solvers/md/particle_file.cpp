@@ -85,7 +85,7 @@ void write_h5md(hid_t root, const std::vector<ParticleFrame>& frames, const Part
     const h5::Handle box_group = h5::create_group(all.id(), "box");
     h5::write_attribute(box_group.id(), "dimension", std::int64_t{3});
     h5::write_attribute(box_group.id(), "boundary", std::vector<std::string>{"periodic", "periodic", "none"});
-    h5::write(box_group.id(), "edges", std::vector<double>{box.width, box.width, box.ceiling}, {3}, length_units);
+    h5::write(box_group.id(), "edges", std::vector<double>{box.width, box.depth, box.ceiling}, {3}, length_units);
     write_element(all.id(), "position", frames, flattened(frames, &ParticleFrame::r), {n, 3}, length_units);
     write_element(all.id(), "velocity", frames, flattened(frames, &ParticleFrame::v), {n, 3}, velocity_units);
   }
@@ -107,7 +107,7 @@ std::string xyz_text(const std::vector<ParticleFrame>& frames, const ParticleBox
     text += fmt::format("{}\nLattice=\"{} 0 0 0 {} 0 0 0 {}\" Properties=species:S:1:pos:R:3:vel:R:3 "
                         "pbc=\"T T F\" Time={} step={} cycle={} phase={} plate_z={} plate_v={} "
                         "units=\"length {}, time {}, velocity {}\"\n",
-                        f.r.size(), box.width, box.width, box.ceiling, f.time, f.step, f.cycle, f.phase,
+                        f.r.size(), box.width, box.depth, box.ceiling, f.time, f.step, f.cycle, f.phase,
                         f.plate_z, f.plate_v, length_units, time_units, velocity_units);
     for (std::size_t i = 0; i < f.r.size(); ++i)
       text += fmt::format("X {} {} {} {} {} {}\n", f.r[i].x, f.r[i].y, f.r[i].z, f.v[i].x, f.v[i].y, f.v[i].z);

@@ -20,12 +20,12 @@ struct ParticleFrame {
   double time = 0.0;
   double phase = 0.0;      ///< k / K
   double plate_z = 0.0, plate_v = 0.0;
-  std::vector<Vec3> r, v;  ///< x and y wrapped into [0, box width)
+  std::vector<Vec3> r, v;  ///< x and y wrapped into [0, width) and [0, depth)
 };
 
-/// The box the frames were taken in: periodic width in x and y, the ceiling above.
+/// The box the frames were taken in: periodic width in x and depth in y, the ceiling above.
 struct ParticleBox {
-  double width = 0.0, ceiling = 0.0;
+  double width = 0.0, depth = 0.0, ceiling = 0.0;
 };
 
 /// Root attribute `kind` of the H5MD particle file (a reader of run files refuses it by this).

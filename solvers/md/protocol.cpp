@@ -23,6 +23,7 @@ MdSettings MdSettings::from(const config::Config& c) {
   s.initial_state = c.text("md.initial_state");
   s.gas_volume_fraction = c.real("md.gas_volume_fraction");
   s.gas_temperature = c.real("md.gas_temperature");
+  s.initial_perturbation = c.real("md.initial_perturbation");
   s.tc_guard = c.text("md.collapse_guard") == "tc";
   s.tc = c.real("md.tc");
   s.queue = c.text("md.event_queue") == "calendar" ? QueueKind::calendar : QueueKind::heap;
@@ -170,7 +171,7 @@ RunOutcome run_protocol(Simulation& sim, const CaseParameters& parameters, const
 
 PhaseSampler make_sampler(const Simulation& sim, const PhaseSchedule& schedule, const MdSettings& settings) {
   return PhaseSampler(static_cast<int>(schedule.phases()), settings.bin_height, settings.ceiling,
-                      sim.geometry().width);
+                      sim.geometry().width * sim.geometry().depth);
 }
 
 RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, const CaseParameters& parameters,

@@ -22,6 +22,7 @@ struct MdSettings {
   double bin_height = 1.0;
   std::string initial_state = "flat_layer";
   double gas_volume_fraction = 0.1, gas_temperature = 1.0;
+  double initial_perturbation = 0.0;  ///< flat layer: largest random lift of a column of sites
   bool tc_guard = false;
   double tc = 1e-5;
   QueueKind queue = QueueKind::calendar;

@@ -59,12 +59,12 @@ State state_from_file(const CaseParameters& c, const MdSettings& s, const Geomet
   if (frame.r.size() != static_cast<std::size_t>(c.particles))
     throw InputError(fmt::format("layer.particles = {} but {} holds {} particles; allowed: layer.particles = {}",
                                  c.particles, which, frame.r.size(), frame.r.size()));
-  const auto same_width = [&](double edge) { return std::fabs(edge - g.width) <= 1e-12 * g.width; };
-  if (!same_width(stored.edges[0]) || !same_width(stored.edges[1]))
-    throw InputError(fmt::format("md.box_width = {} but {} was written in a box of {} x {} "
-                                 "(particles/all/box/edges); allowed: md.box_width = {}, the periodic box "
-                                 "of the file's particles", g.width, which, stored.edges[0], stored.edges[1],
-                                 stored.edges[0]));
+  const auto same = [](double edge, double length) { return std::fabs(edge - length) <= 1e-12 * length; };
+  if (!same(stored.edges[0], g.width) || !same(stored.edges[1], g.depth))
+    throw InputError(fmt::format("md.box_width = {} and md.box_depth = {} but {} was written in a box of {} x {} "
+                                 "(particles/all/box/edges); allowed: md.box_width = {} and md.box_depth = {}, "
+                                 "the periodic box of the file's particles", g.width, g.depth, which, stored.edges[0],
+                                 stored.edges[1], stored.edges[0], stored.edges[1]));
   SimulationData data;
   data.time = frame.time;
   for (std::size_t i = 0; i < frame.r.size(); ++i) data.particles.push_back(Particle{frame.r[i], frame.v[i], frame.time});
@@ -87,7 +87,7 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
     if (s.initial_state == "gas")
       return Simulation(g, rules, homogeneous_gas(g, n, s.gas_volume_fraction, s.gas_temperature, c.run.seed),
                         s.queue);
-    return Simulation(g, rules, flat_layer(g, n, c.run.seed), s.queue);
+    return Simulation(g, rules, flat_layer(g, n, c.run.seed, s.initial_perturbation), s.queue);
   }
   Checkpoint saved = read_checkpoint(restart_from);
   const std::string source = restart_source(restart_from);
@@ -106,7 +106,8 @@ Simulation make_simulation(const config::Config& config, const CaseParameters& c
   }
   resumed = Resumed{saved.position, std::move(saved.sampled),
                     CaseParameters::from(config::Config::from_toml(saved.configuration, source)).run};
-  if (saved.width == g.width && saved.height == g.height) return Simulation(g, rules, std::move(saved.data), s.queue);
+  if (saved.width == g.width && saved.depth == g.depth && saved.height == g.height)
+    return Simulation(g, rules, std::move(saved.data), s.queue);
   // Another box: keep the particles, rebuild cells and events (not a bit-for-bit restart).
   State state{saved.data.time, std::move(saved.data.particles), std::move(saved.data.last_collision)};
   return Simulation(g, rules, state, s.queue);
@@ -378,7 +379,7 @@ int run(const config::Config& config, const std::vector<NamedPath>& inputs,
   const ReplicaSummary all = combined(summaries);
   const RunRecord record = pooled_record(c, mine.first, summaries);
   if (!mine.frames.empty())
-    write_particle_files(c.parameters.run.output, mine.frames, ParticleBox{c.geometry.width, c.geometry.height},
+    write_particle_files(c.parameters.run.output, mine.frames, ParticleBox{c.geometry.width, c.geometry.depth, c.geometry.height},
                          record);
   write_run_file(c.parameters.run.output, record);
   return report_run(c, all, mine.frames.size(), wall.seconds());

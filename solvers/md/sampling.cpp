@@ -5,11 +5,11 @@
 
 namespace shaker::md {
 
-PhaseSampler::PhaseSampler(int phases, double bin_height, double top, double box_width)
+PhaseSampler::PhaseSampler(int phases, double bin_height, double top, double box_area)
     : phases_(phases),
       bins_(static_cast<std::size_t>(std::ceil(top / bin_height))),
       bin_height_(bin_height),
-      samples_(static_cast<std::size_t>(phases), bins_, box_width * box_width * bin_height),
+      samples_(static_cast<std::size_t>(phases), bins_, box_area * bin_height),
       first_time_(static_cast<std::size_t>(phases), 0.0),
       cycles_(static_cast<std::size_t>(phases), 0),
       scratch_(bins_) {}

@@ -18,7 +18,7 @@ namespace shaker::md {
 class PhaseSampler {
  public:
   /// Bins of bin_height from z = 0 (the plate's lowest point) up to `top`, lab frame.
-  PhaseSampler(int phases, double bin_height, double top, double box_width);
+  PhaseSampler(int phases, double bin_height, double top, double box_area);
 
   /// Adds one snapshot of phase index k (0 <= k < phases) taken at time t.
   void add(int k, double t, const std::vector<Vec3>& r, const std::vector<Vec3>& v);

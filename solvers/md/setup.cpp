@@ -16,6 +16,7 @@ namespace {
 Geometry geometry_of(const CaseParameters& c, const MdSettings& s) {
   Geometry g;
   g.width = c.md_box_width;
+  g.depth = c.md_box_depth;
   g.height = s.ceiling;
   g.gravity = gravity;
   g.plate = c.shaker;
@@ -37,8 +38,8 @@ void check_md_memory(const CaseParameters& c, const MdSettings& s, const Geometr
   // fields written out (2 x 9 doubles).
   const double per_particle = sizeof(Particle) + sizeof(Event) + 8.0 + 16.0 + 64.0 + 2.0 * sizeof(Vec3) + 16.0 +
                               4.0 * static_cast<double>(s.crossing_heights.size());
-  const double rows = std::min(std::floor(g.height), g.plate_top() + 8.0 * n / (g.width * g.width) + 3.0);
-  const double cells = std::floor(g.width) * std::floor(g.width) * std::max(rows, 3.0);
+  const double rows = std::min(std::floor(g.height), g.plate_top() + 8.0 * n / (g.width * g.depth) + 3.0);
+  const double cells = std::floor(g.width) * std::floor(g.depth) * std::max(rows, 3.0);
   const double bins = std::ceil(s.ceiling / s.bin_height);
   const double phases = static_cast<double>(c.run.phases_per_cycle);
   // Each particle snapshot: r and v kept until the end, and its lines of the XYZ text.

@@ -145,7 +145,7 @@ bool Simulation::pair_event(std::int32_t i, const Event& event, double before_i)
   update(j, now);
   Vec3 r = p.r - q.r;  // minimum image: at contact |r| = 1 < width / 2
   r.x -= geometry_.width * std::round(r.x / geometry_.width);
-  r.y -= geometry_.width * std::round(r.y / geometry_.width);
+  r.y -= geometry_.depth * std::round(r.y / geometry_.depth);
   if (geometry_.periodic_z) r.z -= geometry_.height * std::round(r.z / geometry_.height);
   const bool tc = rules_.tc_guard;
   const PairCollision c = collide_pair(p, q, r, now, tc ? last_collision(i, before_i, rules_.tc) : no_collision_yet,
@@ -276,7 +276,7 @@ void Simulation::cross_cell(std::int32_t i, std::int32_t direction) {
   };
   switch (direction / 2) {
     case 0: move(x, cells_.nx(), p.r.x, geometry_.width); break;
-    case 1: move(y, cells_.ny(), p.r.y, geometry_.width); break;
+    case 1: move(y, cells_.ny(), p.r.y, geometry_.depth); break;
     default: move(z, cells_.nz(), p.r.z, geometry_.height); break;
   }
   cells_.remove(i);

@@ -135,7 +135,7 @@ const continuum::State& periodic_column(double h) {
 /// Sets every column of `solver`'s box (or block) to the 1D `column` state of the same cell size.
 void every_column_from(const continuum::State& column, continuum::TimeIntegrator& solver) {
   const continuum::Grid& g = solver.op().grid();
-  const continuum::Grid column_grid = continuum::make_grid(1, 1.0, g.height(), g.h);
+  const continuum::Grid column_grid = continuum::make_grid(1, 1.0, 1.0, g.height(), g.h);
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
       for (int i = 0; i < g.nx; ++i)

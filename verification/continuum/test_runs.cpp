@@ -2,6 +2,7 @@
 // 1D run, restart continues identically, and the base-case smoke test (H = 9, e = 0.9, 1D).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -9,13 +10,16 @@
 #include <fstream>
 #include <iterator>
 #include <utility>
+#include <vector>
 
 #include "analysis/analysis.hpp"
 #include "common/errors.hpp"
 #include "common/hdf5_file.hpp"
 #include "common/run_file.hpp"
+#include "common/units.hpp"
 #include "common/version.hpp"
 #include "continuum/checkpoint.hpp"
+#include "continuum/initial_state.hpp"
 #include "continuum/output.hpp"
 #include "continuum/run_continuum.hpp"
 #include "continuum/setup.hpp"
@@ -58,11 +62,12 @@ TEST(MassConservation, ThreeDimensionalToRoundOff) {
   EXPECT_LT(relative_mass_drift(c, 0.3), 1e-13);
 }
 
-/// One horizontally uniform case as a column (cell 0.5, ceiling 20) and as a 2 x 2 box of it,
-/// both at the same fixed step; `c` ends as the box's configuration. Explicit diffusion (the
-/// paper transport's), whose box is the column to the bit: the implicit diffusion's solver
-/// sums in another order on another grid and agrees to 1e-12 (docs/parallel.md).
-std::pair<ContinuumCase, ContinuumCase> column_and_box(config::Config& c) {
+/// One horizontally uniform case as a column (cell 0.5, ceiling 20) and as a box of it
+/// (2 x 2, or 2 x `depth`), both at the same fixed step; `c` ends as the box's configuration.
+/// Explicit diffusion (the paper transport's), whose box is the column to the bit: the
+/// implicit diffusion's solver sums in another order on another grid and agrees to 1e-12
+/// (docs/parallel.md).
+std::pair<ContinuumCase, ContinuumCase> column_and_box(config::Config& c, const std::string& depth = "0") {
   c.set("continuum.transport=paper");
   c.set("continuum.cell_size=0.5");
   c.set("continuum.ceiling=20");
@@ -70,32 +75,53 @@ std::pair<ContinuumCase, ContinuumCase> column_and_box(config::Config& c) {
   ContinuumCase one = continuum_case(c);
   c.set("continuum.dimension=3");
   c.set("continuum.box_width=2");
+  c.set("continuum.box_depth=" + depth);
   ContinuumCase three = continuum_case(c);
   one.integration.fixed_dt = three.integration.fixed_dt = 2e-4;
   return {one, three};
 }
 
-TEST(Uniform3D, MatchesOneDimensionalRunToRoundOff) {
-  config::Config c = base_config(test_directory());
-  const auto [one, three] = column_and_box(c);
+/// Runs the column and the box a tenth of a cycle; the largest relative difference of any box
+/// cell from the column, and the largest |n u_x| and |n u_y| in the box.
+std::pair<double, double> box_against_column(const ContinuumCase& one, const ContinuumCase& three) {
   TimeIntegrator a = make_solver(one), b = make_solver(three);
   const double t_end = 0.1 * one.parameters.shaker.period();
   a.advance_to(t_end);
   b.advance_to(t_end);
-  double worst = 0.0;
+  double worst = 0.0, horizontal = 0.0;
   for (int k = 0; k < one.grid.nz; ++k)
     for (int j = 0; j < three.grid.ny; ++j)
-      for (int i = 0; i < three.grid.nx; ++i)
+      for (int i = 0; i < three.grid.nx; ++i) {
         for (int v : {density, momentum_z, energy}) {
           const double x = a.state().q[v][one.grid.index(0, 0, k)];
           const double y = b.state().q[v][three.grid.index(i, j, k)];
           worst = std::max(worst, std::abs(x - y) / std::max(1e-300, std::abs(x)));
         }
-  double horizontal = 0.0;
-  for (int k = 0; k < three.grid.nz; ++k)
-    horizontal = std::max(horizontal, std::abs(b.state().q[momentum_x][three.grid.index(1, 1, k)]));
-  std::printf("largest relative difference 3D - 1D: %.3e; largest |n u_x| %.3e (%lld steps)\n",
-              worst, horizontal, static_cast<long long>(a.counters().steps));
+        for (int v : {momentum_x, momentum_y})
+          horizontal = std::max(horizontal, std::abs(b.state().q[v][three.grid.index(i, j, k)]));
+      }
+  std::printf("%d x %d box: largest relative difference 3D - 1D: %.3e; largest horizontal momentum %.3e "
+              "(%lld steps)\n", three.grid.nx, three.grid.ny, worst, horizontal,
+              static_cast<long long>(a.counters().steps));
+  return {worst, horizontal};
+}
+
+TEST(Uniform3D, MatchesOneDimensionalRunToRoundOff) {
+  config::Config c = base_config(test_directory());
+  const auto [one, three] = column_and_box(c);
+  const auto [worst, horizontal] = box_against_column(one, three);
+  EXPECT_EQ(worst, 0.0);
+  EXPECT_EQ(horizontal, 0.0);
+}
+
+TEST(Uniform3D, RectangularBoxMatchesOneDimensionalRunToRoundOff) {
+  // The box 2 wide and 3.5 deep (4 x 7 cells): a horizontally uniform state stays the
+  // column's, cell by cell, whatever the box's shape.
+  config::Config c = base_config(test_directory());
+  const auto [one, three] = column_and_box(c, "3.5");
+  ASSERT_EQ(three.grid.nx, 4);
+  ASSERT_EQ(three.grid.ny, 7);
+  const auto [worst, horizontal] = box_against_column(one, three);
   EXPECT_EQ(worst, 0.0);
   EXPECT_EQ(horizontal, 0.0);
 }
@@ -452,6 +478,52 @@ TEST(Output3D, ProfilesFieldsAndXdmf) {
   EXPECT_EQ(grids, 2u);
   EXPECT_NE(text.find("run3d.fields.h5:/snapshot_001/T"), std::string::npos);
   if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
+/// The densities of the cells the initial layer fills completely, in a 3D box 4 x 6 (cell
+/// 0.5) holding the base case's mass per area, at perturbation p and seed `seed`.
+std::vector<double> filled_layer_densities(double p, std::uint64_t seed, double* mass_per_area = nullptr) {
+  const Grid g = make_grid(3, 4.0, 6.0, 20.0, 0.5);
+  LayerSpecification layer;
+  layer.perturbation = p;
+  layer.seed = seed;
+  State state;
+  state.resize(g.size());
+  const double top = flat_layer(g, layer, state);
+  std::vector<double> n;
+  double mass = 0.0;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const double cell = state.q[density][g.index(i, j, k)];
+        mass += cell * g.cell_volume();
+        if ((k + 1) * g.h <= top) n.push_back(cell);
+      }
+  if (mass_per_area) *mass_per_area = mass / (g.nx * g.h * g.ny * g.h);
+  return n;
+}
+
+TEST(InitialPerturbation, HasTheAskedAmplitudeAndIsReproducibleFromTheSeed) {
+  // continuum.perturbation: each cell of the layer drawn at (1 + p u) times the layer's
+  // density, u uniform in [-1, 1], then all scaled to restore the mass per area; the seed is
+  // run.seed. The spread max / min of the filled cells is then at most (1 + p) / (1 - p), and
+  // over 20 rows of 8 x 12 cells it comes within 1 % of that.
+  const double p = 0.05;
+  double mass = 0.0;
+  const std::vector<double> a = filled_layer_densities(p, 3, &mass), again = filled_layer_densities(p, 3);
+  const std::vector<double> other = filled_layer_densities(p, 4), flat = filled_layer_densities(0.0, 3);
+  const auto [lo, hi] = std::minmax_element(a.begin(), a.end());
+  const double spread = *hi / *lo, bound = (1 + p) / (1 - p);
+  std::printf("%zu filled cells: spread %.6f of the bound %.6f; mass per area %.15g\n", a.size(), spread, bound, mass);
+  ASSERT_GT(a.size(), 1000u);
+  EXPECT_LE(spread, bound);
+  EXPECT_GT(spread, 0.99 * bound);
+  EXPECT_NEAR(mass, LayerSpecification{}.mass_per_area, 1e-12 * mass);
+  EXPECT_EQ(a, again);
+  EXPECT_NE(a, other);
+  const auto [flat_lo, flat_hi] = std::minmax_element(flat.begin(), flat.end());
+  EXPECT_EQ(*flat_lo, *flat_hi);  // 0: the flat layer, every filled cell alike
+  EXPECT_EQ(*flat_lo, number_density(LayerSpecification{}.volume_fraction));
 }
 
 }  // namespace

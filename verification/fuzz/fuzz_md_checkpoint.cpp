@@ -32,6 +32,7 @@ struct SmallCase {
   shaker::md::CollisionRules rules;
   SmallCase() {
     geometry.width = parameters.md_box_width;
+    geometry.depth = parameters.md_box_depth;
     geometry.height = settings.ceiling;
     geometry.gravity = shaker::gravity;
     geometry.plate = parameters.shaker;

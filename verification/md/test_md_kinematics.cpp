@@ -14,7 +14,7 @@ Geometry open_box(double width) {
   Geometry g;
   g.periodic_z = true;
   g.gravity = 0.0;
-  g.width = g.height = width;
+  g.width = g.depth = g.height = width;
   return g;
 }
 
@@ -115,7 +115,7 @@ TEST(MdKinematics, NoMissedCollisionsAgainstAllPairsReference) {
 
 Geometry plate_box(double amplitude, double omega) {
   Geometry g;
-  g.width = 5.0;
+  g.width = g.depth = 5.0;
   g.height = 400.0;
   g.gravity = 1.0;
   g.plate = ShakerKinematics::of_amplitude(amplitude, omega);

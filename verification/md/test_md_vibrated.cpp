@@ -129,7 +129,7 @@ constexpr double base_frequency = 0.095;  // the base case's shaker.frequency
 /// A plate of the base case's frequency shaken at peak acceleration gamma g, width x width.
 Geometry shaken_plate(double gamma, double width) {
   Geometry g;
-  g.width = width;
+  g.width = g.depth = width;
   g.plate = ShakerKinematics{gamma, base_frequency};
   return g;
 }
@@ -582,9 +582,76 @@ TEST(MdEnsemble, EveryReplicasTimeSeriesIsThatOfItsSingleRun) {
   }
 }
 
+TEST(MdRectangularBox, ElasticGasConservesEnergyAndStaysInsideTheBox) {
+  // A box 6 wide and 14 deep: the y extent is its own in the cell list, the minimum image and
+  // the wrapping. Elastic gas above a fixed plate: kinetic plus potential energy is conserved,
+  // and every particle stays in [0, 6) x [0, 14), reaching beyond y = 6.
+  Geometry g;
+  g.width = 6.0;
+  g.depth = 14.0;
+  g.height = 60.0;
+  g.plate = ShakerKinematics::fixed_plate();
+  const std::size_t n = 400;
+  Simulation sim(g, constant_restitution(1.0), homogeneous_gas(g, n, 0.2, 3.0, 5));
+  const double e0 = sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time());
+  std::vector<Vec3> r, v;
+  bool inside = true;
+  std::size_t beyond_width = 0;
+  for (int s = 1; s <= 50; ++s) {
+    sim.advance_to(1.0 * s);
+    sim.positions_at(sim.time(), r, v);
+    for (const Vec3& x : r) {
+      inside = inside && x.x >= 0.0 && x.x < g.width && x.y >= 0.0 && x.y < g.depth && x.z >= 0.5 && x.z <= 59.5;
+      beyond_width += x.y > g.width ? 1 : 0;
+    }
+  }
+  const double drift = std::fabs(sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time()) - e0) / e0;
+  std::printf("measured: relative energy drift %.3g after %llu pair collisions; %zu positions beyond y = 6\n",
+              drift, static_cast<unsigned long long>(sim.tally().pair), beyond_width);
+  EXPECT_GT(sim.tally().pair, 10000u);
+  EXPECT_LT(drift, 1e-10);
+  EXPECT_TRUE(inside);
+  EXPECT_GT(beyond_width, 50u * n / 4);  // more than half the box's area lies beyond y = 6
+  EXPECT_EQ(sim.count_overlaps(sim.time(), 1e-9), 0u);
+  EXPECT_TRUE(sim.queue_consistent());
+}
+
+TEST(MdInitialPerturbation, LiftsEachColumnByASeededHeightBelowTheAmplitude) {
+  Geometry g;
+  g.width = 8.0;
+  g.depth = 12.0;
+  g.plate = ShakerKinematics{3.0, base_frequency};
+  const std::size_t n = 500;
+  const State flat = flat_layer(g, n, 7), lifted = flat_layer(g, n, 7, 0.5);
+  const State again = flat_layer(g, n, 7, 0.5), other = flat_layer(g, n, 8, 0.5);
+  double largest = 0.0, smallest = 1.0;
+  bool same_xy = true, reproducible = true, differs = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 a = flat.particles[i].r, b = lifted.particles[i].r;
+    same_xy = same_xy && a.x == b.x && a.y == b.y;
+    largest = std::max(largest, b.z - a.z);
+    smallest = std::min(smallest, b.z - a.z);
+    reproducible = reproducible && b.z == again.particles[i].r.z;
+    differs = differs || b.z != other.particles[i].r.z;
+  }
+  std::printf("measured: lifts from %.4f to %.4f (amplitude 0.5)\n", smallest, largest);
+  EXPECT_TRUE(same_xy);   // the lift moves the layer's sites only up
+  EXPECT_GE(smallest, 0.0);
+  EXPECT_LT(largest, 0.5);
+  EXPECT_GT(largest, 0.45);  // 80 columns: the largest of 80 uniform lifts is this close to 0.5
+  EXPECT_TRUE(reproducible);
+  EXPECT_TRUE(differs);
+  Simulation sim(g, constant_restitution(0.9), lifted);
+  EXPECT_EQ(sim.count_overlaps(sim.time(), 1e-9), 0u);
+  const State unlifted = flat_layer(g, n, 7, 0.0);
+  bool identical = true;
+  for (std::size_t i = 0; i < n; ++i) identical = identical && unlifted.particles[i].r.z == flat.particles[i].r.z;
+  EXPECT_TRUE(identical);  // amplitude 0 is the flat layer bit for bit
+}
+
 TEST(MdHydrostatic, ElasticGasUnderGravityIsIsothermalAndHydrostatic) {
   Geometry g;
-  g.width = 10.0;
+  g.width = g.depth = 10.0;
   g.height = 100.0;  // the gas never reaches the ceiling
   g.plate = ShakerKinematics::fixed_plate();
   CollisionRules rules;

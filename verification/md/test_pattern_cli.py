@@ -140,3 +140,48 @@ def test_a_cell_wider_than_half_the_box_is_refused(shaker, work_dir):
     assert "--pattern-cell = 11 gives 1 x 1 cells" in refused.stderr
     assert "allowed: at most half the box width" in refused.stderr
     assert not Path(work_dir, "coarse.csv").exists()
+
+
+def stripes_in_a_rectangular_box(shaker, directory, width, depth, along):
+    """A short MD run in a width x depth box, whose particle file then gets synthetic frames
+    of its 288 particles: heights 5 + 2 cos(2 pi s / 8), s = x or y (`along`), a stripe
+    pattern of wavelength 8. Returns the CSV rows and the file's box edges."""
+    case = CASE.replace(f"box_width = {WIDTH}", f"box_width = {width}\nbox_depth = {depth}")
+    case = case.replace(f"particles = {PARTICLES}", "particles = 288")
+    Path(directory, "case.toml").write_text(case)
+    subprocess.run([shaker, "md", "case.toml", "--quiet"], cwd=directory, check=True,
+                   capture_output=True)
+    # Along the stripes' wavevector the particles sit on a regular grid, 12 to the wavelength;
+    # across it at random (uneven counts, so the column mass is not uniform). The height
+    # is the cosine at the centre of the particle's cell, so the height field is one mode.
+    rng = np.random.default_rng(0)
+    length, across = (width, depth) if along == "x" else (depth, width)
+    s = np.repeat((np.arange(36) + 0.5) * length / 36, 8)
+    t = rng.uniform(0, across, s.size)
+    centre = (np.floor(s / CELL) + 0.5) * CELL
+    z = 5 + 2 * np.cos(2 * np.pi * centre / 8)
+    x, y = (s, t) if along == "x" else (t, s)
+    synthetic = np.stack([x, y, z], 1)
+    with h5py.File(Path(directory, "run.particles.h5"), "r+") as f:
+        position = f["particles/all/position/value"]
+        position[...] = np.broadcast_to(synthetic, position.shape)
+        edges = f["particles/all/box/edges"][()]
+    subprocess.run([shaker, "analyze", "run.h5", "--patterns", "patterns.csv",
+                    "--pattern-cell", str(CELL)], cwd=directory, check=True, capture_output=True)
+    with open(Path(directory, "patterns.csv"), newline="") as f:
+        return list(csv.DictReader(f)), edges
+
+
+@pytest.mark.parametrize("width, depth, along", [(24.0, 8.0, "x"), (8.0, 24.0, "y")])
+def test_stripes_in_a_rectangular_box(shaker, work_dir, width, depth, along):
+    """The particle file holds the box's real x and y lengths, and the analysis bins and
+    transforms on them: stripes of wavelength 8 across the long side of a 24 x 8 (or 8 x 24)
+    box, three to the box, come out at wavelength 8 with the stripes' symmetry. Taking one
+    length for both sides would put them at 8/3 or 24."""
+    rows, edges = stripes_in_a_rectangular_box(shaker, work_dir, width, depth, along)
+    assert list(edges[:2]) == [width, depth]
+    assert len(rows) == 6
+    for row in rows:
+        assert float(row["height_wavelength [sigma]"]) == pytest.approx(8.0, rel=1e-9)
+        assert float(row["height_a2 [1]"]) == pytest.approx(1.0, rel=1e-9)
+        assert row["height_symmetry"] == "stripes"

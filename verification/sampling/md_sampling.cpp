@@ -205,6 +205,7 @@ namespace {
 md::Simulation make_simulation(const CaseParameters& c, const md::MdSettings& s) {
   md::Geometry g;
   g.width = c.md_box_width;
+  g.depth = c.md_box_depth;
   g.height = s.ceiling;
   g.gravity = gravity;
   g.plate = c.shaker;
@@ -269,7 +270,7 @@ class StudySampling final : public RunObserver {
  private:
   std::unique_ptr<md::PhaseSampler> sampler(double bin) const {
     return std::make_unique<md::PhaseSampler>(static_cast<int>(c_.run.phases_per_cycle), bin, top_,
-                                              c_.md_box_width);
+                                              c_.md_box_width * c_.md_box_depth);
   }
 
   void record_quantities() {

@@ -53,9 +53,20 @@ def lookup(config, dotted):
 
 
 STUDIES = load_studies(os.path.join(VALIDATION, "studies.toml"))
-FILES = {os.path.splitext(os.path.basename(p))[0]
-         for p in glob.glob(os.path.join(VALIDATION, "cases", "*.toml"))}
+ALL_FILES = {os.path.splitext(os.path.basename(p))[0]
+             for p in glob.glob(os.path.join(VALIDATION, "cases", "*.toml"))}
+# The onset study's cases (docs/patterns.md) are run by its Gamma sweep, not by the
+# validation runner, so studies.toml does not list them.
+PATTERN_FILES = {name for name in ALL_FILES if name.startswith("pattern_")}
+FILES = ALL_FILES - PATTERN_FILES
 LISTED = set(STUDIES["by_name"])
+
+# What every onset-study case must set: the rectangular box of both solvers, the layer depth.
+PATTERN_EXPECTED = {"md.box_width": 64.0, "md.box_depth": 16.0, "layer.particles": 5600,
+                    "run.protocol": "periodic"}
+PATTERN_SOLVER_EXPECTED = {"md": {"md.initial_perturbation": 0.5},
+                           "continuum": {"continuum.dimension": 3, "continuum.box_width": 64.0,
+                                         "continuum.box_depth": 16.0}}
 
 
 def test_case_files_are_the_studies():
@@ -148,10 +159,33 @@ def test_every_case_uses_the_default_continuum_setting(shaker, work_dir):
     defaults = tomllib.loads(subprocess.run([shaker, "config", empty], capture_output=True,
                                             text=True, check=True).stdout)["continuum"]
     differences = []
-    for name in sorted(FILES):
+    for name in sorted(ALL_FILES):
         text = effective_config(shaker, case_file(REPOSITORY, name), [])
         continuum = tomllib.loads(text)["continuum"]
         differences += [f"{name}: continuum.{key} = {continuum[key]!r}, default "
                         f"{defaults[key]!r}" for key in CONTINUUM_SETTING
                         if continuum[key] != defaults[key]]
     assert differences == []
+
+
+def test_pattern_cases_are_accepted_at_every_gamma_of_the_sweep(shaker):
+    """Each onset-study case is accepted with the sweep's lowest and highest Gamma, sets the
+    rectangular box, and the continuum cases keep the default continuum model."""
+    assert {"pattern_md_f0p25", "pattern_md_f0p40", "pattern_continuum_f0p25",
+            "pattern_continuum_f0p40"} <= PATTERN_FILES
+    problems = []
+    for name in sorted(PATTERN_FILES):
+        solver = "md" if name.startswith("pattern_md_") else "continuum"
+        for gamma in ("2.0", "3.2"):
+            try:
+                config = tomllib.loads(effective_config(
+                    shaker, case_file(REPOSITORY, name), [f"shaker.gamma={gamma}"]))
+            except ValueError as error:
+                problems.append(str(error))
+                continue
+            expected = dict(PATTERN_EXPECTED, **PATTERN_SOLVER_EXPECTED[solver])
+            expected["case.name"] = name
+            for key, value in expected.items():
+                if lookup(config, key) != value:
+                    problems.append(f"{name}: {key} = {lookup(config, key)!r}, expected {value!r}")
+    assert problems == []
