@@ -67,16 +67,28 @@ def resampled_runs(studies, plan):
             for r in plan if r["solver"] == "md" and r["case"] in sampling.get("cases", [])]
 
 
+# Keys added to the program after runs were first keyed, each with the value that reproduces
+# the program as it was before the key existed (bit for bit): at that value the key is left out
+# of the hash, so that runs finished before it stay reusable. A new key with such a neutral
+# default is added here.
+NEUTRAL_VALUES = {("md", "box_depth"): 0.0, ("md", "initial_perturbation"): 0.0,
+                  ("continuum", "box_depth"): 0.0}
+
+
 def run_key(shaker, run):
     """The effective configuration and its key: the hash of the values that can change the
     solver's result (not of the text, so that comments and formatting in `shaker config` do
     not invalidate finished runs; and not the other solver's section, so that a key added
-    there does not either: the continuum reads only md.box_width of [md])."""
+    there does not either: the continuum reads only md.box_width and md.box_depth of [md]; nor
+    keys at their NEUTRAL_VALUES)."""
     text = effective_config(shaker, run["case_file"], run["overrides"])
     values = tomllib.loads(text)
     if run["solver"] == "continuum":
-        values["md"] = {"box_width": values["md"]["box_width"]}
+        values["md"] = {k: values["md"][k] for k in ("box_width", "box_depth") if k in values["md"]}
     else:
         values.pop("continuum", None)
+    for (section, key), neutral in NEUTRAL_VALUES.items():
+        if values.get(section, {}).get(key) == neutral:
+            del values[section][key]
     canonical = json.dumps(values, sort_keys=True)
     return text, hashlib.sha256(canonical.encode()).hexdigest()

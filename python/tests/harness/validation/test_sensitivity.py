@@ -163,3 +163,19 @@ def test_archive_stands_in_for_runs_lost_with_their_machine(shaker, work_dir):
     third = study_call(changed, status=1)  # 1: runs are missing
     assert "archived_at" not in third["plate_inelastic"]
     assert set(third["plate_inelastic"]["failed"]) == set(cases), "its lost runs: not run"
+
+
+def test_a_key_at_its_neutral_value_leaves_the_run_key_unchanged(shaker):
+    """A key added with a value that reproduces the program before it (NEUTRAL_VALUES) does
+    not change a run's key when it has that value, and does when it has another."""
+    from granular_shaker.validation import plan as study_plan
+    base = dict(case="base", case_file=study_plan.case_file(REPOSITORY, "base"), overrides=[])
+    for solver in ("md", "continuum"):
+        plain = study_plan.run_key(shaker, dict(base, solver=solver))[1]
+        for (section, key), neutral in study_plan.NEUTRAL_VALUES.items():
+            if section == "continuum" and solver == "md":
+                continue
+            at_neutral = dict(base, solver=solver, overrides=[f"{section}.{key}={neutral}"])
+            assert study_plan.run_key(shaker, at_neutral)[1] == plain, (solver, key)
+        deeper = dict(base, solver=solver, overrides=["md.box_depth=25"])
+        assert study_plan.run_key(shaker, deeper)[1] != plain, solver
