@@ -60,3 +60,11 @@ def repository_argument(parser, args):
         return find_repository(args.repository)
     except RepositoryNotFound as problem:
         parser.error(str(problem))
+
+
+def fill_missing_paths(args, defaults):
+    """`args` with every path in `defaults` ({option name: path}) that was left out set."""
+    for name, path in defaults.items():
+        if getattr(args, name) is None:
+            setattr(args, name, path)
+    return args

@@ -37,7 +37,8 @@ import sys
 import time
 
 from granular_shaker.reports import make_validation_report
-from granular_shaker.repository import add_repository_option, repository_argument
+from granular_shaker.repository import (add_repository_option, fill_missing_paths,
+                                        repository_argument)
 from granular_shaker.validation import quantities
 from granular_shaker.validation.claims import evaluate_claims, format_value, required_not_passing
 from granular_shaker.validation.diagnoses import diagnose, load_diagnoses
@@ -89,10 +90,7 @@ def with_repository_defaults(args, repository):
                     claims=os.path.join(repository, "reference-data", "claims.toml"),
                     studies=os.path.join(validation, "studies.toml"),
                     diagnoses=os.path.join(validation, "diagnoses.toml"))
-    for name, path in defaults.items():
-        if getattr(args, name) is None:
-            setattr(args, name, path)
-    return args
+    return fill_missing_paths(args, defaults)
 
 
 def chosen_cases(parser, args, studies):

@@ -40,7 +40,8 @@ import sys
 import time
 
 from granular_shaker.reports import make_sensitivity_report
-from granular_shaker.repository import add_repository_option, repository_argument
+from granular_shaker.repository import (add_repository_option, fill_missing_paths,
+                                        repository_argument)
 from granular_shaker.validation.claims import evaluate_claims, format_value, measure
 from granular_shaker.validation.plan import case_file, load_studies, load_toml, plan_runs, run_key
 from granular_shaker.validation.run import execute_all, log
@@ -247,10 +248,7 @@ def with_repository_defaults(args, repository):
                     claims=os.path.join(repository, "reference-data", "claims.toml"),
                     report=os.path.join(repository, "reports", "continuum-sensitivity.md"),
                     archive=os.path.join(repository, ARCHIVE))
-    for name, path in defaults.items():
-        if getattr(args, name) is None:
-            setattr(args, name, path)
-    return args
+    return fill_missing_paths(args, defaults)
 
 
 def chosen_variants_and_cases(parser, args, studies):

@@ -1,6 +1,7 @@
 """pytest tests of the harness in the package: the validation study (validation/, run by ctest
 as validation.*, defined in the repository's validation/CMakeLists.txt) and the report
 generators (reports/, run by ctest as reports.*), with the synthetic run files they share."""
+import copy
 import os
 import sys
 
@@ -24,3 +25,11 @@ def harness_command(module, *args, repository=True):
     command that reads none)."""
     return ([sys.executable, "-m", f"granular_shaker.{module}"]
             + (["--repository", REPOSITORY] if repository else []) + list(args))
+
+
+def edited_copy(items, change):
+    """A deep copy of `items` with `change` applied to it (a broken copy for a checker to
+    reject)."""
+    items = copy.deepcopy(items)
+    change(items)
+    return items

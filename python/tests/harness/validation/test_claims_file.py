@@ -11,7 +11,6 @@ It then checks that the checker itself catches broken files (a missing field, an
 quantity, a band of the wrong length, a missing id, a case nobody runs), so that a pass means
 something.
 """
-import copy
 import os
 import tomllib
 
@@ -20,7 +19,7 @@ import pytest
 from granular_shaker.validation import quantities
 from granular_shaker.validation.diagnoses import validate_diagnoses
 
-from .. import REPOSITORY as ROOT
+from .. import REPOSITORY as ROOT, edited_copy
 
 VALIDATION = os.path.join(ROOT, "validation")
 
@@ -106,10 +105,8 @@ def validate(claims, studies):
 
 def broken_copies(claims):
     """(description, broken claims list) pairs the checker must reject."""
-    def edit(fn):
-        c = copy.deepcopy(claims)
-        fn(c)
-        return c
+    def edit(change):
+        return edited_copy(claims, change)
     return [
         ("missing field", edit(lambda c: c[3].pop("provenance"))),
         ("unknown quantity", edit(lambda c: c[0].update(quantity="shock_sped"))),
@@ -125,10 +122,8 @@ def broken_copies(claims):
 
 def broken_diagnoses(diagnoses):
     """(description, broken diagnoses) pairs the diagnoses check must reject."""
-    def edit(fn):
-        d = copy.deepcopy(diagnoses)
-        fn(d)
-        return d
+    def edit(change):
+        return edited_copy(diagnoses, change)
     return [
         ("unknown claim", edit(lambda d: d[0].update(claim="C21"))),
         ("unknown category", edit(lambda d: d[0].update(category="e"))),

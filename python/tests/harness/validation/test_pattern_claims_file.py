@@ -9,14 +9,13 @@ empty or reversed band, a band of the wrong length, an unknown comparison, no so
 without a file, a provisional claim that says nothing is missing), so that a pass means
 something.
 """
-import copy
 import math
 import os
 import tomllib
 
 import pytest
 
-from .. import REPOSITORY
+from .. import REPOSITORY, edited_copy
 
 VALIDATION = os.path.join(REPOSITORY, "validation")
 CLAIMS_FILE = os.path.join(REPOSITORY, "reference-data", "pattern-claims.toml")
@@ -91,10 +90,8 @@ CASES = os.path.join(VALIDATION, "cases")
 
 def broken_copies(claims):
     """(description, broken claims list) pairs the checker must reject."""
-    def edit(fn):
-        c = copy.deepcopy(claims)
-        fn(c)
-        return c
+    def edit(change):
+        return edited_copy(claims, change)
     return [
         ("missing field", edit(lambda c: c[2].pop("band_justification"))),
         ("duplicated id", edit(lambda c: c[1].update(id="P1"))),
