@@ -14,7 +14,6 @@
 #include "common/case_parameters.hpp"
 #include "common/checkpoints.hpp"
 #include "common/errors.hpp"
-#include "common/memory.hpp"
 #include "common/output_paths.hpp"
 #include "common/packed_fields.hpp"
 #include "common/progress.hpp"
