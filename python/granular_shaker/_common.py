@@ -5,7 +5,7 @@ import h5py
 import numpy as np
 
 # Schema versions of the HDF5 files (docs/output-schema.md) this package reads.
-KNOWN_SCHEMA_VERSIONS = (1,)
+KNOWN_SCHEMA_VERSIONS = (1, 2)
 FRAMES = ("lab", "plate")
 
 
@@ -36,7 +36,7 @@ def check_frame(frame):
 
 
 def check_schema_version(attrs, path):
-    """Refuse a file without a schema version this package knows."""
+    """The file's schema version; refuses a file without one this package knows."""
     if "schema_version" not in attrs:
         raise SchemaError(f"{path}: no root attribute 'schema_version'; not a granular-shaker "
                           "output file")
@@ -46,6 +46,7 @@ def check_schema_version(attrs, path):
         raise SchemaError(f"{path}: schema_version {version} is not one this reader knows "
                           f"({known}); update granular_shaker to the version of the shaker "
                           "program that wrote the file")
+    return version
 
 
 def provenance(attrs):

@@ -48,7 +48,7 @@ def read_run(path, frame="lab"):
     """Read a run file; `frame` "lab" (as stored) or "plate"."""
     check_frame(frame)
     with h5py.File(path, "r") as f:
-        check_schema_version(f.attrs, path)
+        version = check_schema_version(f.attrs, path)
         if "kind" in f.attrs:
             raise SchemaError(f"{path}: a '{text(f.attrs['kind'])}' file, not a run file "
                               "(read_fields reads fields files, read_snapshots particle files)")
@@ -57,7 +57,7 @@ def read_run(path, frame="lab"):
                 raise SchemaError(f"{path}: no group /{group}; not a complete run file")
         attributes, configuration = provenance(f.attrs)
         profiles = read_group(f["profiles"], path)
-        timeseries = _read_series(f["timeseries"], path)
+        timeseries = _read_series(f["timeseries"], path, version)
         cycle_samples = None
         if "cycle_samples" in f:
             cycle_samples = read_group(f["cycle_samples"], path)
@@ -66,7 +66,7 @@ def read_run(path, frame="lab"):
         replicas = []
         if "replica_timeseries" in f:
             g = f["replica_timeseries"]
-            replicas = [_read_series(g[f"replica_{r:05d}"], path)
+            replicas = [_read_series(g[f"replica_{r:05d}"], path, version)
                         for r in range(1, int(g.attrs["replicas"]))]
     _mask_empty_bins(profiles)
     if frame == "plate":
@@ -75,9 +75,23 @@ def read_run(path, frame="lab"):
                replicas)
 
 
-def _read_series(group, path):
+# Time-series columns schema version 1 named otherwise (docs/output-schema.md, "Time series").
+_VERSION_1_COLUMNS = {"kinetic": "kinetic_energy", "potential": "potential_energy",
+                      "plate_work": "accumulated_drive_work",
+                      "accumulated_body_work": "accumulated_drive_work",
+                      "collisional_loss": "accumulated_collisional_loss",
+                      "energy_closure": "energy_budget_relative_residual"}
+
+
+def _read_series(group, path, version):
     columns = [c.strip() for c in text(group.attrs["columns"]).split(",")]
-    return read_group(group, path, columns)
+    series = read_group(group, path, columns)
+    if version == 1:
+        series = Table({_VERSION_1_COLUMNS.get(name, name): values
+                        for name, values in series.items()},
+                       {_VERSION_1_COLUMNS.get(name, name): units
+                        for name, units in series.units.items()})
+    return series
 
 
 def _mask_empty_bins(profiles):

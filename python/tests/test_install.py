@@ -53,7 +53,8 @@ def test_commands_of_a_virtual_environment_install(work_dir):
     declared = commands()
     assert {"shaker-validation", "shaker-sensitivity", "shaker-validation-report",
             "shaker-sensitivity-report", "shaker-convergence-report", "shaker-benchmark-report",
-            "shaker-base-case-report"} == set(declared), declared
+            "shaker-base-case-report", "shaker-patterns",
+            "shaker-pattern-report"} == set(declared), declared
     elsewhere = os.path.join(work_dir, "elsewhere")
     os.mkdir(elsewhere)
     plain = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}

@@ -90,10 +90,39 @@ def test_continuum_run_plate_frame_puts_every_row_on_the_same_cells(work_dir):
     assert lab.timeseries.units["total_mass"] == "m / sigma^2"
 
 
+def with_columns(path, columns):
+    """Adds time-series columns to a run file, in /timeseries and every replica's series."""
+    with h5py.File(path, "r+") as f:
+        groups = [f["timeseries"], *f["replica_timeseries"].values()]
+        for group in groups:
+            for name, value in columns.items():
+                group.create_dataset(name, data=np.full(group["t"].shape, value))
+                group[name].attrs["units"] = "1"
+            group.attrs["columns"] = group.attrs["columns"] + "," + ",".join(columns)
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_version_1_series_columns_get_their_present_names(work_dir, version):
+    path = os.path.join(work_dir, "run.h5")
+    synthetic.write_md_run(path, schema_version=version)
+    old = {"kinetic": 1.0, "potential": 2.0, "plate_work": 3.0, "collisional_loss": 4.0,
+           "energy_closure": 5.0}
+    with_columns(path, old)
+    run = gs.read_run(path)
+    present = {"kinetic_energy": 1.0, "potential_energy": 2.0, "accumulated_drive_work": 3.0,
+               "accumulated_collisional_loss": 4.0, "energy_budget_relative_residual": 5.0}
+    expected = present if version == 1 else old
+    for series in (run.timeseries, run.replica_timeseries[0]):
+        for name, value in expected.items():
+            np.testing.assert_array_equal(series[name], value)
+            assert series.units[name] == "1"
+        assert not set(old if version == 1 else present) & set(series)
+
+
 def test_run_refusals(work_dir):
     path = os.path.join(work_dir, "run.h5")
-    synthetic.write_md_run(path, schema_version=2)
-    with pytest.raises(gs.SchemaError, match=r"schema_version 2 is not one this reader knows"):
+    synthetic.write_md_run(path, schema_version=3)
+    with pytest.raises(gs.SchemaError, match=r"schema_version 3 is not one this reader knows"):
         gs.read_run(path)
     synthetic.write_md_run(path, units=False)
     with pytest.raises(gs.SchemaError, match=r"/profiles/\S+ has no 'units' attribute"):

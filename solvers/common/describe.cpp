@@ -80,7 +80,7 @@ std::string describe_schema(bool markdown) {
     out += "# Configuration keys\n\n"
            "<!-- Generated: do not edit. Regenerate with\n"
            "     build/release/solvers/app/shaker config --describe --markdown > docs/configuration.md\n"
-           "     (the test unit.Repository.ConfigurationDocIsCurrent fails when this file differs). -->\n\n"
+           "     (the test repository.ConfigurationDoc.IsCurrent fails when this file differs). -->\n\n"
            "One TOML file per case; a key not given takes its default, and the defaults are the\n"
            "paper's base case, so an empty file is the base case. Keys are written as `section.name`\n"
            "here and on the command line (`--set section.name=value`), and as `name = value` under\n"

@@ -8,6 +8,7 @@
 #include <map>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <utility>
 #include <sstream>
@@ -54,29 +55,38 @@ constexpr ScalarName profile_scalars[] = {{"time", &Profile::time, "sqrt(sigma/g
                                           {"bin_height", &Profile::bin_height, "sigma"}};
 
 /// The units of every time-series column either solver writes (docs/output-schema.md); the
-/// per-height counters crossings_z<h> and particles_z<h> are counts.
-std::string series_units(const std::string& column) {
+/// per-height counters crossings_z<h> and particles_z<h> are counts. The MD's energies are the
+/// system's, the continuum's per unit plate area.
+std::string series_units(const std::string& column, const std::string& solver) {
   static const std::map<std::string, std::string> units{
       {"t", "sqrt(sigma/g)"}, {"phase", "1"}, {"plate_z", "sigma"}, {"com_z", "sigma"},
+      {"energy_budget_relative_residual", "1"},
       // MD
-      {"kinetic", "m g sigma"}, {"potential", "m g sigma"}, {"plate_work", "m g sigma"},
-      {"collisional_loss", "m g sigma"}, {"energy_closure", "1"}, {"pair_collisions", "1"},
-      {"plate_collisions", "1"}, {"ceiling_collisions", "1"}, {"cell_crossings", "1"},
+      {"pair_collisions", "1"}, {"plate_collisions", "1"}, {"ceiling_collisions", "1"}, {"cell_crossings", "1"},
       {"guard_activations", "1"}, {"overlaps", "1"}, {"near_plate", "1"}, {"collisions", "1"},
       {"queue_consistent", "1"},
-      // continuum, per unit plate area
-      {"total_mass", "m / sigma^2"}, {"kinetic_energy", "m g / sigma"},
-      {"thermal_energy", "m g / sigma"}, {"potential_energy", "m g / sigma"},
-      {"collisional_loss_rate", "m g^(3/2) / sigma^(3/2)"},
+      // continuum
+      {"total_mass", "m / sigma^2"}, {"collisional_loss_rate", "m g^(3/2) / sigma^(3/2)"},
       {"com_z_change_from_previous_cycle", "sigma"}, {"temperature_floor_uses", "1"},
-      {"steps", "1"}, {"frame_energy", "m g / sigma"}, {"accumulated_body_work", "m g / sigma"},
-      {"accumulated_collisional_loss", "m g / sigma"}, {"accumulated_floor_energy", "m g / sigma"},
-      {"energy_budget_residual", "m g / sigma"}, {"periodicity_last_two_cycles", "1"},
-      {"restitution", "1"}};
+      {"steps", "1"}, {"periodicity_last_two_cycles", "1"}, {"restitution", "1"}};
+  static const std::set<std::string> energies{
+      "kinetic_energy", "potential_energy", "thermal_energy", "frame_energy", "accumulated_drive_work",
+      "accumulated_collisional_loss", "accumulated_floor_energy", "energy_budget_residual"};
+  if (energies.count(column)) return solver == "continuum" ? "m g / sigma" : "m g sigma";
   if (const auto it = units.find(column); it != units.end()) return it->second;
   if (column.rfind("crossings_z", 0) == 0 || column.rfind("particles_z", 0) == 0) return "1";
   throw std::logic_error(fmt::format("time-series column '{}' has no units: declare them in "
                                      "series_units (run_file.cpp) and docs/output-schema.md", column));
+}
+
+/// The time-series columns that schema version 1 named otherwise, by their present names.
+std::string present_column_name(const std::string& version_1_name) {
+  static const std::map<std::string, std::string> renamed{
+      {"kinetic", "kinetic_energy"}, {"potential", "potential_energy"},
+      {"plate_work", "accumulated_drive_work"}, {"accumulated_body_work", "accumulated_drive_work"},
+      {"collisional_loss", "accumulated_collisional_loss"}, {"energy_closure", "energy_budget_relative_residual"}};
+  const auto it = renamed.find(version_1_name);
+  return it == renamed.end() ? version_1_name : it->second;
 }
 
 void write_profiles(hid_t file, const std::vector<Profile>& profiles) {
@@ -241,20 +251,21 @@ namespace {
 
 /// A time series as a group: one 1D dataset per column with its units, and the string
 /// attribute `columns` naming them in order (`/timeseries`, and each replica's in an ensemble).
-void write_series(hid_t parent, const std::string& name, const TimeSeries& series) {
+void write_series(hid_t parent, const std::string& name, const TimeSeries& series, const std::string& solver) {
   h5::Handle group = h5::create_group(parent, name);
   h5::write_attribute(group.id(), "columns", fmt::format("{}", fmt::join(series.names, ",")));
   for (std::size_t i = 0; i < series.names.size(); ++i)
     h5::write(group.id(), series.names[i], series.columns[i], {series.columns[i].size()},
-              series_units(series.names[i]));
+              series_units(series.names[i], solver));
 }
 
-TimeSeries read_series(hid_t parent, const std::string& name) {
+TimeSeries read_series(hid_t parent, const std::string& name, std::int64_t schema_version) {
   h5::Handle group = h5::open_group(parent, name);
   TimeSeries series;
   std::stringstream names(h5::read_string_attribute(group.id(), "columns"));
-  for (std::string column; std::getline(names, column, ',');) {
-    auto values = h5::read_doubles(group.id(), column);
+  for (std::string stored; std::getline(names, stored, ',');) {
+    auto values = h5::read_doubles(group.id(), stored);
+    const std::string column = schema_version == 1 ? present_column_name(stored) : stored;
     if (series.has(column))
       throw InputError(fmt::format("{}: column '{}' is listed twice in attribute 'columns'; allowed: "
                                    "each column once", name, column));
@@ -273,15 +284,15 @@ TimeSeries read_series(hid_t parent, const std::string& name) {
 constexpr const char* replica_group = "replica_timeseries";
 std::string replica_name(std::size_t r) { return fmt::format("replica_{:05d}", r); }
 
-void write_replica_series(hid_t file, const std::vector<TimeSeries>& replicas) {
+void write_replica_series(hid_t file, const std::vector<TimeSeries>& replicas, const std::string& solver) {
   if (replicas.empty()) return;
   h5::Handle group = h5::create_group(file, replica_group);
   h5::write_attribute(group.id(), "replicas", static_cast<std::int64_t>(replicas.size() + 1));
   for (std::size_t r = 1; r <= replicas.size(); ++r)
-    write_series(group.id(), replica_name(r), replicas[r - 1]);
+    write_series(group.id(), replica_name(r), replicas[r - 1], solver);
 }
 
-std::vector<TimeSeries> read_replica_series(hid_t file) {
+std::vector<TimeSeries> read_replica_series(hid_t file, std::int64_t schema_version) {
   if (!h5::exists(file, replica_group)) return {};
   h5::Handle group = h5::open_group(file, replica_group);
   const std::int64_t replicas = h5::read_integer_attribute(group.id(), "replicas");
@@ -294,7 +305,7 @@ std::vector<TimeSeries> read_replica_series(hid_t file) {
     if (!h5::exists(group.id(), name))
       throw InputError(fmt::format("{} has no group {} (attribute replicas = {}: one group per "
                                    "replica 1 .. {})", replica_group, name, replicas, replicas - 1));
-    series.push_back(read_series(group.id(), name));
+    series.push_back(read_series(group.id(), name, schema_version));
   }
   return series;
 }
@@ -333,8 +344,8 @@ void write_run_file(const std::filesystem::path& path, const RunRecord& record) 
     write_run_attributes(file, record);
     write_profiles(file, record.profiles);
     write_samples(file, record.samples, false);
-    write_series(file, "timeseries", record.series);
-    write_replica_series(file, record.replica_series);
+    write_series(file, "timeseries", record.series, record.solver);
+    write_replica_series(file, record.replica_series, record.solver);
   });
 }
 
@@ -350,10 +361,10 @@ RunRecord read_run_file(const std::filesystem::path& path) {
                                    h5::read_string_attribute(file.id(), file_kind_attribute),
                                    file_kind_attribute));
     const std::int64_t version = h5::read_integer_attribute(file.id(), "schema_version");
-    if (version != output_schema_version)
+    if (version < oldest_readable_schema_version || version > output_schema_version)
       throw InputError(fmt::format("schema version {} is not supported (attribute schema_version; "
-                                   "allowed: {}, the version this program reads)", version,
-                                   output_schema_version));
+                                   "allowed: {} to {}, the versions this program reads)", version,
+                                   oldest_readable_schema_version, output_schema_version));
     record.schema_version = static_cast<int>(version);
     record.program_version = h5::read_string_attribute(file.id(), "program_version");
     record.git_commit = h5::read_string_attribute(file.id(), "git_commit");
@@ -374,8 +385,8 @@ RunRecord read_run_file(const std::filesystem::path& path) {
     record.profiles = read_profiles(file.id());
     record.samples = read_samples(file.id(), record.profiles.size(),
                                   record.profiles.empty() ? 0 : record.profiles.front().size(), false);
-    record.series = read_series(file.id(), "timeseries");
-    record.replica_series = read_replica_series(file.id());
+    record.series = read_series(file.id(), "timeseries", version);
+    record.replica_series = read_replica_series(file.id(), version);
     return record;
   } catch (const InputError& error) {
     throw InputError(fmt::format("run file '{}': {}", path.string(), error.what()));

@@ -2,8 +2,8 @@
 // drives the continuum solver; its observers average the profiles at phases k / K over the
 // sampled cycles, record the time series, take the 3D field snapshots and report progress.
 // The time series carries, besides the common columns (t, phase, plate_z, com_z), mass and
-// energies, the container-frame energy budget (frame_energy, accumulated body work,
-// collisional loss and floor energy, and the residual of E - E0 - W + L - F), the periodicity
+// energies, the container-frame energy budget (frame_energy and the budget's columns of
+// common/series_recorder.hpp: drive work, collisional loss, floor energy, residual), the periodicity
 // measure of the last two cycles (each phase's centre of mass against the same phase one cycle
 // earlier; also printed in the summary) and the restitution in effect at each row.
 //
@@ -32,6 +32,7 @@
 #include "common/ranks.hpp"
 #include "common/run_file.hpp"
 #include "common/run_loop.hpp"
+#include "common/series_recorder.hpp"
 #include "common/terminal_log.hpp"
 #include "continuum/checkpoint.hpp"
 #include "continuum/halo.hpp"
@@ -78,87 +79,59 @@ class Box final : public RunObserver {
 };
 
 /// The rows of the time series, one at every stored phase.
-struct Recorder final : RunObserver {
-  std::vector<double> time, phase, plate_z, com, mass, kinetic, thermal, potential, loss_rate, com_change,
-      floor_uses, steps, frame_energy, body_work, collisional_loss, floor_energy, budget_residual,
-      periodicity_column, restitution;
-  double initial_energy = 0, initial_body_work = 0, initial_loss = 0, initial_floor = 0;
-  const Box& box;
-  const ShakerKinematics& shaker;
-  std::size_t phases;
-
-  Recorder(const Box& b, const ShakerKinematics& k, std::size_t K) : box(b), shaker(k), phases(K) {}
+class Recorder final : public RunObserver {
+ public:
+  Recorder(const Box& b, const ShakerKinematics& k, std::size_t K) : box_(b), shaker_(k), phases_(K) {}
   void at_phase(const PhaseInstant&) override {
-    if (box.writer()) add(box.view());
+    if (box_.writer()) add(box_.view());
   }
-  void add(const BoxView& view) {
-    const Diagnostics d = diagnostics(view, shaker);
-    const double t = view.scalars.time;
-    time.push_back(t);
-    phase.push_back(shaker.phase(t));
-    plate_z.push_back(shaker.position(t));
-    com.push_back(d.center_of_mass);
-    mass.push_back(d.mass);
-    kinetic.push_back(d.kinetic);
-    thermal.push_back(d.thermal);
-    potential.push_back(d.potential);
-    loss_rate.push_back(d.loss_rate);
-    com_change.push_back(com.size() > phases ? d.center_of_mass - com[com.size() - 1 - phases]
-                                             : std::numeric_limits<double>::quiet_NaN());
-    floor_uses.push_back(static_cast<double>(view.scalars.counters.temperature_floor_uses));
-    steps.push_back(static_cast<double>(view.scalars.counters.steps));
-    // Energy budget relative to the first row (a restart continues the accumulated terms).
-    const EnergyBudget& b = view.scalars.budget;
-    const double energy = total_energy(view);
-    if (time.size() == 1) {
-      initial_energy = energy;
-      initial_body_work = b.body_work;
-      initial_loss = b.collisional_loss;
-      initial_floor = b.floor_energy;
-    }
-    frame_energy.push_back(energy);
-    body_work.push_back(b.body_work);
-    collisional_loss.push_back(b.collisional_loss);
-    floor_energy.push_back(b.floor_energy);
-    budget_residual.push_back((energy - initial_energy) - (b.body_work - initial_body_work) +
-                              (b.collisional_loss - initial_loss) - (b.floor_energy - initial_floor));
-    periodicity_column.push_back(periodicity());
-    restitution.push_back(view.scalars.e);
-  }
-  TimeSeries series() const {
-    TimeSeries s;
-    s.add("t", time);
-    s.add("phase", phase);
-    s.add("plate_z", plate_z);
-    s.add("com_z", com);
-    s.add("total_mass", mass);
-    s.add("kinetic_energy", kinetic);
-    s.add("thermal_energy", thermal);
-    s.add("potential_energy", potential);
-    s.add("collisional_loss_rate", loss_rate);
-    s.add("com_z_change_from_previous_cycle", com_change);
-    s.add("temperature_floor_uses", floor_uses);
-    s.add("steps", steps);
-    s.add("frame_energy", frame_energy);
-    s.add("accumulated_body_work", body_work);
-    s.add("accumulated_collisional_loss", collisional_loss);
-    s.add("accumulated_floor_energy", floor_energy);
-    s.add("energy_budget_residual", budget_residual);
-    s.add("periodicity_last_two_cycles", periodicity_column);
-    s.add("restitution", restitution);
-    return s;
-  }
+  const TimeSeries& series() const { return rows_.series(); }
+  const std::vector<double>& column(const std::string& name) const { return rows_.series().column(name); }
   /// RMS over the last cycle's phases of the change from the previous cycle, / RMS height
   /// (NaN until two whole cycles are recorded).
   double periodicity() const {
-    if (com.size() < 2 * phases) return std::numeric_limits<double>::quiet_NaN();
+    const std::vector<double>& com = column("com_z");  // the row being recorded included
+    if (com.size() < 2 * phases_) return std::numeric_limits<double>::quiet_NaN();
+    const std::vector<double>& change = column("com_z_change_from_previous_cycle");
     double d2 = 0, h2 = 0;
-    for (std::size_t i = com.size() - phases; i < com.size(); ++i) {
-      d2 += com_change[i] * com_change[i];
+    for (std::size_t i = com.size() - phases_; i < com.size(); ++i) {
+      d2 += change[i] * change[i];
       h2 += com[i] * com[i];
     }
     return std::sqrt(d2 / h2);
   }
+
+ private:
+  void add(const BoxView& view) {
+    const Diagnostics d = diagnostics(view, shaker_);
+    const double t = view.scalars.time;
+    const std::size_t row = rows_.rows();
+    rows_.set("t", t);
+    rows_.set("phase", shaker_.phase(t));
+    rows_.set("plate_z", shaker_.position(t));
+    rows_.set("com_z", d.center_of_mass);
+    rows_.set("total_mass", d.mass);
+    rows_.set("kinetic_energy", d.kinetic);
+    rows_.set("thermal_energy", d.thermal);
+    rows_.set("potential_energy", d.potential);
+    rows_.set("collisional_loss_rate", d.loss_rate);
+    rows_.set("com_z_change_from_previous_cycle", row >= phases_ ? d.center_of_mass - column("com_z")[row - phases_]
+                                                                  : std::numeric_limits<double>::quiet_NaN());
+    rows_.set("temperature_floor_uses", static_cast<double>(view.scalars.counters.temperature_floor_uses));
+    rows_.set("steps", static_cast<double>(view.scalars.counters.steps));
+    const double energy = total_energy(view);
+    const EnergyBudget& b = view.scalars.budget;
+    rows_.set("frame_energy", energy);
+    rows_.set_energy(EnergyTotals{energy, b.body_work, b.collisional_loss, b.floor_energy});
+    rows_.set("periodicity_last_two_cycles", periodicity());
+    rows_.set("restitution", view.scalars.e);
+    rows_.end_row();
+  }
+
+  const Box& box_;
+  const ShakerKinematics& shaker_;
+  std::size_t phases_;
+  SeriesRecorder rows_;
 };
 
 /// The profiles of the run file: horizontally averaged at each stored phase and averaged over
@@ -402,15 +375,17 @@ PhaseSchedule starting_schedule(const ContinuumCase& c, const config::Config& co
 /// The summary on stdout (and in the log), the warnings on stderr.
 void report_run(std::int64_t cycles, double t, double wall_seconds, const Counters& counters, const Recorder& recorder,
                 const std::vector<std::string>& warnings, const std::filesystem::path& output) {
+  const std::vector<double>& mass = recorder.column("total_mass");
+  const std::vector<double>& residual = recorder.column("energy_budget_residual");
+  const std::vector<double>& loss = recorder.column("accumulated_collisional_loss");
   terminal_log::say(stdout, "shaker continuum: {} cycles to t = {:.6g}, wall time {}, {} steps ({} rejected), "
              "temperature floor used {} times; mass drift {:.3e}; periodicity (centre of mass, last "
              "two cycles) {:.3e} (series column periodicity_last_two_cycles); energy budget residual "
              "{:.3e} of the accumulated loss {:.6g}\nwrote {}\n",
              cycles, t, duration_text(wall_seconds), counters.steps,
              counters.rejected_steps, counters.temperature_floor_uses,
-             (recorder.mass.back() - recorder.mass.front()) / recorder.mass.front(),
-             recorder.periodicity(), recorder.budget_residual.back(),
-             recorder.collisional_loss.back() - recorder.initial_loss, output.string());
+             (mass.back() - mass.front()) / mass.front(), recorder.periodicity(), residual.back(),
+             loss.back() - loss.front(), output.string());
   for (const std::string& doubt : warnings)
     terminal_log::say(stderr, "shaker continuum: warning: {} (kept in the run file's attribute warnings)\n", doubt);
 }

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "common/errors.hpp"
+#include "common/series_recorder.hpp"
 #include "md/sampling.hpp"
 
 namespace shaker::md {
@@ -53,54 +54,21 @@ MdSettings MdSettings::from(const config::Config& c) {
 
 namespace {
 
-/// Time-series columns, one row per sampling instant.
-struct SeriesRows {
-  std::vector<std::string> names = {
-      "t", "phase", "plate_z", "com_z", "kinetic", "potential", "plate_work",
-      "collisional_loss", "energy_closure", "pair_collisions", "plate_collisions",
-      "ceiling_collisions", "cell_crossings", "guard_activations", "overlaps", "near_plate",
-      "collisions", "queue_consistent"};
-  std::vector<std::vector<double>> columns;
-  explicit SeriesRows(const std::vector<double>& crossing_heights) {
-    for (double h : crossing_heights) names.push_back(crossing_column(h));
-    for (double h : crossing_heights) names.push_back(distinct_particles_column(h));
-    columns.resize(names.size());
-  }
-  void add(std::initializer_list<double> row, const std::vector<std::uint64_t>& crossings,
-           const std::vector<std::uint64_t>& distinct_particles) {
-    std::size_t k = 0;
-    for (double x : row) columns[k++].push_back(x);
-    for (std::uint64_t c : crossings) columns[k++].push_back(static_cast<double>(c));
-    for (std::uint64_t c : distinct_particles) columns[k++].push_back(static_cast<double>(c));
-  }
-  TimeSeries finish() {
-    TimeSeries s;
-    for (std::size_t k = 0; k < columns.size(); ++k) s.add(names[k], std::move(columns[k]));
-    return s;
-  }
-};
+/// The running totals of the MD's energy budget (no temperature floor).
+EnergyTotals energy_totals(const Tally& tally, double energy) {
+  return EnergyTotals{energy, tally.plate_work, tally.pair_loss + tally.wall_loss, std::nullopt};
+}
 
-/// The energy and running totals at the start of the run, from which its budget counts.
-struct BudgetOrigin {
-  double energy;
-  Tally tally;
-  EnergyBudget at(const Tally& now, double energy_now) const {
-    EnergyBudget b;
-    b.plate_work = now.plate_work - tally.plate_work;
-    b.collisional_loss = now.pair_loss + now.wall_loss - tally.pair_loss - tally.wall_loss;
-    b.energy_change = energy_now - energy;
-    const double scale = std::max({std::fabs(b.plate_work), std::fabs(b.collisional_loss), std::fabs(energy_now), 1e-300});
-    b.relative_closure = std::fabs(b.energy_change + b.collisional_loss - b.plate_work) / scale;
-    return b;
-  }
-};
+EnergyTotals energy_totals(const Simulation& sim, double t) {
+  return energy_totals(sim.tally(), sim.kinetic_energy(t) + sim.potential_energy(t));
+}
 
 /// The rows of RunOutcome::series: one at every stored phase and one at the end of the run.
 class SeriesObserver final : public RunObserver {
  public:
   SeriesObserver(Simulation& sim, const ShakerKinematics& shaker, const MdSettings& settings,
-                 const BudgetOrigin& origin, PhaseSnapshot& snapshot)
-      : sim_(sim), shaker_(shaker), origin_(origin), snapshot_(snapshot), rows_(settings.crossing_heights) {
+                 const Tally& at_start, PhaseSnapshot& snapshot)
+      : sim_(sim), shaker_(shaker), settings_(settings), at_start_(at_start), snapshot_(snapshot) {
     sim.start_height_counts(settings.crossing_heights, shaker.frequency());
   }
   void at_phase(const PhaseInstant& instant) override { record(instant.t); }
@@ -120,24 +88,37 @@ class SeriesObserver final : public RunObserver {
       near_plate += r[i].z - 0.5 - plate_z < 0.5 ? 1.0 : 0.0;  // within half a diameter
     }
     const double potential = sim_.geometry().gravity * com;
-    const EnergyBudget b = origin_.at(sim_.tally(), kinetic + potential);
     const Tally& tally = sim_.tally();
-    rows_.add({t, shaker_.phase(t), plate_z, com / static_cast<double>(sim_.size()), kinetic, potential,
-               b.plate_work, b.collisional_loss, b.relative_closure,
-               static_cast<double>(tally.pair), static_cast<double>(tally.plate),
-               static_cast<double>(tally.ceiling), static_cast<double>(tally.cell),
-               static_cast<double>(tally.guard_activations),
-               static_cast<double>(sim_.count_overlaps(r, 1e-9)), near_plate,
-               static_cast<double>(tally.pair - origin_.tally.pair),
-               sim_.queue_consistent() ? 1.0 : 0.0},
-              sim_.crossings_at(t), sim_.distinct_particles_at(t));
+    rows_.set("t", t);
+    rows_.set("phase", shaker_.phase(t));
+    rows_.set("plate_z", plate_z);
+    rows_.set("com_z", com / static_cast<double>(sim_.size()));
+    rows_.set("kinetic_energy", kinetic);
+    rows_.set("potential_energy", potential);
+    rows_.set_energy(energy_totals(tally, kinetic + potential));
+    rows_.set("pair_collisions", static_cast<double>(tally.pair));
+    rows_.set("plate_collisions", static_cast<double>(tally.plate));
+    rows_.set("ceiling_collisions", static_cast<double>(tally.ceiling));
+    rows_.set("cell_crossings", static_cast<double>(tally.cell));
+    rows_.set("guard_activations", static_cast<double>(tally.guard_activations));
+    rows_.set("overlaps", static_cast<double>(sim_.count_overlaps(r, 1e-9)));
+    rows_.set("near_plate", near_plate);
+    rows_.set("collisions", static_cast<double>(tally.pair - at_start_.pair));
+    rows_.set("queue_consistent", sim_.queue_consistent() ? 1.0 : 0.0);
+    const std::vector<std::uint64_t> crossings = sim_.crossings_at(t), distinct = sim_.distinct_particles_at(t);
+    for (std::size_t k = 0; k < settings_.crossing_heights.size(); ++k)
+      rows_.set(crossing_column(settings_.crossing_heights[k]), static_cast<double>(crossings[k]));
+    for (std::size_t k = 0; k < settings_.crossing_heights.size(); ++k)
+      rows_.set(distinct_particles_column(settings_.crossing_heights[k]), static_cast<double>(distinct[k]));
+    rows_.end_row();
   }
 
   const Simulation& sim_;
   const ShakerKinematics& shaker_;
-  const BudgetOrigin& origin_;
+  const MdSettings& settings_;
+  const Tally& at_start_;
   PhaseSnapshot& snapshot_;
-  SeriesRows rows_;
+  SeriesRecorder rows_;
 };
 
 /// Every particle at the stored phases and cycles of MdSettings::snapshot_*, read from the
@@ -183,9 +164,10 @@ RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, const Ca
 RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, PhaseSampler& sampler,
                         const CaseParameters& parameters, const MdSettings& settings,
                         const std::vector<RunObserver*>& also) {
-  const BudgetOrigin origin{sim.kinetic_energy(sim.time()) + sim.potential_energy(sim.time()), sim.tally()};
+  const Tally at_start = sim.tally();
+  const EnergyTotals start_totals = energy_totals(sim, sim.time());
   PhaseSnapshot snapshot(sim);
-  SeriesObserver series(sim, parameters.shaker, settings, origin, snapshot);
+  SeriesObserver series(sim, parameters.shaker, settings, at_start, snapshot);
   SamplingObserver sampling(sampler, snapshot);
   ParticleSnapshots particles(parameters.shaker, settings, snapshot);
   std::vector<RunObserver*> observers{&series, &sampling};
@@ -203,14 +185,14 @@ RunOutcome run_protocol(Simulation& sim, const PhaseSchedule& schedule, PhaseSam
   out.samples = sampler.samples();
   out.series = series.finish();
   out.frames = std::move(particles.frames);
-  out.budget = origin.at(sim.tally(), sim.kinetic_energy(end) + sim.potential_energy(end));
+  out.budget = balance(start_totals, energy_totals(sim, end));
   out.overlaps = sim.count_overlaps(end, 1e-9);
   out.queue_consistent = sim.queue_consistent();
   const Tally& tally = sim.tally();
-  out.at_start = origin.tally;
-  out.collisions = tally.collisions() - origin.tally.collisions();
-  out.events = out.collisions + (tally.cell - origin.tally.cell) + (tally.stale - origin.tally.stale) +
-               (tally.grazes - origin.tally.grazes);
+  out.at_start = at_start;
+  out.collisions = tally.collisions() - at_start.collisions();
+  out.events = out.collisions + (tally.cell - at_start.cell) + (tally.stale - at_start.stale) +
+               (tally.grazes - at_start.grazes);
   return out;
 }
 

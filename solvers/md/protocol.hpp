@@ -10,6 +10,7 @@
 #include "common/config.hpp"
 #include "common/profile.hpp"
 #include "common/run_loop.hpp"
+#include "common/series_recorder.hpp"
 #include "md/particle_file.hpp"
 #include "md/sampling.hpp"
 #include "md/simulation.hpp"
@@ -43,20 +44,14 @@ std::string crossing_column(double height);
 /// particles_z80.
 std::string distinct_particles_column(double height);
 
-struct EnergyBudget {
-  double plate_work = 0.0, collisional_loss = 0.0, energy_change = 0.0;
-  /// |energy change + loss - work| / max(|work|, |loss|, |energy|)
-  double relative_closure = 0.0;
-};
-
 struct RunOutcome {
   std::vector<Profile> profiles;
   CycleSamples samples;  ///< the per-cycle sums behind the profiles
   /// One row per sampling instant (every phase of every cycle, and the end of the run):
-  /// t, phase, plate_z, com_z (centre of mass), kinetic, potential (g z, lab frame),
-  /// plate_work, collisional_loss (pair + wall, since the start of this run), energy_closure
-  /// (relative, see EnergyBudget), pair/plate/ceiling_collisions and cell_crossings (running
-  /// totals), guard_activations, overlaps (pairs closer than 1 - 1e-9), near_plate (particles
+  /// t, phase, plate_z, com_z (centre of mass), kinetic_energy, potential_energy (g z, lab
+  /// frame), the energy budget's columns (SeriesRecorder::set_energy: the drive is the plate,
+  /// the loss that of pair and wall collisions), pair/plate/ceiling_collisions and
+  /// cell_crossings (running totals), guard_activations, overlaps (pairs closer than 1 - 1e-9), near_plate (particles
   /// less than half a diameter above the plate), collisions (pair collisions since the start
   /// of this run), queue_consistent (1 if the event queue passes Simulation::queue_consistent
   /// at the row's time, else 0: the soak test's per-cycle check), crossings_z<h> for each h of
@@ -67,7 +62,7 @@ struct RunOutcome {
   /// distinct particles at or above h at some instant of the cycle, exact in the same way; the
   /// difference between the rows at two consecutive cycle boundaries is that cycle's count).
   TimeSeries series;
-  EnergyBudget budget;
+  EnergyBalance budget;  ///< from the start of this run to its end
   std::size_t overlaps = 0;  ///< at the end of the run
   bool queue_consistent = false;
   /// Every particle at the stored phases MdSettings::snapshot_phases of its snapshot_cycles,

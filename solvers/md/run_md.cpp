@@ -143,15 +143,15 @@ struct ReplicaSummary {
   /// Since the start of this run, and since the start of the run that wrote the first
   /// checkpoint (the same unless this run continues one: the tally is continued).
   CollisionCounts this_run, since_first_start;
-  EnergyBudget budget;
+  EnergyBalance budget;
   bool queue_consistent = false;
 
   /// The numbers of the summary, in the order they travel.
   template <class Self> static auto scalars(Self& s) {
     return std::tie(s.time, s.seconds, s.events, s.overlaps, s.this_run.pair, s.this_run.plate, s.this_run.ceiling,
                     s.this_run.guard_activations, s.since_first_start.pair, s.since_first_start.plate,
-                    s.since_first_start.ceiling, s.since_first_start.guard_activations, s.budget.plate_work,
-                    s.budget.collisional_loss, s.budget.energy_change, s.budget.relative_closure,
+                    s.since_first_start.ceiling, s.since_first_start.guard_activations, s.budget.drive_work,
+                    s.budget.collisional_loss, s.budget.energy_change, s.budget.relative_residual,
                     s.queue_consistent);
   }
 
@@ -230,11 +230,11 @@ ReplicaSummary combined(const std::vector<ReplicaSummary>& replicas) {
     all.this_run += r.this_run;
     all.since_first_start += r.since_first_start;
     for (auto [into, x] : {std::pair{&all.seconds, r.seconds}, {&all.events, r.events},
-                           {&all.overlaps, r.overlaps}, {&all.budget.plate_work, r.budget.plate_work},
+                           {&all.overlaps, r.overlaps}, {&all.budget.drive_work, r.budget.drive_work},
                            {&all.budget.collisional_loss, r.budget.collisional_loss},
                            {&all.budget.energy_change, r.budget.energy_change}})
       *into += x;
-    all.budget.relative_closure = std::max(all.budget.relative_closure, r.budget.relative_closure);
+    all.budget.relative_residual = std::max(all.budget.relative_residual, r.budget.relative_residual);
     all.queue_consistent = all.queue_consistent && r.queue_consistent;
   }
   return all;
@@ -344,15 +344,15 @@ int report_run(const MdCase& c, const ReplicaSummary& all, std::size_t frames, d
   terminal_log::say(stdout, "  rates{}: {:.4g} collisions/s, {:.4g} events/s\n", here,
                     all.this_run.total() / all.seconds, all.events / all.seconds);
   terminal_log::say(stdout, "  energy budget{}: plate work {:.10g}, collisional loss {:.10g}, energy change {:.10g}, "
-                    "relative closure {:.3g}\n", here, all.budget.plate_work, all.budget.collisional_loss,
-                    all.budget.energy_change, all.budget.relative_closure);
+                    "relative closure {:.3g}\n", here, all.budget.drive_work, all.budget.collisional_loss,
+                    all.budget.energy_change, all.budget.relative_residual);
   terminal_log::say(stdout, "  overlaps at end: {}; event queue consistent: {}\n", count(all.overlaps),
                     all.queue_consistent ? "yes" : "NO");
   terminal_log::say(stdout, "  output: {}\n", run.output);
   if (frames > 0)
     terminal_log::say(stdout, "  particle snapshots: {} frames in {} and {}\n", frames,
                       particle_h5_path(run.output).string(), particle_xyz_path(run.output).string());
-  const bool ok = all.overlaps == 0 && all.queue_consistent && all.budget.relative_closure <= 1e-9;
+  const bool ok = all.overlaps == 0 && all.queue_consistent && all.budget.relative_residual <= 1e-9;
   if (!ok) terminal_log::say(stderr, "shaker md: end-of-run invariant check FAILED (see summary)\n");
   return ok ? 0 : 1;
 }

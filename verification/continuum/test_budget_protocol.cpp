@@ -1,6 +1,6 @@
 // Energy budget and the single-shock protocol through the run driver.
 //  - The budget columns of the series (container frame): frame_energy(t) - frame_energy(0) =
-//    accumulated_body_work - accumulated_collisional_loss + accumulated_floor_energy. The terms
+//    accumulated_drive_work - accumulated_collisional_loss + accumulated_floor_energy. The terms
 //    are accumulated with the Runge–Kutta stage weights, so the discrete budget closes to
 //    round-off at every resolution: the residual must stay below 1e-10 of the energy that
 //    flowed through the layer (work done plus energy lost), for the explicit and the split
@@ -34,7 +34,7 @@ BudgetCheck budget_of_run(const std::filesystem::path& dir, double cell_size, co
   EXPECT_EQ(run(c), 0);
   const RunRecord r = read_run_file(dir / "run.h5");
   const auto& residual = r.series.column("energy_budget_residual");
-  const auto& work = r.series.column("accumulated_body_work");
+  const auto& work = r.series.column("accumulated_drive_work");
   const auto& loss = r.series.column("accumulated_collisional_loss");
   const auto& floor = r.series.column("accumulated_floor_energy");
   BudgetCheck b;

@@ -18,6 +18,7 @@ constexpr int phases = 10, transient = 2, sampled = 2;
 /// Time-series columns counted from the start of each run or compared with rows before it.
 bool run_relative(const std::string& column) {
   return column == "com_z_change_from_previous_cycle" || column == "energy_budget_residual" ||
+         column == "energy_budget_relative_residual" ||
          column == "periodicity_last_two_cycles";
 }
 

@@ -63,7 +63,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // continuum_case allocates a probe of the whole grid after the memory check against the
     // machine's free memory, which allows far more than the fuzzer's RSS limit: a grid beyond
     // a million cells is a legitimate large run here, not a finding (the memory check itself
-    // is a row of verification/unit/bad_input_cases.toml).
+    // is a row of verification/programs/bad_input_cases.toml).
     if (continuum_cells(config) <= 1e6) shaker::continuum::continuum_case(config);
     // The stored configuration of an output file is read back with from_toml: it must round-trip.
     shaker::config::Config::from_toml(config.to_toml(), "round trip");

@@ -17,7 +17,7 @@ constexpr int phases = 10, transient = 2, sampled = 3;
 
 /// Time-series columns counted from the start of each run (README, "Continuing").
 bool run_relative(const std::string& column) {
-  for (const char* name : {"plate_work", "collisional_loss", "energy_closure", "collisions"})
+  for (const char* name : {"energy_budget_residual", "energy_budget_relative_residual", "collisions"})
     if (column == name) return true;
   return column.rfind("crossings_z", 0) == 0 || column.rfind("particles_z", 0) == 0;
 }

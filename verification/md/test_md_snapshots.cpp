@@ -90,7 +90,7 @@ TEST(MdSnapshots, TwoPhasesTimesTwoCyclesGiveFourFramesAtTheRunFilesInstants) {
   EXPECT_EQ(f.phase, (std::vector<double>{0.0, 0.5, 0.0, 0.5}));
   const auto& t = record.series.column("t");
   const auto& com = record.series.column("com_z");
-  const auto& kinetic = record.series.column("kinetic");
+  const auto& kinetic = record.series.column("kinetic_energy");
   const auto& plate = record.series.column("plate_z");
   double worst_com = 0.0, worst_kinetic = 0.0;
   for (std::size_t k = 0; k < 4; ++k) {
@@ -205,11 +205,11 @@ TEST(MdSnapshots, ARunStartsFromAFrameAtItsTime) {
   const double com = frame_mean(f.r, f.particles, 2, 2);
   std::printf("measured: frame 2 at t = %.10g, com_z %.12g; the new run's first row t = %.10g, com_z %.12g, "
               "kinetic %.12g (frame %.12g)\n", f.time[2], com, second.series.column("t")[0],
-              second.series.column("com_z")[0], second.series.column("kinetic")[0], frame_kinetic(f, 2));
+              second.series.column("com_z")[0], second.series.column("kinetic_energy")[0], frame_kinetic(f, 2));
   EXPECT_EQ(second.series.column("t")[0], f.time[2]);
   EXPECT_EQ(second.series.column("com_z")[0], com);
   EXPECT_EQ(second.series.column("com_z")[0], first.series.column("com_z")[phases]);
-  EXPECT_EQ(second.series.column("kinetic")[0], frame_kinetic(f, 2));
+  EXPECT_EQ(second.series.column("kinetic_energy")[0], frame_kinetic(f, 2));
   // The last frame (the default) lies mid-cycle: the run goes on to the next whole cycle first.
   ASSERT_EQ(run(small_case(dir / "third.h5", {"md.initial_state=file", "md.initial_file=" +
                                                (dir / "first.particles.h5").string()})),

@@ -62,7 +62,7 @@ TEST(MdVibrated, BaseCaseSmoke) {
       ++phases_with_shock;
       first_shock = std::min(first_shock, p.phase);
     }
-  const double closure = record.series.column("energy_closure").back();
+  const double closure = record.series.column("energy_budget_relative_residual").back();
   const double overlaps = record.series.column("overlaps").back();
   std::printf("measured: %d/20 cycles in flight, %d/20 with contact, shock at %d phases in "
               "[0.1, 0.4] from f t = %.2f, closure %.3g, overlaps %g\n", cycles_with_flight,
@@ -83,8 +83,8 @@ TEST(MdVibrated, EnergyBudgetClosesWithVelocityDependentRestitution) {
   ASSERT_EQ(run(c), 0);
   const RunRecord record = read_run_file(dir / "vd.h5");
   double worst = 0.0;
-  for (double x : record.series.column("energy_closure")) worst = std::max(worst, x);
-  const double work = record.series.column("plate_work").back();
+  for (double x : record.series.column("energy_budget_relative_residual")) worst = std::max(worst, x);
+  const double work = record.series.column("accumulated_drive_work").back();
   std::printf("measured: largest relative closure %.3g (plate work %.6g)\n", worst, work);
   EXPECT_LT(worst, 1e-9);
   EXPECT_GT(work, 1e4);  // the plate did work
@@ -513,7 +513,7 @@ TEST(MdVibrated, SingleShockSwitchesRestitutionAtTheGivenPhase) {
   EXPECT_EQ(record.profiles.size(), 50u);
   EXPECT_EQ(record.e, 1.0);
   const auto& t = record.series.column("t");
-  const auto& loss = record.series.column("collisional_loss");
+  const auto& loss = record.series.column("accumulated_collisional_loss");
   const double switch_time = (2.0 - 0.33) / 0.095;
   // Before the switch the layer dissipates; after it only wall-rule rounding remains.
   double before = 0.0, after = 0.0;

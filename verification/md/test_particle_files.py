@@ -69,7 +69,7 @@ def test_h5md_layout(shaker, work_dir):
         assert list(box["edges"][()]) == [WIDTH, WIDTH, CEILING]
         # Provenance as the run file has it.
         assert f.attrs["solver"] == "md" and f.attrs["kind"] == "shaker md particles"
-        assert int(f.attrs["schema_version"]) == 1
+        assert int(f.attrs["schema_version"]) == 2
         configuration = tomllib.loads(f.attrs["configuration"])
         assert configuration["md"]["snapshot_cycles"] == [0.0, -1.0]
         for element, units in [("particles/all/position", "sigma"),

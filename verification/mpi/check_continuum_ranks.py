@@ -132,13 +132,14 @@ phases_per_cycle = 4
 seed = 3
 """
 IGNORED_ATTRIBUTES = {"created", "configuration"}
-BUDGET = {"timeseries/accumulated_body_work", "timeseries/accumulated_collisional_loss",
+BUDGET = {"timeseries/accumulated_drive_work", "timeseries/accumulated_collisional_loss",
           "timeseries/accumulated_floor_energy", "timeseries/energy_budget_residual",
-          "energy_budget"}
-BUDGET_SCALE = ("timeseries/frame_energy", "timeseries/accumulated_body_work",
+          "timeseries/energy_budget_relative_residual", "energy_budget"}
+BUDGET_SCALE = ("timeseries/frame_energy", "timeseries/accumulated_drive_work",
                 "timeseries/accumulated_collisional_loss")
 # Time-series columns that count from the start of each run: a continued run starts afresh.
 RUN_RELATIVE = {"timeseries/com_z_change_from_previous_cycle", "timeseries/energy_budget_residual",
+                "timeseries/energy_budget_relative_residual",
                 "timeseries/periodicity_last_two_cycles"}
 TOLERANCE = 1e-12
 

@@ -12,7 +12,8 @@ the file, the time series covers every cycle either way).
 
 MD invariants, each at every row:
   overlaps == 0          no pair closer than 1 - 1e-9 (the solver's own overlap count)
-  energy_closure <= 1e-9 |energy change + loss - work| / max(|work|, |loss|, |energy|): the
+  energy_budget_relative_residual <= 1e-9
+                         |energy change + loss - work| / max(|work|, |loss|, |energy|): the
                          bound `shaker md` applies at the end of a run (exit 1 above it). The
                          event-driven dynamics is exact between collisions, so the budget closes
                          to round-off of the running sums (measured 1e-13 .. 1e-12).
@@ -23,7 +24,7 @@ Continuum invariants, each at every row:
                          the bound of the 1D multi-cycle continuum test (verification/
                          continuum/test_runs.cpp).
   |energy_budget_residual| <= 1e-10 * throughput   throughput: the total variation of the
-                         accumulated body work plus the accumulated collisional loss up to the
+                         accumulated drive work plus the accumulated collisional loss up to the
                          row (the residual is zero at the first row by definition); the bound
                          of verification/continuum/test_budget_protocol.cpp, there applied to
                          the largest residual against the whole run's throughput.
@@ -59,15 +60,17 @@ def first_failure(name, values, ok):
 def check_md(series):
     failures = []
     overlaps = series["overlaps"]
-    closure = series["energy_closure"]
+    closure = series["energy_budget_relative_residual"]
     consistent = series["queue_consistent"]
     failures.append(first_failure("overlaps (allowed 0)", overlaps, overlaps == 0))
-    failures.append(first_failure(f"energy_closure (allowed <= {ENERGY_CLOSURE_BOUND:g})",
-                                  closure, closure <= ENERGY_CLOSURE_BOUND))
+    failures.append(first_failure(
+        f"energy_budget_relative_residual (allowed <= {ENERGY_CLOSURE_BOUND:g})", closure,
+        closure <= ENERGY_CLOSURE_BOUND))
     failures.append(first_failure("queue_consistent (allowed 1)", consistent, consistent == 1))
     worst = float(np.max(closure)) if closure.size else math.nan
-    summary = (f"{closure.size} rows; overlaps max {float(np.max(overlaps)):g}; energy_closure max "
-               f"{worst:.3g}; queue_consistent min {float(np.min(consistent)):g}; "
+    summary = (f"{closure.size} rows; overlaps max {float(np.max(overlaps)):g}; "
+               f"energy_budget_relative_residual max {worst:.3g}; "
+               f"queue_consistent min {float(np.min(consistent)):g}; "
                f"pair collisions {float(series['collisions'][-1]):.0f}")
     return [f for f in failures if f], summary
 
@@ -78,7 +81,7 @@ def check_continuum(series):
     drift = np.abs(mass - mass[0]) / mass[0]
     failures.append(first_failure(f"total_mass relative drift (allowed <= {MASS_DRIFT_BOUND:g})",
                                   drift, drift <= MASS_DRIFT_BOUND))
-    work = series["accumulated_body_work"]
+    work = series["accumulated_drive_work"]
     loss = series["accumulated_collisional_loss"]
     throughput = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(work)))]) + (loss - loss[0])
     residual = np.abs(series["energy_budget_residual"])

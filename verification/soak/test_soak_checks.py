@@ -21,14 +21,15 @@ def write(path, columns, phases):
 
 def md_series(rows):
     return {"t": np.arange(rows, dtype=float), "overlaps": np.zeros(rows),
-            "energy_closure": np.full(rows, 1e-13), "queue_consistent": np.ones(rows),
+            "energy_budget_relative_residual": np.full(rows, 1e-13),
+            "queue_consistent": np.ones(rows),
             "collisions": np.arange(rows) * 100.0}
 
 
 def continuum_series(rows):
     work = np.linspace(0.0, 50.0, rows)
     return {"t": np.arange(rows, dtype=float), "total_mass": np.full(rows, 9.8),
-            "accumulated_body_work": work, "accumulated_collisional_loss": work * 0.9,
+            "accumulated_drive_work": work, "accumulated_collisional_loss": work * 0.9,
             # zero at the first row by definition (relative to it), round-off after
             "energy_budget_residual": np.concatenate([[0.0], np.full(rows - 1, 1e-14)]),
             "com_z_change_from_previous_cycle": np.full(rows, np.nan)}
@@ -49,13 +50,15 @@ CASES = [
     ("md clean", "md", md_series(MD_ROWS), MD_ROWS, None),
     ("md overlap", "md", broken(md_series(MD_ROWS), "overlaps", 5, 1), MD_ROWS,
      "first at row 5"),
-    ("md closure", "md", broken(md_series(MD_ROWS), "energy_closure", 3, 2e-9), MD_ROWS,
-     "energy_closure (allowed <= 1e-09): 1 rows fail, the first at row 3"),
+    ("md closure", "md",
+     broken(md_series(MD_ROWS), "energy_budget_relative_residual", 3, 2e-9), MD_ROWS,
+     "energy_budget_relative_residual (allowed <= 1e-09): 1 rows fail, the first at row 3"),
     ("md queue", "md", broken(md_series(MD_ROWS), "queue_consistent", 7, 0), MD_ROWS,
      "queue_consistent (allowed 1): 1 rows fail, the first at row 7"),
     ("md missing row", "md", md_series(MD_ROWS - 1), MD_ROWS, "has 8 rows, expected 9"),
-    ("md NaN", "md", broken(md_series(MD_ROWS), "energy_closure", 2, np.nan), MD_ROWS,
-     "energy_closure (allowed finite)"),
+    ("md NaN", "md",
+     broken(md_series(MD_ROWS), "energy_budget_relative_residual", 2, np.nan), MD_ROWS,
+     "energy_budget_relative_residual (allowed finite)"),
     ("continuum clean", "continuum", continuum_series(CONTINUUM_ROWS), CONTINUUM_ROWS, None),
     ("continuum mass", "continuum",
      broken(continuum_series(CONTINUUM_ROWS), "total_mass", 4, factor=1 + 1e-11), CONTINUUM_ROWS,

@@ -12,6 +12,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "common/atomic_output.hpp"
 #include "common/config.hpp"
@@ -296,6 +297,35 @@ std::filesystem::path damaged_copy(const TemporaryDirectory& dir, const std::str
   damage(file);
   H5Fclose(file);
   return path;
+}
+
+TEST(RunFile, Version1SeriesColumnsAreReadUnderTheirPresentNames) {
+  const TemporaryDirectory dir;
+  RunRecord record = make_sample_record(true);
+  record.solver = "md";
+  record.series.add("kinetic_energy", {1.0, 2.0, 3.0, 4.0});
+  record.series.add("accumulated_drive_work", {0.0, 0.5, 1.5, 2.5});
+  record.series.add("accumulated_collisional_loss", {0.0, 0.25, 0.75, 1.0});
+  record.series.add("energy_budget_relative_residual", {0.0, 1e-15, 2e-15, 1e-15});
+  const auto path = damaged_copy(
+      dir, "version-1.h5",
+      [](hid_t f) {
+        shaker::h5::write_attribute(f, "schema_version", std::int64_t{1});
+        const hid_t g = H5Gopen2(f, "timeseries", H5P_DEFAULT);
+        for (const auto& [present, old] : {std::pair{"kinetic_energy", "kinetic"}, {"accumulated_drive_work", "plate_work"},
+                                           {"accumulated_collisional_loss", "collisional_loss"},
+                                           {"energy_budget_relative_residual", "energy_closure"}})
+          H5Lmove(g, present, g, old, H5P_DEFAULT, H5P_DEFAULT);
+        shaker::h5::write_attribute(g, "columns", std::string("t,phase,plate_z,com_z,kinetic,plate_work,"
+                                                              "collisional_loss,energy_closure"));
+        H5Gclose(g);
+      },
+      record);
+  const RunRecord read = shaker::read_run_file(path);
+  EXPECT_EQ(read.schema_version, 1);
+  EXPECT_EQ(read.series.names, record.series.names);
+  for (const std::string& name : record.series.names)
+    expect_same_bits(read.series.column(name), record.series.column(name), name);
 }
 
 TEST(RunFile, ReadingForeignOrDamagedFilesThrowsInputError) {

@@ -53,7 +53,7 @@ def test_run_file_read_by_h5py(sample_writer, work_dir):
         "only the final file exists after the write"
     with h5py.File(path, "r") as f:
         a = f.attrs
-        assert int(a["schema_version"]) == 1, f"schema_version {a['schema_version']}"
+        assert int(a["schema_version"]) == 2, f"schema_version {a['schema_version']}"
         for name in ("program_version", "git_commit", "created", "solver", "model_variant",
                      "configuration"):
             assert isinstance(a[name], str) and a[name] != "", f"attribute {name} is text"

@@ -20,6 +20,7 @@ import pytest
 from granular_shaker.reports import (figure_rules, make_base_case_report as base,
                                      make_benchmark_report as bench,
                                      make_convergence_report as conv,
+                                     make_pattern_report as patterns,
                                      make_sensitivity_report as sens,
                                      make_validation_report as val)
 
@@ -28,7 +29,7 @@ from . import test_base_case_report, test_benchmark_report, test_convergence_rep
 
 PACKAGE = os.path.dirname(os.path.abspath(figure_rules.__file__))
 REPORTS = os.path.join(REPOSITORY, "reports")
-GENERATORS = (base, bench, conv, sens, val)
+GENERATORS = (base, bench, conv, patterns, sens, val)
 FIGURE_PREFIX = "figure_"
 PYPLOT_DRAWING_CALLS = {"subplots", "figure", "subplot_mosaic", "subplot"}
 TABLES = os.path.join(REPORTS, "convergence-tables")
@@ -224,6 +225,13 @@ FIGURE_CASES = {
     "make_benchmark_report.figure_history": lambda i: [
         bench.figure_history(i.benchmark, bench.throughput_series(i.benchmark)),
         bench.figure_history(i.benchmark[1:2], {})],
+    "make_pattern_report.figure_order_parameter": lambda i: [patterns.figure_order_parameter({
+        "pattern_md_f0p25": {"points": [dict(gamma=g, order=m, order_error=0.02) for g, m in
+                                        zip((2.0, 2.4, 2.8, 3.2), (0.3, 0.32, 0.6, 0.8))],
+                             "onset": dict(gamma_c=2.5, floor=0.09, slope=0.6)},
+        "pattern_md_f0p40": {"points": [dict(gamma=g, order=0.3, order_error=0.02)
+                                        for g in (2.0, 2.4, 2.8, 3.2)],
+                             "onset": dict(reason="no onset")}})],
     "make_sensitivity_report.figure_variants":
         lambda i: [sens.figure_variants(i.sensitivity[0])],
     "make_sensitivity_report.figure_knudsen_maps":

@@ -39,8 +39,9 @@ CASES = {
 # Time-series columns that count from the start of each run (docs/output-schema.md), or that
 # compare with rows before it: a continued run starts them afresh, so they are not compared.
 RUN_RELATIVE = {
-    "md": {"plate_work", "collisional_loss", "energy_closure", "collisions"},
+    "md": {"energy_budget_residual", "energy_budget_relative_residual", "collisions"},
     "continuum": {"com_z_change_from_previous_cycle", "energy_budget_residual",
+                  "energy_budget_relative_residual",
                   "periodicity_last_two_cycles"},
 }
 RUN_RELATIVE_PREFIXES = ("crossings_z", "particles_z")

@@ -1,0 +1,229 @@
+"""The onset-of-patterns sweep: every pattern case at every Gamma and seed, analysed for
+patterns, the onset fitted (docs/patterns.md).
+
+    shaker-patterns --shaker build/release/solvers/app/shaker [--study reduced|full]
+        [--workdir DIR] [--jobs 2] [--results DIR/patterns.json] [--report reports/patterns.md]
+        [--reuse-only] [--repository DIR]
+
+(or `python3 -m granular_shaker.patterns.sweep ...`). The sweep is read from
+validation/patterns.toml. Runs are keyed by their effective configuration as the validation
+study keys them (granular_shaker.validation.plan.run_key), so an interrupted sweep resumes
+where it stopped; each finished run is analysed once by `shaker analyze RUN.h5 --patterns`,
+its table kept beside the run file.
+
+Per point (case, Gamma): the saturated order parameter of the column mass (the mean over the
+sampled frames at the stored phase with the larger pattern) with its standard error, the
+wavelength, the angular moments and the cycle-to-cycle correlation. With several seeds the
+point's value is the mean over seeds and its error their standard error (independent runs);
+with one seed, the standard error over its frames. Per case: the onset fit
+(granular_shaker.patterns.onset.fit_onset) and, below that onset, the Swift-Hohenberg fit.
+
+Exit status 0 when the results are written; 1 if a run or an analysis failed; 2 for bad
+arguments.
+"""
+import argparse
+import csv
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg
+from granular_shaker.repository import (add_repository_option, fill_missing_paths,
+                                        repository_argument)
+from granular_shaker.validation.plan import case_file, load_toml
+from granular_shaker.validation.run import execute_all, log
+from granular_shaker.validation.summary import git, write_json_atomically
+
+SWEEP_FILE = os.path.join("validation", "patterns.toml")
+FIELD = "mass"  # the column mass: its noise is the counts' (docs/analysis.md "Patterns")
+
+
+def load_sweep(repository, name):
+    """The named sweep of validation/patterns.toml; ValueError names what is wrong."""
+    studies = load_toml(os.path.join(repository, SWEEP_FILE))["study"]
+    if name not in studies:
+        raise ValueError(f"--study {name}: allowed: {', '.join(sorted(studies))} "
+                         f"({SWEEP_FILE})")
+    sweep = studies[name]
+    for key in ("cases", "gamma", "seeds", "overrides", "timeout"):
+        if key not in sweep:
+            raise ValueError(f"{SWEEP_FILE} [study.{name}] has no '{key}'")
+    for case in sweep["cases"]:
+        if not os.path.isfile(case_file(repository, case)):
+            raise ValueError(f"{SWEEP_FILE} [study.{name}]: no case file for '{case}'")
+    if sorted(set(sweep["gamma"])) != list(sweep["gamma"]) or len(sweep["gamma"]) < 5:
+        raise ValueError(f"{SWEEP_FILE} [study.{name}]: gamma must be increasing, at least 5")
+    return sweep
+
+
+def plan_points(repository, sweep):
+    """One run per case, Gamma and seed, in the run dicts of the validation study."""
+    plan = []
+    for case in sweep["cases"]:
+        for gamma in sweep["gamma"]:
+            for seed in sweep["seeds"]:
+                plan.append(dict(case=case, case_file=case_file(repository, case),
+                                 solver="md", replicas=1, gamma=gamma, seed=seed,
+                                 overrides=[f"shaker.gamma={gamma}", f"run.seed={seed}",
+                                            *sweep["overrides"]],
+                                 timeout=sweep["timeout"], fallback=[], expect_failure=False))
+    return plan
+
+
+def analyze(shaker, record):
+    """The pattern table of a finished run (made once, kept beside the run file); None and a
+    reason when there is none."""
+    if record["status"] != "ok":
+        return None, f"run {record['status']}"
+    table = record["path"] + ".patterns.csv"
+    if not os.path.exists(table):
+        result = subprocess.run([shaker, "analyze", record["path"], "--patterns",
+                                 table + ".partial"], capture_output=True, text=True)
+        if result.returncode != 0:
+            return None, f"shaker analyze --patterns exited {result.returncode}: " \
+                         f"{result.stderr.strip()[-500:]}"
+        os.replace(table + ".partial", table)
+    return table, None
+
+
+def read_table(path):
+    """The pattern table as columns keyed by their names without units."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    columns = {}
+    for header in rows[0] if rows else []:
+        name = header.split(" [")[0]
+        values = [row[header] for row in rows]
+        try:
+            columns[name] = np.array([float(v) for v in values])
+        except ValueError:
+            columns[name] = np.array(values)
+    return columns
+
+
+def frame_summary(columns):
+    """The run's saturated pattern: at the stored phase with the larger mean order parameter,
+    the means over its frames and their standard errors."""
+    phases = np.unique(columns["phase"])
+    best = None
+    for phase in phases:
+        at = columns["phase"] == phase
+        order = columns[f"{FIELD}_order_parameter"][at]
+        if best is None or order.mean() > best["order"]:
+            best = dict(phase=float(phase), frames=int(at.sum()), order=float(order.mean()),
+                        order_error=float(order.std(ddof=1) / np.sqrt(order.size))
+                        if order.size > 1 else float("nan"))
+            for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
+                values = columns[f"{FIELD}_{name}"][at]
+                values = values[np.isfinite(values)]
+                best[name] = float(values.mean()) if values.size else float("nan")
+    return best
+
+
+def point_summary(runs):
+    """A point (case, Gamma) from its runs' summaries: the mean over seeds, their standard
+    error (one seed: its frames' standard error)."""
+    order = np.array([r["order"] for r in runs])
+    if order.size > 1:
+        error = float(order.std(ddof=1) / np.sqrt(order.size))
+    else:
+        error = runs[0]["order_error"]
+    point = dict(order=float(order.mean()), order_error=error, seeds=len(runs))
+    for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
+        point[name] = float(np.mean([r[name] for r in runs]))
+    return point
+
+
+def fits(points):
+    """The onset and Swift-Hohenberg fits of one case's points, or the reason there are none."""
+    usable = [p for p in points if np.isfinite(p["order_error"]) and p["order_error"] > 0]
+    gamma = np.array([p["gamma"] for p in usable])
+    order = np.array([p["order"] for p in usable])
+    error = np.array([p["order_error"] for p in usable])
+    out = {}
+    try:
+        onset = fit_onset(gamma, order, error)
+        out["onset"] = vars(onset)
+    except (NoOnset, ValueError) as reason:
+        out["onset"] = dict(reason=str(reason))
+        return out
+    try:
+        below = onset.gamma_c - onset.gamma_c_error
+        out["swift_hohenberg"] = vars(fit_swift_hohenberg(gamma, order, error, below))
+    except (NoOnset, ValueError) as reason:
+        out["swift_hohenberg"] = dict(reason=str(reason))
+    return out
+
+
+def collect(shaker, plan):
+    """Every case's points and fits from the finished runs; the failures met."""
+    failures, cases = [], {}
+    for run in plan:
+        table, reason = analyze(shaker, run["record"])
+        if table is None:
+            failures.append(f"{run['case']} Gamma {run['gamma']} seed {run['seed']}: {reason}")
+            continue
+        run["summary"] = frame_summary(read_table(table))
+    for case in dict.fromkeys(r["case"] for r in plan):
+        points = []
+        for gamma in dict.fromkeys(r["gamma"] for r in plan if r["case"] == case):
+            runs = [r["summary"] for r in plan
+                    if r["case"] == case and r["gamma"] == gamma and "summary" in r]
+            if runs:
+                points.append(dict(gamma=gamma, **point_summary(runs)))
+        cases[case] = dict(points=points, **fits(points))
+    return cases, failures
+
+
+def parse_arguments(argv):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--shaker", required=True, help="the shaker program")
+    parser.add_argument("--study", default="reduced", help="a sweep of validation/patterns.toml")
+    parser.add_argument("--workdir", help="runs and results (default: validation/work/patterns)")
+    parser.add_argument("--jobs", type=int, default=1, help="runs side by side (>= 1)")
+    parser.add_argument("--results", help="the results JSON (default: WORKDIR/patterns.json)")
+    parser.add_argument("--report", help="also write the report here (reports/patterns.md)")
+    parser.add_argument("--reuse-only", action="store_true", help="judge finished runs only")
+    add_repository_option(parser)
+    args = parser.parse_args(argv)
+    repository = repository_argument(parser, args)
+    if args.jobs < 1:
+        parser.error(f"--jobs {args.jobs}: allowed: >= 1")
+    fill_missing_paths(args, {"workdir": os.path.join(repository, "validation", "work",
+                                                      "patterns")})
+    args.results = args.results or os.path.join(args.workdir, "patterns.json")
+    try:
+        sweep = load_sweep(repository, args.study)
+    except ValueError as error:
+        parser.error(str(error))
+    return args, repository, sweep
+
+
+def main(argv=None):
+    args, repository, sweep = parse_arguments(argv)
+    os.makedirs(os.path.join(args.workdir, "runs"), exist_ok=True)
+    start = time.monotonic()
+    plan = execute_all(args.shaker, args.workdir, plan_points(repository, sweep), args.jobs,
+                       rerun=False, reuse_only=args.reuse_only)
+    cases, failures = collect(args.shaker, plan)
+    results = dict(study=args.study, sweep=sweep, commit=git(repository, "rev-parse", "HEAD"),
+                   seconds=time.monotonic() - start, cases=cases, failures=failures,
+                   runs=[dict(case=r["case"], gamma=r["gamma"], seed=r["seed"],
+                              status=r["record"]["status"], seconds=r["record"]["seconds"],
+                              reused=r["record"].get("reused", False)) for r in plan])
+    write_json_atomically(args.results, results)
+    log(f"wrote {args.results}")
+    if args.report:
+        from granular_shaker.reports import make_pattern_report
+        make_pattern_report.write(results, repository, args.report)
+        log(f"wrote {args.report}")
+    for failure in failures:
+        print(f"shaker-patterns: {failure}", file=sys.stderr)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
