@@ -17,6 +17,18 @@ from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
 CLAIMS = os.path.join("reference-data", "pattern-claims.toml")
+# A point shows an ordered standing wave when its spectrum's angular moments name stripes (A2,
+# docs/analysis.md "Patterns": the symmetry threshold) and its pattern inverts from one cycle to
+# the next (the subharmonic response).
+STRIPES_A2 = 0.5
+SUBHARMONIC_CORRELATION = -0.5
+
+
+def ordered(point):
+    return (point["a2"] >= STRIPES_A2
+            and point["correlation_previous_cycle"] <= SUBHARMONIC_CORRELATION)
+
+
 FIGURES = "patterns"  # beside the report
 
 
@@ -56,6 +68,11 @@ def claim_verdicts(claims, cases):
                             "fitted noise power dimensionless are not measured"}.get(
                 claim["id"], "the continuum's sweep is not run (its fields are not yet "
                              "analysed for patterns, and a point costs hours on 2 cores)")
+            if claim["id"] == "P1":
+                reason += "; MD: " + "; ".join(
+                    f"{name}: " + (", ".join(f"{p['gamma']:g}" for p in case["points"]
+                                             if ordered(p)) or "none")
+                    for name, case in md.items()) + " (Gamma of ordered stripes)"
         elif claim["id"] == "P9":
             strengths = {name: case.get("swift_hohenberg", {}).get("strength")
                          for name, case in md.items()}
@@ -81,6 +98,16 @@ def case_lines(name, case):
                      f"| {p['seeds']} | {rc.fmt(p['wavelength'])} | {rc.fmt(p['a2'], 3)} | "
                      f"{rc.fmt(p['correlation_previous_cycle'], 3)} |")
     lines.append("")
+    shown = [p["gamma"] for p in case["points"] if ordered(p)]
+    if shown:
+        lines.append(f"- ordered standing waves (A2 >= {STRIPES_A2}, cycle-to-cycle correlation "
+                     f"<= {SUBHARMONIC_CORRELATION}) at Gamma "
+                     + ", ".join(f"{g:g}" for g in shown))
+    else:
+        lines.append(f"- no ordered standing wave at any Gamma of the sweep (A2 >= {STRIPES_A2} "
+                     f"with cycle-to-cycle correlation <= {SUBHARMONIC_CORRELATION} nowhere): the "
+                     "order parameter is the layer's disordered fluctuation, and an onset fitted "
+                     "to it is the rise of that noise, not a pattern's onset")
     for model, key, parameter in (("onset fit", "onset", "gamma_c"),
                                   ("Swift-Hohenberg fit below onset", "swift_hohenberg",
                                    "gamma_mf")):

@@ -98,5 +98,6 @@ def test_a_small_sweep_runs_resumes_and_reports(work_dir, shaker):
     text = open(report).read()
     for claim in [f"P{i}" for i in range(1, 10)]:
         assert f"| {claim} (" in text
+    assert ("ordered standing waves (A2" in text) != ("no ordered standing wave" in text)
     assert os.path.exists(os.path.join(work_dir, make_pattern_report.FIGURES,
                                        "order_parameter.png"))
