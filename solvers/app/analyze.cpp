@@ -16,7 +16,6 @@
 #include "common/output_paths.hpp"
 #include "common/run_file.hpp"
 #include "common/version.hpp"
-#include "md/particle_file.hpp"
 
 namespace shaker {
 namespace {
@@ -236,14 +235,16 @@ int command_analyze(const AnalyzeOptions& o) {
   if (!o.patterns_csv.empty()) {
     if (o.run_files.size() != 1)
       throw InputError(fmt::format("--patterns with {} run files; allowed: one RUN, whose particle "
-                                   "file it reads", o.run_files.size()));
-    inputs.push_back({"particle file", md::particle_h5_path(o.run_files.front())});
+                                   "or fields file it reads", o.run_files.size()));
+    inputs.push_back({"snapshot file (RUN.particles.h5 of shaker md with md.snapshot_phases, or "
+                      "RUN.fields.h5 of a 3D shaker continuum with continuum.field_phases)",
+                      pattern_snapshots_path(o.run_files.front())});
     check_input_file(inputs.back());
   }
   check_output_paths(outputs, inputs);
   std::vector<RunRecord> runs;
   for (const auto& file : o.run_files) runs.push_back(read_run_file(file));
-  // Read before anything is printed or written: a bad particle file is bad input.
+  // Read before anything is printed or written: a bad snapshot file is bad input.
   const PatternTables patterns =
       o.patterns_csv.empty() ? PatternTables{} : pattern_tables(inputs.back().path, o.pattern_cell);
   const RunRecord run = pool_runs(runs);

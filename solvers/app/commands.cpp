@@ -115,10 +115,12 @@ CLI::App* add_analyze_subcommand(CLI::App& app, AnalyzeOptions& options) {
   analyze->add_option("--pooled", options.pooled_file,
                       "also write the pooled run (profiles and samples of all RUNs) to this file");
   auto* patterns = analyze->add_option("--patterns", options.patterns_csv,
-                      "also write the pattern quantities of the run's particle file (RUN.particles.h5), "
-                      "one row per frame, as CSV (one RUN only)");
+                      "also write the pattern quantities of the run's particle file (RUN.particles.h5) "
+                      "or, for a 3D continuum run, its fields file (RUN.fields.h5), one row per frame, "
+                      "as CSV (one RUN only)");
   analyze->add_option("--pattern-cell", options.pattern_cell,
-                      "with --patterns: width of the cells the particles are binned on (sigma)")
+                      "with --patterns: width of the cells the particles are binned on (sigma; the "
+                      "continuum's fields keep their own cells)")
       ->check(finite_between(0.01, 1e6))->capture_default_str()->needs(patterns);
   analyze->add_flag("--quiet", options.quiet, "print nothing (with --csv, --json, --profiles-csv, --pooled or --patterns)");
   analyze->add_option("--relative-drop", options.criteria.relative_drop,

@@ -40,21 +40,25 @@ int command_config(const RunOptions& options);
 struct AnalyzeOptions {
   std::vector<std::string> run_files;  ///< one run, or runs of one configuration to pool
   std::string csv_file, json_file, profiles_csv, pooled_file;
-  /// --patterns: the pattern quantities of the run's particle file, per frame, as CSV
+  /// --patterns: the pattern quantities of the run's particle or fields file, per frame, as CSV
   std::string patterns_csv;
-  double pattern_cell = 2.0;  ///< --pattern-cell: width of the pattern grid's cells (sigma)
+  double pattern_cell = 2.0;  ///< --pattern-cell: width of the MD pattern grid's cells (sigma)
   analysis::ShockCriteria criteria;
   bool quiet = false;
 };
 CLI::App* add_analyze_subcommand(CLI::App& app, AnalyzeOptions& options);
 int command_analyze(const AnalyzeOptions& options);
-/// The pattern quantities (docs/analysis.md, "Patterns") of every frame of the MD particle
-/// file `particles` on cells about `cell` wide: a CSV row per frame, and summary lines (means
-/// over the frames of each stored phase) for the printed table.
+/// The pattern quantities (docs/analysis.md, "Patterns") of every frame of `snapshots`: an MD
+/// particle file, binned on cells about `cell` wide, or a 3D continuum fields file, on its own
+/// cells: a CSV row per frame, and summary lines (means over the frames of each stored phase)
+/// for the printed table.
 struct PatternTables {
   std::string csv, summary;
 };
-PatternTables pattern_tables(const std::filesystem::path& particles, double cell);
+PatternTables pattern_tables(const std::filesystem::path& snapshots, double cell);
+/// The snapshots --patterns reads for a run file: RUN.particles.h5, or RUN.fields.h5 where
+/// only that exists.
+std::filesystem::path pattern_snapshots_path(const std::filesystem::path& run_file);
 int command_describe(bool markdown);  ///< shaker config --describe [--markdown]
 struct CompareOptions {
   std::string first, second, csv_file;

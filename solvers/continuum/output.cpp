@@ -169,8 +169,6 @@ std::vector<double> velocity_vectors(const FieldSnapshot& f) {
   return v;
 }
 
-std::string snapshot_group(std::size_t s) { return fmt::format("snapshot_{:03d}", s); }
-
 /// The XDMF 3 sidecar: a temporal collection of the snapshots, each an unstructured grid of the
 /// shared hexahedra on its own corners, fields cell-centred; `file` is the HDF5 file's name.
 std::string xdmf_text(const std::string& file, const Grid& g,
@@ -180,7 +178,7 @@ std::string xdmf_text(const std::string& file, const Grid& g,
   std::string xdmf = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
                      "<Grid Name=\"fields\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (std::size_t s = 0; s < snapshots.size(); ++s) {
-    const std::string group = snapshot_group(s);
+    const std::string group = fields_snapshot_group(s);
     // Time in shortest round-trip form, so that a reader gets the stored double.
     xdmf += fmt::format("<Grid Name=\"{}\" GridType=\"Uniform\">\n<Time Value=\"{}\"/>\n"
                         "<Topology TopologyType=\"Hexahedron\" NumberOfElements=\"{}\">\n",
@@ -220,7 +218,7 @@ void write_fields(const std::filesystem::path& h5_path, const Grid& g,
     h5::write(root, "hexahedra", hexahedra(g), {g.interior_cells(), 8}, "1");
     for (std::size_t s = 0; s < snapshots.size(); ++s) {
       const FieldSnapshot& f = snapshots[s];
-      h5::Handle group = h5::create_group(root, snapshot_group(s));
+      h5::Handle group = h5::create_group(root, fields_snapshot_group(s));
       h5::write_attribute(group.id(), "time", f.time);
       h5::write_attribute(group.id(), "phase", f.phase);
       h5::write_attribute(group.id(), "plate_z", f.plate_z);
@@ -234,5 +232,7 @@ void write_fields(const std::filesystem::path& h5_path, const Grid& g,
   });
   write_text_atomically(derived_name(h5_path, ".xdmf"), xdmf_text(h5_path.filename().string(), g, snapshots));
 }
+
+std::string fields_snapshot_group(std::size_t s) { return fmt::format("snapshot_{:03d}", s); }
 
 }  // namespace shaker::continuum

@@ -53,6 +53,8 @@ struct FieldSnapshot {
 FieldSnapshot snapshot(const BoxView& box, const ShakerKinematics& shaker, std::int64_t cycle);
 /// Root attribute `kind` of the fields file: a reader of run files refuses it by this.
 inline constexpr const char* fields_file_kind = "shaker continuum fields";
+/// The fields file's group of snapshot s: snapshot_000, snapshot_001, ...
+std::string fields_snapshot_group(std::size_t s);
 /// Writes the fields file (h5_path) and its .xdmf sidecar atomically; the file's root carries
 /// the run file's attributes, from `run` (docs/output-schema.md).
 void write_fields(const std::filesystem::path& h5_path, const Grid& grid,

@@ -66,8 +66,8 @@ def claim_verdicts(claims, cases):
             reason = {"P4": "the experiments' dispersion relation is not yet in reference-data",
                       "P7": "the Swift-Hohenberg coefficients (xi0, tau0, q0) that make the "
                             "fitted noise power dimensionless are not measured"}.get(
-                claim["id"], "the continuum's sweep is not run (its fields are not yet "
-                             "analysed for patterns, and a point costs hours on 2 cores)")
+                claim["id"], "the continuum's sweep is not run (a point of its 64 x 16 box "
+                             "costs hours on 2 cores: docs/patterns.md, Cost)")
             if claim["id"] == "P1":
                 reason += "; MD: " + "; ".join(
                     f"{name}: " + (", ".join(f"{p['gamma']:g}" for p in case["points"]
