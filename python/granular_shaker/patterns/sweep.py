@@ -22,7 +22,6 @@ Exit status 0 when the results are written; 1 if a run or an analysis failed; 2 
 arguments.
 """
 import argparse
-import csv
 import os
 import subprocess
 import sys
@@ -31,6 +30,7 @@ import time
 import numpy as np
 
 from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg
+from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
                                         repository_argument)
 from granular_shaker.validation.plan import case_file, load_toml
@@ -87,21 +87,6 @@ def analyze(shaker, record):
                          f"{result.stderr.strip()[-500:]}"
         os.replace(table + ".partial", table)
     return table, None
-
-
-def read_table(path):
-    """The pattern table as columns keyed by their names without units."""
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    columns = {}
-    for header in rows[0] if rows else []:
-        name = header.split(" [")[0]
-        values = [row[header] for row in rows]
-        try:
-            columns[name] = np.array([float(v) for v in values])
-        except ValueError:
-            columns[name] = np.array(values)
-    return columns
 
 
 def frame_summary(columns):
@@ -166,7 +151,7 @@ def collect(shaker, plan):
         if table is None:
             failures.append(f"{run['case']} Gamma {run['gamma']} seed {run['seed']}: {reason}")
             continue
-        run["summary"] = frame_summary(read_table(table))
+        run["summary"] = frame_summary(read_shaker_csv(table)[0])
     for case in dict.fromkeys(r["case"] for r in plan):
         points = []
         for gamma in dict.fromkeys(r["gamma"] for r in plan if r["case"] == case):

@@ -7,6 +7,7 @@ reason where the sweep does not give the claim's quantity.
         [--repository DIR]
 """
 import argparse
+import json
 import os
 import sys
 import tomllib
@@ -164,7 +165,6 @@ def write(results, repository, output):
 
 
 def main(argv=None):
-    import json
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--results", required=True, help="patterns.json of the sweep")
     parser.add_argument("--output", help="the report (default: reports/patterns.md)")

@@ -4,6 +4,7 @@ units of table headers.
 Nothing under a final output name is ever half-written: text and figures go to a temporary
 name in the same directory and are renamed into place.
 """
+import csv
 import datetime
 import math
 import os
@@ -107,17 +108,25 @@ NU_PER_N = math.pi / 6  # nu = (pi/6) n (docs/analysis.md), so se(nu) = (pi/6) s
 
 
 def read_shaker_csv(path):
-    """A CSV of `shaker analyze` (--csv, --profiles-csv), whose header names each column with
-    its units in brackets ("z [sigma]"): {name: float array}, {name: units}."""
-    with open(path) as f:
-        header = f.readline().rstrip("\n").split(",")
+    """A CSV of `shaker analyze` (--csv, --profiles-csv, --patterns), whose header names each
+    column with its units in brackets ("z [sigma]"; a column of words, such as a symmetry class,
+    has none): {name: array}, {name: units}. Numeric columns are float arrays, others arrays of
+    str."""
+    with open(path, newline="") as f:
+        header, *rows = list(csv.reader(f))
     names, units = [], {}
     for cell in header:
         name, _, unit = cell.partition(" [")
         names.append(name)
         units[name] = unit.rstrip("]")
-    table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    return {name: table[:, i] for i, name in enumerate(names)}, units
+    columns = {}
+    for i, name in enumerate(names):
+        values = [row[i] for row in rows]
+        try:
+            columns[name] = np.array([float(v) for v in values], dtype=float)
+        except ValueError:
+            columns[name] = np.array(values)
+    return columns, units
 
 
 def profile_errors(profiles, k):
