@@ -226,10 +226,10 @@ FIGURE_CASES = {
         bench.figure_history(i.benchmark, bench.throughput_series(i.benchmark)),
         bench.figure_history(i.benchmark[1:2], {})],
     "make_pattern_report.figure_order_parameter": lambda i: [patterns.figure_order_parameter({
-        "pattern_md_f0p25": {"points": [dict(gamma=g, order=m, order_error=0.02) for g, m in
+        "pattern_md_f0p18": {"points": [dict(gamma=g, order=m, order_error=0.02) for g, m in
                                         zip((2.0, 2.4, 2.8, 3.2), (0.3, 0.32, 0.6, 0.8))],
                              "onset": dict(gamma_c=2.5, floor=0.09, slope=0.6)},
-        "pattern_md_f0p40": {"points": [dict(gamma=g, order=0.3, order_error=0.02)
+        "pattern_md_f0p14": {"points": [dict(gamma=g, order=0.3, order_error=0.02)
                                         for g in (2.0, 2.4, 2.8, 3.2)],
                              "onset": dict(reason="no onset")}})],
     "make_sensitivity_report.figure_variants":

@@ -62,11 +62,11 @@ FILES = ALL_FILES - PATTERN_FILES
 LISTED = set(STUDIES["by_name"])
 
 # What every onset-study case must set: the rectangular box of both solvers, the layer depth.
-PATTERN_EXPECTED = {"md.box_width": 64.0, "md.box_depth": 16.0, "layer.particles": 5600,
-                    "run.protocol": "periodic"}
-PATTERN_SOLVER_EXPECTED = {"md": {"md.initial_perturbation": 0.5},
-                           "continuum": {"continuum.dimension": 3, "continuum.box_width": 64.0,
-                                         "continuum.box_depth": 16.0}}
+PATTERN_EXPECTED = {"md.box_width": 128.0, "md.box_depth": 8.0, "layer.particles": 5600,
+                    "run.protocol": "periodic", "material.e": 0.7}
+PATTERN_SOLVER_EXPECTED = {"md": {"md.initial_perturbation": 0.5, "md.collapse_guard": "tc"},
+                           "continuum": {"continuum.dimension": 3, "continuum.box_width": 128.0,
+                                         "continuum.box_depth": 8.0}}
 
 
 def test_case_files_are_the_studies():
@@ -171,8 +171,8 @@ def test_every_case_uses_the_default_continuum_setting(shaker, work_dir):
 def test_pattern_cases_are_accepted_at_every_gamma_of_the_sweep(shaker):
     """Each onset-study case is accepted with the sweep's lowest and highest Gamma, sets the
     rectangular box, and the continuum cases keep the default continuum model."""
-    assert {"pattern_md_f0p25", "pattern_md_f0p40", "pattern_continuum_f0p25",
-            "pattern_continuum_f0p40"} <= PATTERN_FILES
+    assert {"pattern_md_f0p18", "pattern_md_f0p14", "pattern_continuum_f0p18",
+            "pattern_continuum_f0p14"} <= PATTERN_FILES
     problems = []
     for name in sorted(PATTERN_FILES):
         solver = "md" if name.startswith("pattern_md_") else "continuum"

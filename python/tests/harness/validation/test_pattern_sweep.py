@@ -4,6 +4,7 @@ of known values, and a whole sweep of a small box through `shaker`, resumed from
 import json
 import os
 import shutil
+import tomllib
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from .. import REPOSITORY
 
 TINY_SWEEP = """
 [study.tiny]
-cases = ["pattern_md_f0p25"]
+cases = ["pattern_md_f0p18"]
 gamma = [2.0, 2.4, 2.8, 3.2, 3.6]
 seeds = [1]
 overrides = ["layer.particles=300", "md.box_width=16.0", "md.box_depth=8.0",
@@ -28,7 +29,7 @@ def tiny_repository(path):
     """A repository holding what the sweep reads: its definition, the case, the claims."""
     for folder in ("validation/cases", "reference-data"):
         os.makedirs(os.path.join(path, folder))
-    for name in ("validation/studies.toml", "validation/cases/pattern_md_f0p25.toml",
+    for name in ("validation/studies.toml", "validation/cases/pattern_md_f0p18.toml",
                  "reference-data/claims.toml", "reference-data/pattern-claims.toml"):
         shutil.copy(os.path.join(REPOSITORY, name), os.path.join(path, name))
     with open(os.path.join(path, sweep.SWEEP_FILE), "w") as f:
@@ -79,14 +80,14 @@ def test_a_small_sweep_runs_resumes_and_reports(work_dir, shaker):
     assert sweep.main(arguments) == 0
     with open(os.path.join(workdir, "patterns.json")) as f:
         first = json.load(f)
-    points = first["cases"]["pattern_md_f0p25"]["points"]
+    points = first["cases"]["pattern_md_f0p18"]["points"]
     print("measured:", [(p["gamma"], round(p["order"], 4), round(p["order_error"], 4))
                         for p in points])
     assert [p["gamma"] for p in points] == [2.0, 2.4, 2.8, 3.2, 3.6]
     for p in points:
         # 300 particles on 8 x 4 cells: the column mass carries Poisson noise at least
         assert 0.0 < p["order"] < 10.0 and 0.0 < p["order_error"] < p["order"]
-    onset = first["cases"]["pattern_md_f0p25"]["onset"]
+    onset = first["cases"]["pattern_md_f0p18"]["onset"]
     assert "gamma_c" in onset or "does not" in onset["reason"]
     assert all(not r["reused"] for r in first["runs"])
     # Resumed: every run reused, the same numbers.
@@ -101,3 +102,63 @@ def test_a_small_sweep_runs_resumes_and_reports(work_dir, shaker):
     assert ("ordered standing waves (A2" in text) != ("no ordered standing wave" in text)
     assert os.path.exists(os.path.join(work_dir, make_pattern_report.FIGURES,
                                        "order_parameter.png"))
+
+
+def test_the_experiments_wavelength_follows_the_dispersion_relation():
+    relation = dict(offset=1.0, amplitude=2.0, exponent=1.0)
+    # f sqrt(H) = 0.5 * 2 = 1: lambda = H (1 + 2) = 12
+    assert make_pattern_report.experiment_wavelength(relation, 0.5, 4.0) == pytest.approx(12.0)
+    # f sqrt(H) = 0.25 * 2 = 0.5: lambda = 4 (1 + 2 / 0.5) = 20
+    assert make_pattern_report.experiment_wavelength(relation, 0.25, 4.0) == pytest.approx(20.0)
+
+
+def test_a_pattern_case_gives_its_frequency_and_depth():
+    frequency, depth = make_pattern_report.case_parameters(REPOSITORY, "pattern_md_f0p18")
+    assert frequency == 0.18
+    assert depth == pytest.approx(5.0, abs=0.01)  # 5600 particles on 128 x 8
+
+
+def synthetic_case(wavelength, onset, ordered_below=False):
+    """Points of a sweep with stripes (A2 1, correlation -1) above `onset`, noise below."""
+    points = []
+    for gamma in (2.0, 2.2, 2.4, 2.6, 2.8, 3.0):
+        stripes = gamma > onset or (ordered_below and gamma == 2.0)
+        points.append(dict(gamma=gamma, order=1.0 if stripes else 0.2, order_error=0.01,
+                           wavelength=wavelength + {2.6: -0.5, 2.8: 0.5}.get(gamma, 0.0),
+                           a2=1.0 if stripes else 0.2, a4=0.1, a6=0.1,
+                           correlation_previous_cycle=-0.95 if stripes else 0.0))
+    return dict(points=points, onset=dict(gamma_c=onset, gamma_c_error=0.05))
+
+
+def verdicts(cases, dispersion):
+    with open(os.path.join(REPOSITORY, make_pattern_report.CLAIMS), "rb") as f:
+        claims = tomllib.load(f)["claim"]
+    parameters = {"pattern_md_f0p14": (0.14, 5.0), "pattern_md_f0p18": (0.18, 5.0)}
+    return {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, parameters, dispersion)}
+
+
+def test_the_md_part_of_the_wavelength_claims_is_judged():
+    relation = dict(offset=1.0, amplitude=1.0, exponent=1.0)
+    # lambda_exp = 5 (1 + 1 / (f sqrt 5)): 20.97 at f = 0.14, 17.4226 at f = 0.18
+    cases = {"pattern_md_f0p18": synthetic_case(17.4226, 2.5),
+             "pattern_md_f0p14": synthetic_case(25.0, 2.3)}
+    rows = verdicts(cases, relation)
+    assert rows["P1"]["verdict"] == "MD pass; continuum not measured"
+    assert rows["P3"]["verdict"] == "MD pass; continuum not measured"
+    assert "1.435 ± " in rows["P3"]["value"]  # 25 / 17.4226
+    assert rows["P4"]["verdict"] == "MD pass; continuum not measured"
+    assert "pattern_md_f0p14: 1.192" in rows["P4"]["value"]  # 25 / 20.97, in [0.8, 1.25]
+    assert "pattern_md_f0p18: 1 " in rows["P4"]["value"]
+    cases["pattern_md_f0p14"] = synthetic_case(30.0, 2.3)  # 30 / 20.97 = 1.43: too long
+    assert verdicts(cases, relation)["P4"]["verdict"] == "MD fail; continuum not measured"
+    for row in rows.values():  # claims the MD cannot judge alone stay unmeasured
+        if row["id"] in ("P2", "P5", "P6", "P7", "P8"):
+            assert row["verdict"] == "not measured" and row["reason"]
+
+
+def test_stripes_below_the_onset_fail_the_md_part_of_p1():
+    cases = {"pattern_md_f0p18": synthetic_case(21.3, 2.5, ordered_below=True),
+             "pattern_md_f0p14": synthetic_case(25.6, 2.3)}
+    assert verdicts(cases, None)["P1"]["verdict"] == "MD fail; continuum not measured"
+    assert verdicts(cases, None)["P4"]["verdict"] == "not measured"  # no dispersion relation
