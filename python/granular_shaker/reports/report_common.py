@@ -69,6 +69,13 @@ def utc_now():
     return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
 
 
+def readable_mode():
+    """The mode a plain open() would give a new file (mkstemp's files are private: 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_text_atomically(path, text):
     directory = os.path.dirname(os.path.abspath(path))
     os.makedirs(directory, exist_ok=True)
@@ -76,6 +83,7 @@ def write_text_atomically(path, text):
     try:
         with os.fdopen(fd, "w") as f:
             f.write(text)
+        os.chmod(temporary, readable_mode())
         os.replace(temporary, path)
     except BaseException:
         if os.path.exists(temporary):
@@ -90,6 +98,7 @@ def save_figure_atomically(figure, path, dpi=90):
     os.close(fd)
     try:
         figure.savefig(temporary, dpi=dpi, format="png")
+        os.chmod(temporary, readable_mode())
         os.replace(temporary, path)
     except BaseException:
         if os.path.exists(temporary):

@@ -162,3 +162,21 @@ def test_stripes_below_the_onset_fail_the_md_part_of_p1():
              "pattern_md_f0p14": synthetic_case(25.6, 2.3)}
     assert verdicts(cases, None)["P1"]["verdict"] == "MD fail; continuum not measured"
     assert verdicts(cases, None)["P4"]["verdict"] == "not measured"  # no dispersion relation
+
+
+def test_reports_and_figures_are_written_readable_by_others(work_dir):
+    """Atomic writes go through a private temporary file; the report must not stay private."""
+    from granular_shaker.reports import report_common
+    previous = os.umask(0o022)
+    try:
+        path = os.path.join(work_dir, "report.md")
+        report_common.write_text_atomically(path, "text\n")
+        figure = make_pattern_report.figure_order_parameter(
+            {"pattern_md_f0p18": {"points": [dict(gamma=g, order=0.5, order_error=0.01)
+                                             for g in (2.0, 2.2)]}})
+        picture = os.path.join(work_dir, "figure.png")
+        report_common.save_figure_atomically(figure, picture)
+    finally:
+        os.umask(previous)
+    assert os.stat(path).st_mode & 0o777 == 0o644
+    assert os.stat(picture).st_mode & 0o777 == 0o644
