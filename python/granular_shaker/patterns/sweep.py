@@ -11,7 +11,12 @@ study keys them (granular_shaker.validation.plan.run_key), so an interrupted swe
 where it stopped; each finished run is analysed once by `shaker analyze RUN.h5 --patterns`,
 its table kept beside the run file.
 
-Per point (case, Gamma): the saturated order parameter of the column mass (the mean over the
+A sweep may hold a `continuum` table of its own (cases, gamma, seeds, overrides, timeout):
+the continuum's pattern cases, each run from a seeded flat layer and judged by the growth rate
+of its fastest pattern mode (granular_shaker.patterns.growth), the onset where that rate
+changes sign.
+
+Per MD point (case, Gamma): the saturated order parameter of the column mass (the mean over the
 sampled frames at the stored phase with the larger pattern) with its standard error, the
 wavelength, the angular moments and the cycle-to-cycle correlation. With several seeds the
 point's value is the mean over seeds and its error their standard error (independent runs);
@@ -29,6 +34,8 @@ import time
 
 import numpy as np
 
+from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
+                                             fit_zero_crossing)
 from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg
 from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
@@ -41,6 +48,18 @@ SWEEP_FILE = os.path.join("validation", "patterns.toml")
 FIELD = "mass"  # the column mass: its noise is the counts' (docs/analysis.md "Patterns")
 
 
+def check_part(repository, part, where):
+    """ValueError naming what is wrong with one solver's part of a sweep."""
+    for key in ("cases", "gamma", "seeds", "overrides", "timeout"):
+        if key not in part:
+            raise ValueError(f"{where} has no '{key}'")
+    for case in part["cases"]:
+        if not os.path.isfile(case_file(repository, case)):
+            raise ValueError(f"{where}: no case file for '{case}'")
+    if sorted(set(part["gamma"])) != list(part["gamma"]) or len(part["gamma"]) < 5:
+        raise ValueError(f"{where}: gamma must be increasing, at least 5")
+
+
 def load_sweep(repository, name):
     """The named sweep of validation/patterns.toml; ValueError names what is wrong."""
     studies = load_toml(os.path.join(repository, SWEEP_FILE))["study"]
@@ -48,28 +67,33 @@ def load_sweep(repository, name):
         raise ValueError(f"--study {name}: allowed: {', '.join(sorted(studies))} "
                          f"({SWEEP_FILE})")
     sweep = studies[name]
-    for key in ("cases", "gamma", "seeds", "overrides", "timeout"):
-        if key not in sweep:
-            raise ValueError(f"{SWEEP_FILE} [study.{name}] has no '{key}'")
-    for case in sweep["cases"]:
-        if not os.path.isfile(case_file(repository, case)):
-            raise ValueError(f"{SWEEP_FILE} [study.{name}]: no case file for '{case}'")
-    if sorted(set(sweep["gamma"])) != list(sweep["gamma"]) or len(sweep["gamma"]) < 5:
-        raise ValueError(f"{SWEEP_FILE} [study.{name}]: gamma must be increasing, at least 5")
+    check_part(repository, sweep, f"{SWEEP_FILE} [study.{name}]")
+    if "continuum" in sweep:
+        check_part(repository, sweep["continuum"], f"{SWEEP_FILE} [study.{name}.continuum]")
     return sweep
 
 
+def solver_parts(sweep):
+    """(solver, part) of the sweep: the MD's keys at its top, the continuum's in its table."""
+    parts = [("md", sweep)]
+    if "continuum" in sweep:
+        parts.append(("continuum", sweep["continuum"]))
+    return parts
+
+
 def plan_points(repository, sweep):
-    """One run per case, Gamma and seed, in the run dicts of the validation study."""
+    """One run per solver, case, Gamma and seed, in the run dicts of the validation study."""
     plan = []
-    for case in sweep["cases"]:
-        for gamma in sweep["gamma"]:
-            for seed in sweep["seeds"]:
-                plan.append(dict(case=case, case_file=case_file(repository, case),
-                                 solver="md", replicas=1, gamma=gamma, seed=seed,
-                                 overrides=[f"shaker.gamma={gamma}", f"run.seed={seed}",
-                                            *sweep["overrides"]],
-                                 timeout=sweep["timeout"], fallback=[], expect_failure=False))
+    for solver, part in solver_parts(sweep):
+        for case in part["cases"]:
+            for gamma in part["gamma"]:
+                for seed in part["seeds"]:
+                    plan.append(dict(case=case, case_file=case_file(repository, case),
+                                     solver=solver, replicas=1, gamma=gamma, seed=seed,
+                                     overrides=[f"shaker.gamma={gamma}", f"run.seed={seed}",
+                                                *part["overrides"]],
+                                     timeout=part["timeout"], fallback=[],
+                                     expect_failure=False))
     return plan
 
 
@@ -143,23 +167,63 @@ def fits(points):
     return out
 
 
+def growth_summary(run_path):
+    """The growth of a continuum run's fastest pattern mode, from its fields file."""
+    cycles, phases, amplitudes, length = column_mass_modes(
+        os.path.splitext(run_path)[0] + ".fields.h5")
+    mode, fit, rates = fastest_pattern_mode(cycles, phases, amplitudes)
+    return dict(mode=mode, mode_wavelength=length / mode, rate=fit.rate,
+                rate_error=fit.rate_error, fit_cycles=[fit.first_cycle, fit.last_cycle],
+                mode_rates={str(m): rate for m, rate in rates.items()})
+
+
+def growth_fits(points):
+    """The continuum's onset: where its growth rate changes sign."""
+    try:
+        crossing = fit_zero_crossing([p["gamma"] for p in points], [p["rate"] for p in points],
+                                     [p["rate_error"] for p in points])
+        return dict(onset=vars(crossing))
+    except (NoGrowthFit, ValueError) as reason:
+        return dict(onset=dict(reason=str(reason)))
+
+
+def case_points(plan, case):
+    """A case's points, one per Gamma, from its runs' summaries."""
+    points = []
+    for gamma in dict.fromkeys(r["gamma"] for r in plan if r["case"] == case):
+        runs = [r for r in plan if r["case"] == case and r["gamma"] == gamma and "summary" in r]
+        if not runs:
+            continue
+        point = dict(gamma=gamma, **point_summary([r["summary"] for r in runs]))
+        if "growth" in runs[0]:
+            point.update(runs[0]["growth"], final_order=runs[0]["summary"]["final_order"])
+        points.append(point)
+    return points
+
+
 def collect(shaker, plan):
     """Every case's points and fits from the finished runs; the failures met."""
     failures, cases = [], {}
     for run in plan:
+        where = f"{run['case']} Gamma {run['gamma']} seed {run['seed']}"
         table, reason = analyze(shaker, run["record"])
         if table is None:
-            failures.append(f"{run['case']} Gamma {run['gamma']} seed {run['seed']}: {reason}")
+            failures.append(f"{where}: {reason}")
             continue
-        run["summary"] = frame_summary(read_shaker_csv(table)[0])
+        columns = read_shaker_csv(table)[0]
+        run["summary"] = frame_summary(columns)
+        if run["solver"] == "continuum":
+            run["summary"]["final_order"] = float(columns[f"{FIELD}_order_parameter"][-1])
+            try:
+                run["growth"] = growth_summary(run["record"]["path"])
+            except (NoGrowthFit, OSError, KeyError) as error:
+                failures.append(f"{where}: no growth rate: {error}")
+                del run["summary"]
     for case in dict.fromkeys(r["case"] for r in plan):
-        points = []
-        for gamma in dict.fromkeys(r["gamma"] for r in plan if r["case"] == case):
-            runs = [r["summary"] for r in plan
-                    if r["case"] == case and r["gamma"] == gamma and "summary" in r]
-            if runs:
-                points.append(dict(gamma=gamma, **point_summary(runs)))
-        cases[case] = dict(points=points, **fits(points))
+        solver = next(r["solver"] for r in plan if r["case"] == case)
+        points = case_points(plan, case)
+        found = growth_fits(points) if solver == "continuum" else fits(points)
+        cases[case] = dict(solver=solver, points=points, **found)
     return cases, failures
 
 

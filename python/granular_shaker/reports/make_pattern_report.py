@@ -33,15 +33,20 @@ def ordered(point):
 FIGURES = "patterns"  # beside the report
 
 
+def solver_cases(cases, solver):
+    """The cases of one solver (results before the continuum joined the sweep name none)."""
+    return {name: case for name, case in cases.items() if case.get("solver", "md") == solver}
+
+
 def onset_curve(fit, gamma):
     return np.sqrt(fit["floor"] + fit["slope"] * np.maximum(gamma - fit["gamma_c"], 0.0))
 
 
 def figure_order_parameter(cases):
-    """The saturated order parameter against Gamma, each case with its onset fit."""
+    """The saturated order parameter against Gamma, each MD case with its onset fit."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for name, case in cases.items():
+    for name, case in solver_cases(cases, "md").items():
         points = case["points"]
         gamma = np.array([p["gamma"] for p in points])
         drawn = ax.errorbar(gamma, [p["order"] for p in points],
@@ -57,11 +62,36 @@ def figure_order_parameter(cases):
     return fig
 
 
+def figure_growth_rate(cases):
+    """The continuum's growth rate of its fastest pattern mode against Gamma, with the onset
+    where it changes sign."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    for name, case in cases.items():
+        points = case["points"]
+        drawn = ax.errorbar([p["gamma"] for p in points], [p["rate"] for p in points],
+                            yerr=[p["rate_error"] for p in points],
+                            label=f"continuum {name} (± standard error)",
+                            **{**rc.CONTINUUM_STYLE, "marker": "s", "ms": 3})
+        onset = case.get("onset", {})
+        if "gamma_c" in onset:
+            ax.axvline(onset["gamma_c"], color=drawn[0].get_color(), lw=1, ls="--",
+                       label=f"{name}: Gamma_c = {onset['gamma_c']:.3f}")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("plate acceleration Gamma [g]")
+    ax.set_ylabel("growth rate of the fastest pattern mode [1/cycle]")
+    rc.legend_above(fig, columns=1)
+    return fig
+
+
 # A layer H diameters deep as poured holds 9.8425 / 9 particles per sigma^2 per diameter of
 # depth (the base case: 3937 particles on 20 x 20 for H = 9, docs/models.md).
 PARTICLES_PER_AREA_AND_DEPTH = 9.8425 / 9.0
-NOT_RUN = ("the continuum's sweep is not run (a point of its 128 x 8 box costs hours on 2 "
-           "cores: docs/patterns.md, Cost)")
+NOT_RUN = ("the continuum's sweep is not part of this study (a point of its full design costs "
+           "hours on 2 cores: docs/patterns.md, Cost)")
+NO_SATURATION = ("the continuum's runs end in the linear stage of the pattern's growth (its onset "
+                 "is the change of sign of the growth rate), so it has no saturated amplitude "
+                 "to compare")
 
 
 def case_parameters(repository, name):
@@ -146,10 +176,117 @@ def md_part(claim, md, parameters, dispersion):
     return None
 
 
+def onset_of(case, key="onset", parameter="gamma_c"):
+    fit = (case or {}).get(key, {})
+    return (fit[parameter], fit[parameter + "_error"]) if parameter in fit else None
+
+
+def ratio_with_error(a, b):
+    (x, dx), (y, dy) = a, b
+    return x / y, x / y * np.hypot(dx / x, dy / y)
+
+
+def first_growing_point(case):
+    """The continuum's first point above its onset (its fastest mode is the pattern's)."""
+    onset = onset_of(case)
+    above = [p for p in case["points"] if onset and p["gamma"] > onset[0]]
+    return above[0] if above else None
+
+
+def continuum_part(claim, continuum, parameters, dispersion):
+    """(value, verdict) of a claim's continuum part, or None when it does not measure it."""
+    measured = {n: c for n, c in continuum.items() if n in claim["cases"] and onset_of(c)}
+    if not measured:
+        return None
+    if claim["id"] == "P1":
+        # In a box a few cells deep every mode along x is a stripe: the planform follows from
+        # the geometry, so the part judged is growth above the onset and decay below it.
+        fine = all((p["rate"] > 0) == (p["gamma"] > onset_of(c)[0])
+                   for c in measured.values() for p in c["points"])
+        return ("; ".join(f"{n}: growth rate changes sign once, at Gamma_c "
+                          f"{rc.fmt(onset_of(c)[0])}" for n, c in measured.items()),
+                "pass" if fine else "fail")
+    first = {n: first_growing_point(c) for n, c in measured.items()}
+    if claim["id"] == "P3" and len(first) == 2 and None not in first.values():
+        low, high = sorted(first, key=lambda n: parameters[n][0])
+        ratio = first[low]["mode_wavelength"] / first[high]["mode_wavelength"]
+        return f"{rc.fmt(ratio)} (box modes {first[low]['mode']}, {first[high]['mode']})", \
+            judge(ratio, claim)
+    if claim["id"] == "P4" and dispersion is not None:
+        values, verdicts = [], []
+        for name, point in first.items():
+            if point is None:
+                continue
+            expected = experiment_wavelength(dispersion, *parameters[name])
+            ratio = point["mode_wavelength"] / expected
+            values.append(f"{name}: {rc.fmt(ratio)} ({rc.fmt(point['mode_wavelength'])} sigma, "
+                          f"box mode {point['mode']}, at Gamma {point['gamma']:g}, against "
+                          f"{rc.fmt(expected)})")
+            verdicts.append(judge(ratio, claim))
+        if values:
+            return "; ".join(values), "pass" if all(v == "pass" for v in verdicts) else "fail"
+    return None
+
+
+def combined(md, continuum):
+    """One verdict of a claim on both solvers from its parts ((value, verdict) or None)."""
+    if md is None and continuum is None:
+        return None
+    parts = [f"{who}: {part[0]}" for who, part in (("MD", md), ("continuum", continuum)) if part]
+    if md and continuum:
+        verdict = "pass" if md[1] == continuum[1] == "pass" else "fail"
+    elif md:
+        verdict = f"MD {md[1]}; continuum not measured"
+    else:
+        verdict = f"continuum {continuum[1]}; MD not measured"
+    return "; ".join(parts), verdict
+
+
+def md_against_continuum(claim, md, continuum):
+    """(value, verdict) of a claim comparing the two solvers at one frequency, or a reason."""
+    name_md = next((n for n in claim["cases"] if n in md), None)
+    name_continuum = next((n for n in claim["cases"] if n in continuum), None)
+    if name_continuum is None or onset_of(continuum[name_continuum]) is None:
+        return None, NOT_RUN if name_continuum is None else (
+            "the continuum's growth rate does not change sign over its sweep: "
+            + continuum[name_continuum]["onset"].get("reason", ""))
+    case_md, case_continuum = md.get(name_md), continuum[name_continuum]
+    onset_continuum = onset_of(case_continuum)
+    if claim["id"] == "P5":
+        return None, NO_SATURATION
+    if claim["id"] == "P2":
+        if onset_of(case_md) is None:
+            return None, "the MD's onset is not fitted (its case's onset fit)"
+        value, error = ratio_with_error(onset_of(case_md), onset_continuum)
+    elif claim["id"] == "P8":
+        if onset_of(case_md, "swift_hohenberg", "gamma_mf") is None:
+            return None, "the MD's Swift-Hohenberg fit below onset has no mean-field onset"
+        value, error = ratio_with_error(onset_of(case_md, "swift_hohenberg", "gamma_mf"),
+                                        onset_continuum)
+    elif claim["id"] == "P6":
+        top = min(onset_continuum[0], (onset_of(case_md) or (np.inf,))[0])
+        below = [p for p in case_continuum["points"] if p["gamma"] < top]
+        md_points = {p["gamma"]: p for p in (case_md or {}).get("points", [])}
+        shared = [p for p in below if p["gamma"] in md_points]
+        if not shared:
+            return None, "no Gamma below both solvers' onsets that both sweeps ran"
+        point = shared[-1]
+        mine = md_points[point["gamma"]]
+        value = mine["order"] / point["final_order"]
+        error = value * mine["order_error"] / mine["order"]
+        return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)} at Gamma {point['gamma']:g} (MD "
+                f"{rc.fmt(mine['order'])}, continuum's last frame {rc.fmt(point['final_order'])}"
+                " [1/sigma^2])", judge(value, claim)), ""
+    else:
+        return None, f"claim {claim['id']} is not judged from the sweep"
+    return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)}", judge(value, claim)), ""
+
+
 def claim_verdicts(claims, cases, parameters=None, dispersion=None):
     """Every claim with its verdict: measured by the sweep, or not measured and why. A claim on
-    both solvers that the MD cases measure gets the MD's verdict, marked as the MD's alone."""
-    md = {name: case for name, case in cases.items() if name.startswith("pattern_md")}
+    both solvers that only one of them measures gets that one's verdict, marked as its alone."""
+    md = {n: c for n, c in solver_cases(cases, "md").items() if n.startswith("pattern_md")}
+    continuum = solver_cases(cases, "continuum")
     parameters = parameters or {}
     rows = []
     for claim in claims:
@@ -158,16 +295,22 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None):
             reason = ("the Swift-Hohenberg coefficients (xi0, tau0, q0) that make the fitted "
                       "noise power dimensionless are not measured")
         elif claim["solvers"] == "md_vs_continuum":
-            reason = NOT_RUN
+            part, reason = md_against_continuum(claim, md, continuum)
+            if part is not None:
+                value, verdict = part
         elif claim["solvers"] == "both":
-            part = md_part(claim, md, parameters, dispersion)
+            part = combined(md_part(claim, md, parameters, dispersion),
+                            continuum_part(claim, continuum, parameters, dispersion))
             if part is None:
-                reason = NOT_RUN + "; the MD sweep does not measure it either (" + (
-                    "no stripes above a fitted onset" if claim["id"] != "P4" or dispersion
-                    else "no experimental dispersion relation") + ")"
+                reason = (NOT_RUN if not continuum else "neither solver measures it") + (
+                    "; the MD sweep does not measure it either (" + (
+                        "no stripes above a fitted onset" if claim["id"] != "P4" or dispersion
+                        else "no experimental dispersion relation") + ")")
             else:
-                value, verdict = "MD: " + part[0], f"MD {part[1]}; continuum not measured"
-                reason = NOT_RUN
+                value, verdict = part
+                if "not measured" in verdict:
+                    reason = NOT_RUN if "continuum not" in verdict else \
+                        "the MD sweep does not measure it"
         elif claim["id"] == "P9":
             strengths = {name: case.get("swift_hohenberg", {}).get("strength")
                          for name, case in md.items()}
@@ -185,7 +328,28 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None):
     return rows
 
 
+def continuum_case_lines(name, case):
+    lines = [f"### {name} (continuum)", "", "| Gamma [g] | growth rate [1/cycle] | fastest pattern "
+             "mode m | its wavelength [sigma] | cycles fitted | order parameter, last frame "
+             "[1/sigma^2] |", "| --- | --- | --- | --- | --- | --- |"]
+    for p in case["points"]:
+        lines.append(f"| {p['gamma']:g} | {rc.fmt(p['rate'])} ± {rc.fmt(p['rate_error'], 2)} | "
+                     f"{p['mode']} | {rc.fmt(p['mode_wavelength'])} | {p['fit_cycles'][0]:g} to "
+                     f"{p['fit_cycles'][1]:g} | {rc.fmt(p['final_order'])} |")
+    onset = case.get("onset", {})
+    if "gamma_c" in onset:
+        lines += ["", f"- onset (growth rate zero): Gamma_c = {onset['gamma_c']:.4f} ± "
+                  f"{onset['gamma_c_error']:.2g} (straight line through {onset['points']} points "
+                  f"nearest the change of sign, chi^2 per degree of freedom "
+                  f"{onset['chi2_per_dof']:.3g})"]
+    else:
+        lines += ["", f"- onset: none: {onset.get('reason', 'not fitted')}"]
+    return lines + [""]
+
+
 def case_lines(name, case):
+    if case.get("solver") == "continuum":
+        return continuum_case_lines(name, case)
     lines = [f"### {name}", "", "| Gamma [g] | order parameter [1/sigma^2] | seeds | "
              "wavelength [sigma] | A2 | cycle-to-cycle correlation |", "| --- | --- | --- | --- "
              "| --- | --- |"]
@@ -219,9 +383,11 @@ def case_lines(name, case):
     return lines + [""]
 
 
-def report_text(results, claims, figure, parameters=None, dispersion=None):
+def report_text(results, claims, figure, parameters=None, dispersion=None, growth_figure=None):
     sweep, runs = results["sweep"], results["runs"]
-    lines = ["# Onset of patterns: MD sweep", "",
+    continuum = sweep.get("continuum")
+    lines = ["# Onset of patterns: " + ("MD and continuum sweeps" if continuum else "MD sweep"),
+             "",
              f"Generated by `shaker-patterns --study {results['study']}` at commit "
              f"{results['commit'][:12]} (granular_shaker.patterns.sweep; design and definitions: "
              "docs/patterns.md). Cases "
@@ -238,6 +404,17 @@ def report_text(results, claims, figure, parameters=None, dispersion=None):
              "Swift-Hohenberg form floor + strength / sqrt((Gamma_mf - Gamma)/Gamma_mf) "
              "(python/granular_shaker/patterns/onset.py, whose tests measure the bias and "
              "coverage of both fits' errors).", "", f"![order parameter]({figure})", ""]
+    if continuum:
+        lines += [f"The continuum: cases {', '.join(continuum['cases'])}; Gamma "
+                  f"{continuum['gamma'][0]:g} to {continuum['gamma'][-1]:g} "
+                  f"({len(continuum['gamma'])} points); overrides "
+                  + (", ".join(f"`{o}`" for o in continuum["overrides"]) or "none")
+                  + ". Each run starts from the flat layer with a seeded perturbation; the "
+                  "growth rate per cycle of each Fourier mode of its column mass is fitted over "
+                  "the modes' linear stage, and the onset is where the fastest pattern mode's "
+                  "rate changes sign (python/granular_shaker/patterns/growth.py, whose tests "
+                  "measure the bias and coverage of its errors).", "",
+                  f"![growth rate]({growth_figure})", ""]
     for name, case in results["cases"].items():
         lines += case_lines(name, case)
     lines += ["## Claims (reference-data/pattern-claims.toml)", "",
@@ -257,8 +434,12 @@ def write(results, repository, output):
     figures = os.path.join(os.path.dirname(os.path.abspath(output)), FIGURES)
     name = rc.write_figure(figure_order_parameter(results["cases"]), figures,
                            "order_parameter.png")
+    continuum = solver_cases(results["cases"], "continuum")
+    growth = rc.write_figure(figure_growth_rate(continuum), figures, "growth_rate.png") \
+        if continuum else None
     text = report_text(results, reference["claim"], f"{FIGURES}/{name}", parameters,
-                       reference.get("experiment_dispersion"))
+                       reference.get("experiment_dispersion"),
+                       growth and f"{FIGURES}/{growth}")
     rc.write_text_atomically(output, text)
 
 

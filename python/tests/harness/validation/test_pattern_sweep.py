@@ -123,11 +123,12 @@ def synthetic_case(wavelength, onset, ordered_below=False):
     points = []
     for gamma in (2.0, 2.2, 2.4, 2.6, 2.8, 3.0):
         stripes = gamma > onset or (ordered_below and gamma == 2.0)
-        points.append(dict(gamma=gamma, order=1.0 if stripes else 0.2, order_error=0.01,
+        points.append(dict(gamma=gamma, order=1.0 if stripes else 0.2, order_error=0.01, seeds=1,
                            wavelength=wavelength + {2.6: -0.5, 2.8: 0.5}.get(gamma, 0.0),
                            a2=1.0 if stripes else 0.2, a4=0.1, a6=0.1,
                            correlation_previous_cycle=-0.95 if stripes else 0.0))
-    return dict(points=points, onset=dict(gamma_c=onset, gamma_c_error=0.05))
+    return dict(points=points, onset=dict(gamma_c=onset, gamma_c_error=0.05, floor=0.04,
+                                          slope=1.0, chi2_per_dof=1.0, points=len(points)))
 
 
 def verdicts(cases, dispersion):
@@ -180,3 +181,75 @@ def test_reports_and_figures_are_written_readable_by_others(work_dir):
         os.umask(previous)
     assert os.stat(path).st_mode & 0o777 == 0o644
     assert os.stat(picture).st_mode & 0o777 == 0o644
+
+
+def synthetic_continuum(onset, mode_wavelength=21.3333, slope=0.5):
+    """A continuum sweep whose growth rate crosses zero at `onset`, its fastest mode growing
+    above it; the order parameter of its last frame 1e-6 below onset."""
+    points = []
+    for gamma in (2.0, 2.2, 2.4, 2.6, 2.8, 3.0):
+        points.append(dict(gamma=gamma, rate=slope * (gamma - onset), rate_error=0.01, mode=6,
+                           mode_wavelength=mode_wavelength, fit_cycles=[5, 39],
+                           final_order=1e-6 if gamma < onset else 0.1, order=0.1,
+                           order_error=0.01, seeds=1, wavelength=21.3, a2=1.0, a4=1.0, a6=1.0,
+                           correlation_previous_cycle=-1.0))
+    return dict(solver="continuum", points=points,
+                onset=dict(gamma_c=onset, gamma_c_error=0.02, slope=slope, slope_error=0.01,
+                           chi2_per_dof=1.0, points=4))
+
+
+def test_the_continuum_parts_and_the_comparisons_are_judged():
+    relation = dict(offset=1.0, amplitude=1.0, exponent=1.0)  # 17.4226 sigma at f = 0.18
+    md = synthetic_case(17.4226, 2.5)
+    md["swift_hohenberg"] = dict(gamma_mf=2.32, gamma_mf_error=0.02)
+    cases = {"pattern_md_f0p18": md, "pattern_md_f0p14": synthetic_case(25.0, 2.3),
+             "pattern_continuum_f0p18": synthetic_continuum(2.3, mode_wavelength=17.4226)}
+    parameters = {"pattern_continuum_f0p18": (0.18, 5.0)}
+    with open(os.path.join(REPOSITORY, make_pattern_report.CLAIMS), "rb") as f:
+        claims = tomllib.load(f)["claim"]
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    # P2: 2.5 / 2.3 = 1.087 +- 1.087 * hypot(0.05 / 2.5, 0.02 / 2.3) = 0.0237, in [1.04, 1.16]
+    assert rows["P2"]["verdict"] == "pass"
+    assert rows["P2"]["value"] == "1.087 ± 0.024"
+    assert rows["P8"]["verdict"] == "pass"  # 2.32 / 2.3 = 1.0087, in [0.97, 1.03]
+    # P6 at Gamma 2.2, below both onsets: MD 0.2 against the continuum's 1e-6
+    assert rows["P6"]["verdict"] == "pass" and rows["P6"]["value"].startswith("2e+05")
+    assert rows["P1"]["verdict"] == "pass"  # MD stripes above 2.5, continuum growth above 2.3
+    assert rows["P4"]["verdict"] == "pass" and "continuum: pattern_continuum_f0p18: 1 " in \
+        rows["P4"]["value"]
+    assert rows["P5"]["verdict"] == "not measured" and "linear stage" in rows["P5"]["reason"]
+    # the continuum's wavelength far from the experiments' fails P4 as a whole
+    cases["pattern_continuum_f0p18"] = synthetic_continuum(2.3, mode_wavelength=64.0)
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P4"]["verdict"] == "fail"
+    # a continuum whose rate rises, falls below zero and rises again fails its part of P1
+    bent = synthetic_continuum(2.3)
+    bent["points"][3]["rate"] = -0.05
+    cases["pattern_continuum_f0p18"] = bent
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P1"]["verdict"] == "fail"
+
+
+def test_a_report_with_the_continuum_shows_its_growth_rates(work_dir):
+    results = dict(study="synthetic", commit="0" * 40, seconds=1.0, failures=[], runs=[],
+                   sweep=dict(cases=["pattern_md_f0p18"], gamma=[2.0, 3.0], seeds=[1],
+                              overrides=[], continuum=dict(cases=["pattern_continuum_f0p18"],
+                                                           gamma=[2.0, 3.0], seeds=[1],
+                                                           overrides=["a=1"])),
+                   cases={"pattern_md_f0p18": synthetic_case(21.3, 2.5),
+                          "pattern_continuum_f0p18": synthetic_continuum(2.3)})
+    output = os.path.join(work_dir, "patterns.md")
+    make_pattern_report.write(results, REPOSITORY, output)
+    text = open(output).read()
+    assert text.startswith("# Onset of patterns: MD and continuum sweeps")
+    assert "### pattern_continuum_f0p18 (continuum)" in text
+    assert "| 2.4 | 0.05 ± 0.01 | 6 | 21.33 | 5 to 39 | 0.1 |" in text
+    assert "- onset (growth rate zero): Gamma_c = 2.3000 ± 0.02" in text
+    assert os.path.exists(os.path.join(work_dir, make_pattern_report.FIGURES,
+                                       "growth_rate.png"))

@@ -1,0 +1,166 @@
+"""The continuum's onset from the growth rate of its pattern (docs/patterns.md).
+
+The continuum has no noise: a flat layer seeded with a small perturbation keeps its pattern
+modes linear for many cycles, each growing or decaying by a fixed factor per cycle. The order
+parameter M (the rms of the column mass about its mean) is then dominated by the fastest mode,
+and ln M rises or falls on a straight line in the cycle count until the pattern saturates (or,
+below onset, reaches the round-off of the solver). The onset is where that growth rate, per
+cycle, crosses zero as Gamma rises.
+
+- fit_growth_rate: the slope of ln M against the cycle over the linear stage: from
+  `first_cycle` (after the layer's first impacts have settled) to the last cycle before M
+  exceeds `saturation_fraction` of its largest value (a supercritical amplitude, M = L /
+  sqrt(1 + (L / M_sat)^2) for the linear growth L, bends ln M by 2 % there), by least
+  squares (a decaying one ends before it falls within 1 / saturation_fraction^2 of its
+  smallest value, the solver's floor), with the standard error of the slope from the
+  scatter about the line (the cycle-to-cycle modulation of a mode that is not purely
+  subharmonic).
+- column_mass_modes and fastest_pattern_mode: the amplitude of each Fourier mode of the column
+  mass along the box's long side, from a continuum run's fields file, and the growth rate of
+  the fastest-growing one. The pattern modes are m >= 2: mode 1, the box's own length, carries
+  a slow sloshing of the whole layer (a period of several cycles, not a standing wave).
+- fit_zero_crossing: Gamma_c from a weighted straight line through the growth rates of the
+  points nearest to the change of sign, its error from the line's covariance (delta method).
+
+python/tests/test_pattern_growth.py measures the bias and the coverage of both errors on
+synthetic series and sweeps of known rate and onset.
+"""
+from dataclasses import dataclass
+
+import h5py
+import numpy as np
+
+FIRST_PATTERN_MODE = 2
+
+
+class NoGrowthFit(ValueError):
+    """The series or the sweep cannot give the quantity asked for."""
+
+
+@dataclass
+class GrowthRate:
+    rate: float          # per cycle: ln M grows by this much each cycle
+    rate_error: float
+    first_cycle: float
+    last_cycle: float
+    points: int
+
+
+@dataclass
+class ZeroCrossing:
+    gamma_c: float
+    gamma_c_error: float
+    slope: float         # d(rate)/d(Gamma), per cycle
+    slope_error: float
+    chi2_per_dof: float
+    points: int
+
+
+def fit_growth_rate(cycles, order, first_cycle=5.0, saturation_fraction=0.2, min_points=5):
+    """The growth rate of ln(order) per cycle over the linear stage (module docstring).
+    Raises NoGrowthFit when fewer than min_points frames lie in it."""
+    cycles, order = np.asarray(cycles, float), np.asarray(order, float)
+    if cycles.shape != order.shape or cycles.ndim != 1:
+        raise ValueError("cycles and order parameters must be 1D arrays of one length")
+    usable = np.isfinite(order) & (order > 0) & (cycles >= first_cycle)
+    cycles, order = cycles[usable], order[usable]
+    end = _end_of_linear_stage(order, saturation_fraction)
+    cycles, order = cycles[:end], order[:end]
+    if cycles.size < min_points:
+        raise NoGrowthFit(f"{cycles.size} frames in the linear stage from cycle {first_cycle} "
+                          f"(need {min_points})")
+    design = np.column_stack([np.ones_like(cycles), cycles])
+    coefficients, *_ = np.linalg.lstsq(design, np.log(order), rcond=None)
+    residual = np.log(order) - design @ coefficients
+    variance = residual @ residual / (cycles.size - 2)
+    covariance = variance * np.linalg.inv(design.T @ design)
+    return GrowthRate(float(coefficients[1]), float(np.sqrt(covariance[1, 1])),
+                      float(cycles[0]), float(cycles[-1]), int(cycles.size))
+
+
+def _end_of_linear_stage(order, fraction):
+    """The number of leading frames in the linear stage: a growing series ends before it first
+    exceeds `fraction` of its largest value, a decaying one before it first falls below
+    1 / `fraction`^2 times its smallest (a floor of the solver's adds to the mode, where a
+    saturation multiplies it, so it needs the wider margin), each only when the series spans
+    more than the square of that factor, so that the stage cut off is at most the later half
+    of the series."""
+    if order.size < 2:
+        return order.size
+    if np.polyfit(np.arange(order.size), np.log(order), 1)[0] > 0:
+        beyond = order > fraction * order.max()
+        spans = order.max() > order[0] / fraction ** 2
+    else:
+        beyond = order < order.min() / fraction ** 2
+        spans = order.min() < order[0] * fraction ** 4
+    return int(np.argmax(beyond)) if spans else order.size
+
+
+def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
+    """Gamma_c where the growth rate changes sign: a weighted straight line through the
+    `neighbours` points on each side of the change nearest to it. Raises NoGrowthFit when the
+    rates do not change sign from negative to positive."""
+    gamma, rate, error = (np.asarray(a, float) for a in (gamma, rate, rate_error))
+    if not (gamma.shape == rate.shape == error.shape) or gamma.ndim != 1:
+        raise ValueError("one growth rate and one error per acceleration")
+    if not (np.all(np.isfinite(rate)) and np.all(error > 0)):
+        raise ValueError("growth rates must be finite and their errors > 0")
+    order = np.argsort(gamma)
+    gamma, rate, error = gamma[order], rate[order], error[order]
+    positive = np.flatnonzero(rate > 0)
+    if positive.size == 0 or positive[0] == 0:
+        raise NoGrowthFit("the growth rates do not change sign from negative to positive "
+                          f"over Gamma {gamma[0]:.4g} to {gamma[-1]:.4g}")
+    change = positive[0]
+    chosen = slice(max(change - neighbours, 0), min(change + neighbours, gamma.size))
+    g, r, s = gamma[chosen], rate[chosen], error[chosen]
+    design = np.column_stack([np.ones_like(g), g]) / s[:, None]
+    coefficients, *_ = np.linalg.lstsq(design, r / s, rcond=None)
+    residual = r / s - design @ coefficients
+    dof = g.size - 2
+    chi2_per_dof = float(residual @ residual / dof) if dof > 0 else float("nan")
+    covariance = np.linalg.inv(design.T @ design) * (max(1.0, chi2_per_dof) if dof > 0 else 1.0)
+    intercept, slope = coefficients
+    if not slope > 0:
+        raise NoGrowthFit(f"the growth rate does not rise with Gamma near the change of sign "
+                          f"(slope {slope:.3g})")
+    gamma_c = -intercept / slope
+    gradient = np.array([-1.0 / slope, intercept / slope ** 2])
+    gamma_c_error = float(np.sqrt(gradient @ covariance @ gradient))
+    return ZeroCrossing(float(gamma_c), gamma_c_error, float(slope),
+                        float(np.sqrt(covariance[1, 1])), chi2_per_dof, int(g.size))
+
+
+def column_mass_modes(fields_path, modes=12):
+    """From a continuum fields file (docs/output-schema.md): per snapshot its cycle and phase,
+    the amplitudes |c_m| / c_0 of the Fourier modes m = 1..modes of the column mass along x
+    (n summed over z, averaged over y), and the box's length along x [sigma]."""
+    with h5py.File(fields_path, "r") as fields:
+        length = float(fields.attrs["nx"]) * float(fields.attrs["cell_size"])
+        names = sorted(name for name in fields if name.startswith("snapshot_"))
+        if not names:
+            raise NoGrowthFit(f"{fields_path}: no snapshots")
+        cycles, phases, amplitudes = [], [], []
+        for name in names:
+            snapshot = fields[name]
+            column = snapshot["n"][...].sum(axis=0).mean(axis=0)
+            if column.size <= 2 * modes:
+                raise NoGrowthFit(f"{fields_path}: {column.size} cells along x cannot hold "
+                                  f"{modes} modes")
+            spectrum = np.abs(np.fft.rfft(column))
+            cycles.append(int(snapshot.attrs["cycle"]))
+            phases.append(round(float(snapshot.attrs["phase"]) % 1.0, 6) % 1.0)
+            amplitudes.append(spectrum[1:modes + 1] / spectrum[0])
+    return np.array(cycles), np.array(phases), np.array(amplitudes), length
+
+
+def fastest_pattern_mode(cycles, phases, amplitudes, **fit_options):
+    """At the stored phase with the larger mean amplitude, the growth rate of every pattern
+    mode (m >= FIRST_PATTERN_MODE); returns (m, its GrowthRate, {m: rate})."""
+    best_phase = max(np.unique(phases), key=lambda p: amplitudes[phases == p].mean())
+    at = phases == best_phase
+    rates = {}
+    for m in range(FIRST_PATTERN_MODE, amplitudes.shape[1] + 1):
+        rates[m] = fit_growth_rate(cycles[at], amplitudes[at, m - 1], **fit_options)
+    fastest = max(rates, key=lambda m: rates[m].rate)
+    return fastest, rates[fastest], {m: fit.rate for m, fit in rates.items()}

@@ -1,0 +1,139 @@
+"""The continuum's growth-rate onset (granular_shaker.patterns.growth) on synthetic series and
+sweeps of known rate and onset: the bias of the fitted values and the coverage of their errors
+over many independent noisy realisations, at the scatter the continuum's series show (a few per
+cent in M from cycle to cycle)."""
+import numpy as np
+import pytest
+
+from granular_shaker.patterns import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
+                                      fit_growth_rate, fit_zero_crossing)
+
+CYCLES = np.arange(40.0)
+RATE, START = 0.15, 1e-4
+GAMMA = np.round(np.arange(2.4, 3.21, 0.1), 10)
+ONSET, DRATE = 2.72, 0.5       # the rate rises by 0.5 per cycle and unit of Gamma
+REALISATIONS = 300
+
+
+def growing(rate, saturation=np.inf):
+    """ln M on a line of slope `rate`, saturating at M = saturation as a supercritical
+    amplitude does (dA/dt = s A - g A^3)."""
+    linear = START * np.exp(rate * CYCLES)
+    return linear / np.sqrt(1.0 + (linear / saturation) ** 2)
+
+
+def scattered(series, relative, seed):
+    return series * np.exp(relative * np.random.default_rng(seed).standard_normal(series.size))
+
+
+def test_a_clean_exponential_gives_its_rate_and_the_linear_stage_ends_before_saturation():
+    fit = fit_growth_rate(CYCLES, growing(RATE))
+    assert fit.rate == pytest.approx(RATE, rel=1e-9)
+    # no plateau in sight: the frames after M first exceeds a fifth of its largest are left out
+    assert fit.first_cycle == 5 and fit.last_cycle == 28
+    saturating = fit_growth_rate(CYCLES, growing(RATE, saturation=0.01))
+    # M passes a fifth of its largest value (0.0096) between cycles 19 and 20: frames to 19
+    assert saturating.last_cycle == 19
+    assert saturating.rate == pytest.approx(RATE, rel=0.01)
+    decaying = fit_growth_rate(CYCLES, growing(-0.2))
+    # a decaying series ends before it falls within 25 times its smallest value (cycle 22.9)
+    assert decaying.rate == pytest.approx(-0.2, rel=1e-9) and decaying.last_cycle == 22
+    floored = fit_growth_rate(CYCLES, growing(-0.5) + 1e-9)
+    # on a floor of 1e-9 the fit stops before 2.5e-8 (cycle 16.7), where the floor is 3 % of M
+    assert floored.last_cycle == 16
+    assert floored.rate == pytest.approx(-0.5, rel=0.01)
+
+
+def rate_fits(rate, saturation, relative):
+    fits = [fit_growth_rate(CYCLES, scattered(growing(rate, saturation), relative, seed))
+            for seed in range(REALISATIONS)]
+    deviation = np.array([f.rate for f in fits]) - rate
+    error = np.array([f.rate_error for f in fits])
+    one, two = np.mean(np.abs(deviation) <= error), np.mean(np.abs(deviation) <= 2 * error)
+    print(f"measured at rate {rate}: bias {deviation.mean():.2e}, mean error {error.mean():.2e}, "
+          f"coverage {one:.3f} (1 error), {two:.3f} (2 errors)")
+    return deviation, error, one, two
+
+
+def test_near_onset_the_rate_error_covers_the_truth_as_a_standard_error_should():
+    # A slow mode (a factor 3 in 40 cycles) never reaches its plateau: no bend in the window.
+    deviation, error, one, two = rate_fits(0.03, 1e-2, 0.05)
+    assert abs(deviation.mean()) < 0.2 * error.mean()
+    assert 0.6 <= one <= 0.8
+    assert 0.9 <= two <= 1.0
+
+
+def test_a_fast_mode_that_saturates_is_biased_low_by_its_bend_only():
+    # The frames up to a fifth of the plateau bend ln M by up to 2 %: the rate comes out low by
+    # about 1 % (measured), more than its error at little scatter. The onset uses the rates
+    # nearest to zero, which are the slow ones above.
+    deviation, error, one, two = rate_fits(RATE, 1e-2, 0.02)
+    assert -0.02 * RATE < deviation.mean() < 0.0
+
+
+def test_the_onset_error_covers_the_truth():
+    truth = DRATE * (GAMMA - ONSET)
+    fits = []
+    for seed in range(REALISATIONS):
+        rates = [fit_growth_rate(CYCLES, scattered(growing(r), 0.05, seed * 100 + i))
+                 for i, r in enumerate(truth)]
+        fits.append(fit_zero_crossing(GAMMA, [f.rate for f in rates],
+                                      [f.rate_error for f in rates]))
+    deviation = np.array([f.gamma_c for f in fits]) - ONSET
+    error = np.array([f.gamma_c_error for f in fits])
+    one, two = np.mean(np.abs(deviation) <= error), np.mean(np.abs(deviation) <= 2 * error)
+    print(f"measured: bias {deviation.mean():.2e}, mean error {error.mean():.2e}, coverage "
+          f"{one:.3f} (1 error), {two:.3f} (2 errors)")
+    assert abs(deviation.mean()) < 0.2 * error.mean()
+    assert 0.6 <= one <= 0.8
+    assert 0.9 <= two <= 1.0
+    assert all(f.points == 4 for f in fits)
+
+
+def test_a_sweep_without_a_change_of_sign_is_refused():
+    with pytest.raises(NoGrowthFit, match="do not change sign"):
+        fit_zero_crossing(GAMMA, -np.ones(GAMMA.size), 0.1 * np.ones(GAMMA.size))
+    with pytest.raises(NoGrowthFit, match="do not change sign"):
+        fit_zero_crossing(GAMMA, np.ones(GAMMA.size), 0.1 * np.ones(GAMMA.size))
+    with pytest.raises(NoGrowthFit, match="linear stage"):
+        fit_growth_rate(CYCLES[:8], growing(RATE)[:8])
+
+
+@pytest.mark.parametrize("gamma, rate, error, message", [
+    ([2.5, 2.6], [-1.0], [0.1, 0.1], "one growth rate"),
+    ([2.5, 2.6], [-1.0, np.nan], [0.1, 0.1], "finite"),
+    ([2.5, 2.6], [-1.0, 1.0], [0.1, 0.0], "> 0"),
+])
+def test_bad_input_is_refused_with_what_is_wrong(gamma, rate, error, message):
+    with pytest.raises(ValueError, match=message):
+        fit_zero_crossing(gamma, rate, error)
+
+
+def write_fields(path, frames, nx=64, cell=2.0):
+    """A fields file of the schema's shape (docs/output-schema.md) whose column mass carries
+    mode 6 growing by e^0.1 and mode 3 decaying by e^-0.3 per cycle, at phases 0 and 0.5."""
+    import h5py
+    x = np.arange(nx)
+    with h5py.File(path, "w") as f:
+        f.attrs["nx"], f.attrs["cell_size"] = nx, cell
+        for index, (cycle, phase) in enumerate(frames):
+            column = 1.0 + 1e-4 * np.exp(0.1 * cycle) * np.cos(2 * np.pi * 6 * x / nx) \
+                + 1e-3 * np.exp(-0.3 * cycle) * np.sin(2 * np.pi * 3 * x / nx)
+            n = np.broadcast_to(column / 10.0, (10, 4, nx))
+            group = f.create_group(f"snapshot_{index:03d}")
+            group["n"] = n
+            group.attrs["cycle"], group.attrs["phase"] = cycle, phase
+
+
+def test_the_modes_of_a_fields_file_and_the_fastest_pattern_mode(tmp_path):
+    # the phase of the frame closing a cycle may be stored as 0.9999999999: it is phase 0
+    frames = [(c, p) for c in range(30) for p in (0.0, 0.5)]
+    frames = [(c, 0.9999999999 if p == 0.0 and c % 3 else p) for c, p in frames]
+    write_fields(tmp_path / "run.fields.h5", frames)
+    cycles, phases, amplitudes, length = column_mass_modes(tmp_path / "run.fields.h5")
+    assert length == 128.0
+    assert sorted(set(phases)) == [0.0, 0.5]
+    assert amplitudes[0, 5] == pytest.approx(0.5e-4, rel=1e-9)  # |c_6| / c_0 of a cosine
+    mode, fit, rates = fastest_pattern_mode(cycles, phases, amplitudes)
+    assert mode == 6 and fit.rate == pytest.approx(0.1, rel=1e-6)
+    assert rates[3] == pytest.approx(-0.3, rel=1e-6)
