@@ -5,6 +5,7 @@ cent in M from cycle to cycle)."""
 import numpy as np
 import pytest
 
+from granular_shaker.patterns import growth
 from granular_shaker.patterns import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                       fit_growth_rate, fit_zero_crossing)
 
@@ -137,3 +138,23 @@ def test_the_modes_of_a_fields_file_and_the_fastest_pattern_mode(tmp_path):
     mode, fit, rates = fastest_pattern_mode(cycles, phases, amplitudes)
     assert mode == 6 and fit.rate == pytest.approx(0.1, rel=1e-6)
     assert rates[3] == pytest.approx(-0.3, rel=1e-6)
+
+
+def test_modes_on_the_solvers_floor_are_not_taken_for_slow_growth():
+    # Modes 2 and 3 fall onto a floor of 1e-10 within a few cycles, where they scatter with a
+    # rate near zero; mode 4 decays at 0.15 per cycle, the slowest true decay: the fastest.
+    rng = np.random.default_rng(7)
+    cycles = np.arange(40.0)
+    floor = 1e-10 * np.exp(0.5 * rng.standard_normal((40, 3)))
+    amplitudes = np.column_stack([
+        np.full(40, 1e-5),                                   # mode 1, never a pattern mode
+        1e-5 * np.exp(-3.0 * cycles) + floor[:, 0],
+        1e-5 * np.exp(-4.0 * cycles) + floor[:, 1],
+        1e-5 * np.exp(-0.15 * cycles) + floor[:, 2]])
+    phases = np.zeros(40)
+    assert growth.solver_floor(amplitudes) == 0.0  # mode 4 keeps the median up: no floor yet
+    amplitudes[:, 0] = 1e-5 * np.exp(-0.5 * cycles) + 1e-10
+    mode, fit, rates = fastest_pattern_mode(cycles, phases, amplitudes)
+    assert growth.solver_floor(amplitudes) > 0.0
+    assert mode == 4 and fit.rate == pytest.approx(-0.15, rel=0.02)
+    assert set(rates) == {4}  # modes 2 and 3 have no frames 10 times above the floor

@@ -31,6 +31,12 @@ import h5py
 import numpy as np
 
 FIRST_PATTERN_MODE = 2
+# The modes of a run sit on a floor of the solver's when their typical amplitude over the last
+# frames is this fraction of their typical first amplitude or less (three decades of decay);
+# a mode is fitted only while it stands FLOOR_MARGIN above that floor.
+FLOOR_DECAY = 1e-3
+FLOOR_MARGIN = 10.0
+FLOOR_FRAMES = 10
 
 
 class NoGrowthFit(ValueError):
@@ -56,14 +62,20 @@ class ZeroCrossing:
     points: int
 
 
-def fit_growth_rate(cycles, order, first_cycle=5.0, saturation_fraction=0.2, min_points=5):
-    """The growth rate of ln(order) per cycle over the linear stage (module docstring).
+def fit_growth_rate(cycles, order, first_cycle=5.0, saturation_fraction=0.2, min_points=5,
+                    floor=0.0):
+    """The growth rate of ln(order) per cycle over the linear stage (module docstring), which
+    also ends before the first frame within FLOOR_MARGIN of a known `floor` of the solver.
     Raises NoGrowthFit when fewer than min_points frames lie in it."""
     cycles, order = np.asarray(cycles, float), np.asarray(order, float)
     if cycles.shape != order.shape or cycles.ndim != 1:
         raise ValueError("cycles and order parameters must be 1D arrays of one length")
     usable = np.isfinite(order) & (order > 0) & (cycles >= first_cycle)
     cycles, order = cycles[usable], order[usable]
+    if floor > 0:
+        at_floor = np.flatnonzero(order <= FLOOR_MARGIN * floor)
+        if at_floor.size:
+            cycles, order = cycles[:at_floor[0]], order[:at_floor[0]]
     end = _end_of_linear_stage(order, saturation_fraction)
     cycles, order = cycles[:end], order[:end]
     if cycles.size < min_points:
@@ -154,13 +166,31 @@ def column_mass_modes(fields_path, modes=12):
     return np.array(cycles), np.array(phases), np.array(amplitudes), length
 
 
-def fastest_pattern_mode(cycles, phases, amplitudes, **fit_options):
+def solver_floor(amplitudes):
+    """The amplitude the modes decay to and stay at (round-off and the solver's floors), or 0
+    when the run shows none: the median over the modes of the last FLOOR_FRAMES frames, if it
+    lies FLOOR_DECAY or more below the median of the first frame."""
+    late = float(np.median(amplitudes[-FLOOR_FRAMES:]))
+    return late if late <= FLOOR_DECAY * float(np.median(amplitudes[0])) else 0.0
+
+
+def fastest_pattern_mode(cycles, phases, amplitudes, min_points=10, **fit_options):
     """At the stored phase with the larger mean amplitude, the growth rate of every pattern
-    mode (m >= FIRST_PATTERN_MODE); returns (m, its GrowthRate, {m: rate})."""
+    mode (m >= FIRST_PATTERN_MODE) with at least `min_points` frames in its linear stage above
+    the solver's floor (a mode that reaches the floor sooner decays by more than a decade per
+    cycle or two, and frames on the floor are noise, not growth); returns (m, its GrowthRate,
+    {m: rate}). Raises NoGrowthFit when no mode has enough frames."""
     best_phase = max(np.unique(phases), key=lambda p: amplitudes[phases == p].mean())
     at = phases == best_phase
+    floor = solver_floor(amplitudes[at])
     rates = {}
     for m in range(FIRST_PATTERN_MODE, amplitudes.shape[1] + 1):
-        rates[m] = fit_growth_rate(cycles[at], amplitudes[at, m - 1], **fit_options)
+        try:
+            rates[m] = fit_growth_rate(cycles[at], amplitudes[at, m - 1],
+                                       min_points=min_points, floor=floor, **fit_options)
+        except NoGrowthFit:
+            continue
+    if not rates:
+        raise NoGrowthFit(f"no pattern mode has {min_points} frames in its linear stage")
     fastest = max(rates, key=lambda m: rates[m].rate)
     return fastest, rates[fastest], {m: fit.rate for m, fit in rates.items()}

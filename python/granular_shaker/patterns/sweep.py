@@ -146,9 +146,21 @@ def point_summary(runs):
     return point
 
 
+def rising_branch(points):
+    """The points up to the one with the largest order parameter. Past it the pattern's
+    amplitude falls again as Gamma grows (the layer's flight lengthens towards the next
+    bifurcation), which the supercritical form near onset does not describe."""
+    if not points:
+        return points
+    top = int(np.argmax([p["order"] for p in points]))
+    return points[:top + 1]
+
+
 def fits(points):
-    """The onset and Swift-Hohenberg fits of one case's points, or the reason there are none."""
-    usable = [p for p in points if np.isfinite(p["order_error"]) and p["order_error"] > 0]
+    """The onset and Swift-Hohenberg fits of one case's points (the onset on the rising
+    branch), or the reason there are none."""
+    usable = [p for p in rising_branch(points)
+              if np.isfinite(p["order_error"]) and p["order_error"] > 0]
     gamma = np.array([p["gamma"] for p in usable])
     order = np.array([p["order"] for p in usable])
     error = np.array([p["order_error"] for p in usable])

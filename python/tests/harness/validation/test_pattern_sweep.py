@@ -253,3 +253,16 @@ def test_a_report_with_the_continuum_shows_its_growth_rates(work_dir):
     assert "- onset (growth rate zero): Gamma_c = 2.3000 ± 0.02" in text
     assert os.path.exists(os.path.join(work_dir, make_pattern_report.FIGURES,
                                        "growth_rate.png"))
+
+
+def test_the_onset_is_fitted_on_the_rising_branch_only():
+    gamma = np.round(np.arange(2.0, 3.61, 0.1), 10)
+    # M^2 = 0.04 + (Gamma - 2.45) above onset up to 3.2, then the amplitude falls again
+    power = 0.04 + np.maximum(gamma - 2.45, 0.0) - 1.5 * np.maximum(gamma - 3.2, 0.0)
+    points = [dict(gamma=g, order=float(np.sqrt(p)), order_error=0.01 * float(np.sqrt(p)))
+              for g, p in zip(gamma, power)]
+    assert [p["gamma"] for p in sweep.rising_branch(points)][-1] == 3.2
+    onset = sweep.fits(points)["onset"]
+    assert onset["gamma_c"] == pytest.approx(2.45, abs=0.005)
+    assert onset["chi2_per_dof"] < 1e-6
+    assert sweep.rising_branch([]) == []
