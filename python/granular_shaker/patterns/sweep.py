@@ -159,8 +159,12 @@ def rising_branch(points):
 def fits(points):
     """The onset and Swift-Hohenberg fits of one case's points (the onset on the rising
     branch), or the reason there are none."""
-    usable = [p for p in rising_branch(points)
-              if np.isfinite(p["order_error"]) and p["order_error"] > 0]
+    rising = rising_branch(points)
+    usable = [p for p in rising if np.isfinite(p["order_error"]) and p["order_error"] > 0]
+    if 0 < len(rising) < 5 <= len(points):
+        return dict(onset=dict(reason=f"the order parameter peaks at Gamma {rising[-1]['gamma']:g}"
+                               f": its rising branch holds {len(rising)} points, fewer than the "
+                               "5 an onset fit needs"))
     gamma = np.array([p["gamma"] for p in usable])
     order = np.array([p["order"] for p in usable])
     error = np.array([p["order_error"] for p in usable])

@@ -66,7 +66,7 @@ PATTERN_EXPECTED = {"md.box_width": 128.0, "md.box_depth": 8.0, "layer.particles
                     "run.protocol": "periodic", "material.e": 0.7}
 PATTERN_SOLVER_EXPECTED = {"md": {"md.initial_perturbation": 0.5, "md.collapse_guard": "tc"},
                            "continuum": {"continuum.dimension": 3, "continuum.box_width": 128.0,
-                                         "continuum.box_depth": 8.0}}
+                                         "continuum.box_depth": 4.0}}
 
 
 def test_case_files_are_the_studies():
