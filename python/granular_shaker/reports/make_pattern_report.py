@@ -242,14 +242,21 @@ def combined(md, continuum):
     return "; ".join(parts), verdict
 
 
+def continuum_missing(claim, continuum):
+    """Why the continuum does not measure a claim's part: not run, or no onset in its sweep."""
+    ran = [n for n in claim["cases"] if n in continuum]
+    if not ran:
+        return NOT_RUN
+    return "; ".join(f"{n}: no continuum onset: {continuum[n]['onset'].get('reason', '')} "
+                     "(docs/patterns.md, 'The continuum's onset')" for n in ran)
+
+
 def md_against_continuum(claim, md, continuum):
     """(value, verdict) of a claim comparing the two solvers at one frequency, or a reason."""
     name_md = next((n for n in claim["cases"] if n in md), None)
     name_continuum = next((n for n in claim["cases"] if n in continuum), None)
     if name_continuum is None or onset_of(continuum[name_continuum]) is None:
-        return None, NOT_RUN if name_continuum is None else (
-            "the continuum's growth rate does not change sign over its sweep: "
-            + continuum[name_continuum]["onset"].get("reason", ""))
+        return None, continuum_missing(claim, continuum)
     case_md, case_continuum = md.get(name_md), continuum[name_continuum]
     onset_continuum = onset_of(case_continuum)
     if claim["id"] == "P5":
@@ -302,15 +309,15 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None):
             part = combined(md_part(claim, md, parameters, dispersion),
                             continuum_part(claim, continuum, parameters, dispersion))
             if part is None:
-                reason = (NOT_RUN if not continuum else "neither solver measures it") + (
+                reason = continuum_missing(claim, continuum) + (
                     "; the MD sweep does not measure it either (" + (
                         "no stripes above a fitted onset" if claim["id"] != "P4" or dispersion
                         else "no experimental dispersion relation") + ")")
             else:
                 value, verdict = part
                 if "not measured" in verdict:
-                    reason = NOT_RUN if "continuum not" in verdict else \
-                        "the MD sweep does not measure it"
+                    reason = continuum_missing(claim, continuum) if "continuum not" in verdict \
+                        else "the MD sweep does not measure it"
         elif claim["id"] == "P9":
             strengths = {name: case.get("swift_hohenberg", {}).get("strength")
                          for name, case in md.items()}

@@ -269,3 +269,18 @@ def test_the_onset_is_fitted_on_the_rising_branch_only():
     assert sweep.rising_branch([]) == []
     early = [dict(p, order=2.0 - 0.1 * i) for i, p in enumerate(points)]  # falls from the 1st
     assert "rising branch holds 1 points" in sweep.fits(early)["onset"]["reason"]
+
+
+def test_a_continuum_without_an_onset_is_named_as_the_reason():
+    decaying = synthetic_continuum(5.0)  # every rate negative over Gamma 2 to 3
+    decaying["onset"] = dict(reason="the growth rates do not change sign from negative to "
+                                    "positive over Gamma 2 to 3")
+    cases = {"pattern_md_f0p18": synthetic_case(21.3, 2.5),
+             "pattern_md_f0p14": synthetic_case(25.6, 2.3),
+             "pattern_continuum_f0p18": decaying}
+    rows = verdicts(cases, None)
+    assert rows["P2"]["verdict"] == "not measured"
+    assert rows["P2"]["reason"].startswith("pattern_continuum_f0p18: no continuum onset: the "
+                                           "growth rates do not change sign")
+    assert rows["P1"]["verdict"] == "MD pass; continuum not measured"
+    assert "no continuum onset" in rows["P1"]["reason"]
