@@ -158,3 +158,13 @@ def test_modes_on_the_solvers_floor_are_not_taken_for_slow_growth():
     assert growth.solver_floor(amplitudes) > 0.0
     assert mode == 4 and fit.rate == pytest.approx(-0.15, rel=0.02)
     assert set(rates) == {4}  # modes 2 and 3 have no frames 10 times above the floor
+
+
+def test_a_band_of_growth_gives_the_onset_of_its_rising_side():
+    gamma = np.array([2.2, 2.6, 3.0, 3.4, 3.8, 4.2])
+    rate = np.array([-0.4, -0.3, -0.2, -0.1, 0.05, -0.2])  # grows near 3.8 only
+    crossing = fit_zero_crossing(gamma, rate, np.full(6, 0.01))
+    assert crossing.points == 3  # 3.0, 3.4 and 3.8; not 4.2, where it decays again
+    # the line through (3.0, -0.2), (3.4, -0.1), (3.8, 0.05) crosses zero near 3.69
+    slope, intercept = np.polyfit(gamma[2:5], rate[2:5], 1)
+    assert crossing.gamma_c == pytest.approx(-intercept / slope, rel=1e-9)

@@ -20,7 +20,8 @@ cycle, crosses zero as Gamma rises.
   the fastest-growing one. The pattern modes are m >= 2: mode 1, the box's own length, carries
   a slow sloshing of the whole layer (a period of several cycles, not a standing wave).
 - fit_zero_crossing: Gamma_c from a weighted straight line through the growth rates of the
-  points nearest to the change of sign, its error from the line's covariance (delta method).
+  points nearest to the first change of sign from decay to growth (on its rising side only),
+  its error from the line's covariance (delta method).
 
 python/tests/test_pattern_growth.py measures the bias and the coverage of both errors on
 synthetic series and sweeps of known rate and onset.
@@ -109,9 +110,9 @@ def _end_of_linear_stage(order, fraction):
 
 
 def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
-    """Gamma_c where the growth rate changes sign: a weighted straight line through the
-    `neighbours` points on each side of the change nearest to it. Raises NoGrowthFit when the
-    rates do not change sign from negative to positive."""
+    """Gamma_c where the growth rate first changes sign from negative to positive: a weighted
+    straight line through the `neighbours` points below the change and up to `neighbours`
+    growing points from it. Raises NoGrowthFit when the rates do not change sign so."""
     gamma, rate, error = (np.asarray(a, float) for a in (gamma, rate, rate_error))
     if not (gamma.shape == rate.shape == error.shape) or gamma.ndim != 1:
         raise ValueError("one growth rate and one error per acceleration")
@@ -124,7 +125,12 @@ def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
         raise NoGrowthFit("the growth rates do not change sign from negative to positive "
                           f"over Gamma {gamma[0]:.4g} to {gamma[-1]:.4g}")
     change = positive[0]
-    chosen = slice(max(change - neighbours, 0), min(change + neighbours, gamma.size))
+    # Only the rising side of the first change of sign: a rate that falls below zero again
+    # further up (a band of instability) does not belong to this onset's line.
+    rising = change
+    while rising + 1 < min(change + neighbours, gamma.size) and rate[rising + 1] > 0:
+        rising += 1
+    chosen = slice(max(change - neighbours, 0), rising + 1)
     g, r, s = gamma[chosen], rate[chosen], error[chosen]
     design = np.column_stack([np.ones_like(g), g]) / s[:, None]
     coefficients, *_ = np.linalg.lstsq(design, r / s, rcond=None)
