@@ -289,9 +289,22 @@ def md_against_continuum(claim, md, continuum):
     return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)}", judge(value, claim)), ""
 
 
-def claim_verdicts(claims, cases, parameters=None, dispersion=None):
+def coarse_continuum_note(sweep):
+    """The caveat of a continuum run at a coarser cell than its case files' (a study override),
+    or "" when it ran as designed."""
+    cells = [o.split("=", 1)[1] for o in (sweep.get("continuum") or {}).get("overrides", [])
+             if o.startswith("continuum.cell_size=")]
+    if not cells:
+        return ""
+    return (f"the continuum ran at cell {cells[-1]} (this study's override), where numerical "
+            "dissipation carries much of its modes' decay: its onset there most likely bounds "
+            "its own from above (docs/patterns.md, 'The continuum's onset')")
+
+
+def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_note=""):
     """Every claim with its verdict: measured by the sweep, or not measured and why. A claim on
-    both solvers that only one of them measures gets that one's verdict, marked as its alone."""
+    both solvers that only one of them measures gets that one's verdict, marked as its alone.
+    `continuum_note` is added to the reason of every verdict the continuum takes part in."""
     md = {n: c for n, c in solver_cases(cases, "md").items() if n.startswith("pattern_md")}
     continuum = solver_cases(cases, "continuum")
     parameters = parameters or {}
@@ -330,6 +343,10 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None):
                 reason = "needs Swift-Hohenberg fits at both frequencies: " + "; ".join(
                     f"{n}: {c.get('swift_hohenberg', c.get('onset', {})).get('reason', 'fitted')}"
                     for n, c in md.items())
+        uses_continuum = claim["solvers"] == "md_vs_continuum" and verdict != "not measured" \
+            or claim["solvers"] == "both" and "continuum:" in str(value)
+        if continuum_note and uses_continuum:
+            reason = "; ".join(r for r in (reason, continuum_note) if r)
         rows.append(dict(id=claim["id"], statement=claim["statement"], value=value,
                          verdict=verdict, reason=reason, status=claim["status"]))
     return rows
@@ -426,7 +443,8 @@ def report_text(results, claims, figure, parameters=None, dispersion=None, growt
         lines += case_lines(name, case)
     lines += ["## Claims (reference-data/pattern-claims.toml)", "",
               "| claim | statement | value | verdict | why |", "| --- | --- | --- | --- | --- |"]
-    for row in claim_verdicts(claims, results["cases"], parameters, dispersion):
+    for row in claim_verdicts(claims, results["cases"], parameters, dispersion,
+                              coarse_continuum_note(sweep)):
         lines.append(f"| {row['id']} ({row['status']}) | {row['statement']} | {row['value']} | "
                      f"{row['verdict']} | {row['reason']} |")
     if results["failures"]:

@@ -284,3 +284,22 @@ def test_a_continuum_without_an_onset_is_named_as_the_reason():
                                            "growth rates do not change sign")
     assert rows["P1"]["verdict"] == "MD pass; continuum not measured"
     assert "no continuum onset" in rows["P1"]["reason"]
+
+
+def test_a_continuum_at_a_coarser_cell_says_so_beside_its_verdicts():
+    sweep_table = dict(continuum=dict(overrides=["continuum.cell_size=2.0",
+                                                 "continuum.box_depth=8.0"]))
+    note = make_pattern_report.coarse_continuum_note(sweep_table)
+    assert note.startswith("the continuum ran at cell 2.0")
+    assert make_pattern_report.coarse_continuum_note(dict(continuum=dict(overrides=[]))) == ""
+    assert make_pattern_report.coarse_continuum_note({}) == ""
+    with open(os.path.join(REPOSITORY, make_pattern_report.CLAIMS), "rb") as f:
+        claims = tomllib.load(f)["claim"]
+    cases = {"pattern_md_f0p18": synthetic_case(21.3, 2.5),
+             "pattern_md_f0p14": synthetic_case(25.6, 2.3),
+             "pattern_continuum_f0p18": synthetic_continuum(2.3)}
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {"pattern_md_f0p14": (0.14, 5.0), "pattern_md_f0p18": (0.18, 5.0),
+                        "pattern_continuum_f0p18": (0.18, 5.0)}, None, note)}
+    assert note in rows["P2"]["reason"] and note in rows["P1"]["reason"]
+    assert note not in rows["P9"]["reason"]  # an MD-only claim
