@@ -26,8 +26,9 @@ SUBHARMONIC_CORRELATION = -0.5
 
 
 def ordered(point):
-    return (point["a2"] >= STRIPES_A2
-            and point["correlation_previous_cycle"] <= SUBHARMONIC_CORRELATION)
+    """A point without a symmetry measurement (a figure's bare points) is not ordered."""
+    return (point.get("a2", 0.0) >= STRIPES_A2
+            and point.get("correlation_previous_cycle", 0.0) <= SUBHARMONIC_CORRELATION)
 
 
 FIGURES = "patterns"  # beside the report
@@ -56,6 +57,10 @@ def figure_order_parameter(cases):
             fine = np.linspace(gamma.min(), gamma.max(), 200)
             ax.plot(fine, onset_curve(case["onset"], fine), color=drawn[0].get_color(), lw=1,
                     label=f"{name}: onset fit, Gamma_c = {case['onset']['gamma_c']:.3f}")
+        elif order_bracket(case):
+            low, high = order_bracket(case)[2:]
+            ax.axvspan(low, high, color=drawn[0].get_color(), alpha=0.15,
+                       label=f"{name}: onset of order between Gamma {low:g} and {high:g}")
     ax.set_xlabel("plate acceleration Gamma [g]")
     ax.set_ylabel("order parameter of the column mass [1/sigma^2]")
     rc.legend_above(fig, columns=1)
@@ -77,7 +82,7 @@ def figure_growth_rate(cases):
         if "gamma_c" in onset:
             ax.axvline(onset["gamma_c"], color=drawn[0].get_color(), lw=1, ls="--",
                        label=f"{name}: Gamma_c = {onset['gamma_c']:.3f}")
-    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.axhline(0.0, color="0.5", lw=0.8, label="no growth")
     ax.set_xlabel("plate acceleration Gamma [g]")
     ax.set_ylabel("growth rate of the fastest pattern mode [1/cycle]")
     rc.legend_above(fig, columns=1)
@@ -124,9 +129,33 @@ def stripe_wavelength(case):
     return float(lengths.mean()), float(lengths.std(ddof=1) / np.sqrt(lengths.size))
 
 
+def order_bracket(case):
+    """The onset of ordered standing waves bracketed by the sweep: (midpoint, its standard
+    error as a uniform distribution over the bracket, last disordered Gamma, first ordered
+    Gamma), when every point above some Gamma is ordered and none below it; else None."""
+    points = sorted(case["points"], key=lambda p: p["gamma"])
+    flags = [ordered(p) for p in points]
+    if True not in flags or False not in flags:
+        return None
+    first = flags.index(True)
+    if first == 0 or not all(flags[first:]):
+        return None
+    low, high = points[first - 1]["gamma"], points[first]["gamma"]
+    return 0.5 * (low + high), (high - low) / np.sqrt(12.0), low, high
+
+
+def md_onset(case):
+    """The MD's onset of order: the onset fit's, else the sweep's bracket of ordered points."""
+    fitted = onset_of(case)
+    if fitted is not None:
+        return fitted
+    bracket = order_bracket(case) if case else None
+    return bracket[:2] if bracket else None
+
+
 def stripes_above_onset_only(case):
-    """MD part of P1: ordered stripes at the Gamma above the fitted onset, none below it."""
-    onset = case.get("onset", {}).get("gamma_c")
+    """MD part of P1: ordered stripes at the Gamma above the onset, none below it."""
+    onset = (md_onset(case) or (None,))[0]
     shown = ordered_gammas(case)
     if onset is None or not shown:
         return None
@@ -201,11 +230,14 @@ def continuum_part(claim, continuum, parameters, dispersion):
     if claim["id"] == "P1":
         # In a box a few cells deep every mode along x is a stripe: the planform follows from
         # the geometry, so the part judged is growth above the onset and decay below it.
-        fine = all((p["rate"] > 0) == (p["gamma"] > onset_of(c)[0])
-                   for c in measured.values() for p in c["points"])
-        return ("; ".join(f"{n}: growth rate changes sign once, at Gamma_c "
-                          f"{rc.fmt(onset_of(c)[0])}" for n, c in measured.items()),
-                "pass" if fine else "fail")
+        def contrary(case):
+            return [p["gamma"] for p in case["points"]
+                    if (p["rate"] > 0) != (p["gamma"] > onset_of(case)[0])]
+
+        return ("; ".join(f"{n}: growth from Gamma_c {rc.fmt(onset_of(c)[0])}" + (
+            "; against it at Gamma " + ", ".join(f"{g:g}" for g in contrary(c))
+            if contrary(c) else "") for n, c in measured.items()),
+                "pass" if not any(contrary(c) for c in measured.values()) else "fail")
     first = {n: first_growing_point(c) for n, c in measured.items()}
     if claim["id"] == "P3" and len(first) == 2 and None not in first.values():
         low, high = sorted(first, key=lambda n: parameters[n][0])
@@ -243,12 +275,20 @@ def combined(md, continuum):
 
 
 def continuum_missing(claim, continuum):
-    """Why the continuum does not measure a claim's part: not run, or no onset in its sweep."""
-    ran = [n for n in claim["cases"] if n in continuum]
-    if not ran:
+    """Why the continuum does not measure a claim's part: cases not run, or no onset."""
+    if not continuum:
         return NOT_RUN
-    return "; ".join(f"{n}: no continuum onset: {continuum[n]['onset'].get('reason', '')} "
-                     "(docs/patterns.md, 'The continuum's onset')" for n in ran)
+    reasons = []
+    for name in claim["cases"]:
+        if "continuum" not in name:
+            continue
+        if name not in continuum:
+            reasons.append(f"{name}: not run in this study")
+        elif onset_of(continuum[name]) is None:
+            reasons.append(f"{name}: no continuum onset: "
+                           f"{continuum[name]['onset'].get('reason', '')} (docs/patterns.md, "
+                           "'The continuum's onset')")
+    return "; ".join(reasons) or "the continuum's cases do not give its quantity"
 
 
 def md_against_continuum(claim, md, continuum):
@@ -262,28 +302,32 @@ def md_against_continuum(claim, md, continuum):
     if claim["id"] == "P5":
         return None, NO_SATURATION
     if claim["id"] == "P2":
-        if onset_of(case_md) is None:
-            return None, "the MD's onset is not fitted (its case's onset fit)"
-        value, error = ratio_with_error(onset_of(case_md), onset_continuum)
+        if md_onset(case_md) is None:
+            return None, "the MD's onset is neither fitted nor bracketed by ordered points"
+        value, error = ratio_with_error(md_onset(case_md), onset_continuum)
     elif claim["id"] == "P8":
         if onset_of(case_md, "swift_hohenberg", "gamma_mf") is None:
-            return None, "the MD's Swift-Hohenberg fit below onset has no mean-field onset"
+            fit = (case_md or {}).get("swift_hohenberg") or (case_md or {}).get("onset", {})
+            return None, ("no Swift-Hohenberg fit of the MD below onset: "
+                          + fit.get("reason", "not fitted"))
         value, error = ratio_with_error(onset_of(case_md, "swift_hohenberg", "gamma_mf"),
                                         onset_continuum)
     elif claim["id"] == "P6":
-        top = min(onset_continuum[0], (onset_of(case_md) or (np.inf,))[0])
-        below = [p for p in case_continuum["points"] if p["gamma"] < top]
-        md_points = {p["gamma"]: p for p in (case_md or {}).get("points", [])}
-        shared = [p for p in below if p["gamma"] in md_points]
-        if not shared:
-            return None, "no Gamma below both solvers' onsets that both sweeps ran"
-        point = shared[-1]
-        mine = md_points[point["gamma"]]
+        # Each solver below its own onset: the MD's noise at its highest Gamma below its onset,
+        # the continuum's last frame at its Gamma nearest to that below its own onset.
+        onset_md = md_onset(case_md)
+        below_md = [p for p in (case_md or {}).get("points", [])
+                    if onset_md is not None and p["gamma"] < onset_md[0]]
+        below = [p for p in case_continuum["points"] if p["gamma"] < onset_continuum[0]]
+        if not below_md or not below:
+            return None, "no point below its onset in one of the solvers' sweeps"
+        mine = max(below_md, key=lambda p: p["gamma"])
+        point = min(below, key=lambda p: abs(p["gamma"] - mine["gamma"]))
         value = mine["order"] / point["final_order"]
         error = value * mine["order_error"] / mine["order"]
-        return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)} at Gamma {point['gamma']:g} (MD "
-                f"{rc.fmt(mine['order'])}, continuum's last frame {rc.fmt(point['final_order'])}"
-                " [1/sigma^2])", judge(value, claim)), ""
+        return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)} (MD {rc.fmt(mine['order'])} at Gamma "
+                f"{mine['gamma']:g}, continuum's last frame {rc.fmt(point['final_order'])} at "
+                f"Gamma {point['gamma']:g} [1/sigma^2])", judge(value, claim)), ""
     else:
         return None, f"claim {claim['id']} is not judged from the sweep"
     return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)}", judge(value, claim)), ""
@@ -404,6 +448,11 @@ def case_lines(name, case):
                          f"{fit['chi2_per_dof']:.3g}, {fit['points']} points)")
         else:
             lines.append(f"- {model}: none: {fit['reason']}")
+    bracket = order_bracket(case)
+    if "gamma_c" not in case.get("onset", {}) and bracket:
+        lines.append(f"- onset of order bracketed by the sweep: Gamma_c = {bracket[0]:.4g} ± "
+                     f"{bracket[1]:.2g} (last disordered point {bracket[2]:g}, first ordered "
+                     f"{bracket[3]:g}; the error of a uniform distribution over the bracket)")
     return lines + [""]
 
 

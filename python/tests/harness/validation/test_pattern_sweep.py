@@ -235,6 +235,7 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
         claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
                         "pattern_md_f0p18": (0.18, 5.0)}, relation)}
     assert rows["P1"]["verdict"] == "fail"
+    assert "growth from Gamma_c 2.3; against it at Gamma 2.6" in rows["P1"]["value"]
 
 
 def test_a_report_with_the_continuum_shows_its_growth_rates(work_dir):
@@ -303,3 +304,16 @@ def test_a_continuum_at_a_coarser_cell_says_so_beside_its_verdicts():
                         "pattern_continuum_f0p18": (0.18, 5.0)}, None, note)}
     assert note in rows["P2"]["reason"] and note in rows["P1"]["reason"]
     assert note not in rows["P9"]["reason"]  # an MD-only claim
+
+
+def test_without_an_onset_fit_the_md_onset_is_the_bracket_of_ordered_points():
+    case = synthetic_case(21.3, 2.5)  # ordered at 2.6, 2.8, 3.0; disordered at 2.4 and below
+    case["onset"] = dict(reason="the best onset is at the end of the sweep")
+    middle, error, low, high = make_pattern_report.order_bracket(case)
+    assert (low, high) == (2.4, 2.6)
+    assert middle == pytest.approx(2.5) and error == pytest.approx(0.2 / np.sqrt(12.0))
+    assert make_pattern_report.md_onset(case) == (middle, error)
+    assert make_pattern_report.stripes_above_onset_only(case) is True
+    mixed = synthetic_case(21.3, 2.5, ordered_below=True)  # ordered at 2.0 too: no bracket
+    mixed["onset"] = {}
+    assert make_pattern_report.order_bracket(mixed) is None
