@@ -76,7 +76,7 @@ def figure_growth_rate(cases):
         points = case["points"]
         drawn = ax.errorbar([p["gamma"] for p in points], [p["rate"] for p in points],
                             yerr=[p["rate_error"] for p in points],
-                            label=f"continuum {name} (± standard error)",
+                            label=f"continuum {name}: fastest pattern mode (± standard error)",
                             **{**rc.CONTINUUM_STYLE, "marker": "s", "ms": 3})
         onset = case.get("onset", {})
         if "gamma_c" in onset:
@@ -84,7 +84,7 @@ def figure_growth_rate(cases):
                        label=f"{name}: Gamma_c = {onset['gamma_c']:.3f}")
     ax.axhline(0.0, color="0.5", lw=0.8, label="no growth")
     ax.set_xlabel("plate acceleration Gamma [g]")
-    ax.set_ylabel("growth rate of the fastest pattern mode [1/cycle]")
+    ax.set_ylabel("growth rate [1/cycle]")
     rc.legend_above(fig, columns=1)
     return fig
 

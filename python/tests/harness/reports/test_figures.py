@@ -231,7 +231,19 @@ FIGURE_CASES = {
                              "onset": dict(gamma_c=2.5, floor=0.09, slope=0.6)},
         "pattern_md_f0p14": {"points": [dict(gamma=g, order=0.3, order_error=0.02)
                                         for g in (2.0, 2.4, 2.8, 3.2)],
-                             "onset": dict(reason="no onset")}})],
+                             "onset": dict(reason="no onset")}}),
+        patterns.figure_order_parameter({"pattern_md_f0p18": {
+            "points": [dict(gamma=g, order=m, order_error=0.02, a2=1.0,
+                            correlation_previous_cycle=c) for g, m, c in
+                       zip((2.0, 2.1, 2.2, 2.4), (0.6, 0.7, 1.2, 1.8), (0.0, -0.2, -0.7, -0.8))],
+            "onset": dict(reason="the best onset is at the end of the sweep")}})],
+    "make_pattern_report.figure_growth_rate": lambda i: [patterns.figure_growth_rate({
+        "pattern_continuum_f0p18": {"points": [dict(gamma=g, rate=r, rate_error=0.02) for g, r in
+                                               zip((2.2, 3.0, 3.8, 4.2), (-0.2, -0.1, 0.06, -0.1))],
+                                    "onset": dict(gamma_c=3.5, gamma_c_error=0.07)},
+        "pattern_continuum_f0p14": {"points": [dict(gamma=g, rate=-0.2, rate_error=0.02)
+                                               for g in (2.2, 3.0, 3.8, 4.2)],
+                                    "onset": dict(reason="no change of sign")}})],
     "make_sensitivity_report.figure_variants":
         lambda i: [sens.figure_variants(i.sensitivity[0])],
     "make_sensitivity_report.figure_knudsen_maps":
