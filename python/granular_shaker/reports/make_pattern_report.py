@@ -340,9 +340,9 @@ def coarse_continuum_note(sweep):
              if o.startswith("continuum.cell_size=")]
     if not cells:
         return ""
-    return (f"the continuum ran at cell {cells[-1]} (this study's override), where numerical "
-            "dissipation carries much of its modes' decay: its onset there most likely bounds "
-            "its own from above (docs/patterns.md, 'The continuum's onset')")
+    return (f"the continuum ran at cell {cells[-1]} (this study's override), coarser than its "
+            "case files': its growth rates there are not grid-converged (docs/patterns.md, 'The "
+            "continuum's onset', compares them with the case files' cell)")
 
 
 def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_note=""):
