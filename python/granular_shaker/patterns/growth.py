@@ -31,6 +31,8 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
+from .onset import linear_fit
+
 FIRST_PATTERN_MODE = 2
 # The modes of a run sit on a floor of the solver's when their typical amplitude over the last
 # frames is this fraction of their typical first amplitude or less (three decades of decay);
@@ -82,11 +84,10 @@ def fit_growth_rate(cycles, order, first_cycle=5.0, saturation_fraction=0.2, min
     if cycles.size < min_points:
         raise NoGrowthFit(f"{cycles.size} frames in the linear stage from cycle {first_cycle} "
                           f"(need {min_points})")
-    design = np.column_stack([np.ones_like(cycles), cycles])
-    coefficients, *_ = np.linalg.lstsq(design, np.log(order), rcond=None)
-    residual = np.log(order) - design @ coefficients
-    variance = residual @ residual / (cycles.size - 2)
-    covariance = variance * np.linalg.inv(design.T @ design)
+    # Unit weights: the scatter about the line sets the variance.
+    coefficients, covariance, chi2 = linear_fit([np.ones_like(cycles), cycles], np.log(order),
+                                                np.ones_like(cycles))
+    covariance = covariance * chi2 / (cycles.size - 2)
     return GrowthRate(float(coefficients[1]), float(np.sqrt(covariance[1, 1])),
                       float(cycles[0]), float(cycles[-1]), int(cycles.size))
 
@@ -131,13 +132,12 @@ def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
     while rising + 1 < min(change + neighbours, gamma.size) and rate[rising + 1] > 0:
         rising += 1
     chosen = slice(max(change - neighbours, 0), rising + 1)
-    g, r, s = gamma[chosen], rate[chosen], error[chosen]
-    design = np.column_stack([np.ones_like(g), g]) / s[:, None]
-    coefficients, *_ = np.linalg.lstsq(design, r / s, rcond=None)
-    residual = r / s - design @ coefficients
+    g = gamma[chosen]
+    coefficients, covariance, chi2 = linear_fit([np.ones_like(g), g], rate[chosen],
+                                                error[chosen])
     dof = g.size - 2
-    chi2_per_dof = float(residual @ residual / dof) if dof > 0 else float("nan")
-    covariance = np.linalg.inv(design.T @ design) * (max(1.0, chi2_per_dof) if dof > 0 else 1.0)
+    chi2_per_dof = chi2 / dof if dof > 0 else float("nan")
+    covariance = covariance * (max(1.0, chi2_per_dof) if dof > 0 else 1.0)
     intercept, slope = coefficients
     if not slope > 0:
         raise NoGrowthFit(f"the growth rate does not rise with Gamma near the change of sign "

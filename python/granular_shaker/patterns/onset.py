@@ -69,7 +69,7 @@ def _power_and_error(order, error):
     return order ** 2, 2.0 * np.abs(order) * error
 
 
-def _linear_fit(columns, y, sigma):
+def linear_fit(columns, y, sigma):
     """Weighted least squares of y on the columns: coefficients, their covariance, chi^2."""
     design = np.column_stack(columns) / sigma[:, None]
     target = y / sigma
@@ -103,7 +103,7 @@ def _best_fit(x_of, candidates, chi2, best, y, sigma, what):
     inside = np.flatnonzero(chi2 <= chi2[best] + scale)
     step = candidates[1] - candidates[0]
     half_width = 0.5 * (candidates[inside[-1]] - candidates[inside[0]] + step)
-    coefficients, covariance, _ = _linear_fit([np.ones_like(y), x_of(candidates[best])], y, sigma)
+    coefficients, covariance, _ = linear_fit([np.ones_like(y), x_of(candidates[best])], y, sigma)
     errors = np.sqrt(np.diag(covariance) * scale)
     if not coefficients[1] > 2.0 * errors[1]:
         raise NoOnset(f"{what} ({coefficients[1]:.3g} +- {errors[1]:.2g})")
