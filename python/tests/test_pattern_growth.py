@@ -4,6 +4,7 @@ over many independent noisy realisations, at the scatter the continuum's series 
 cent in M from cycle to cycle)."""
 import numpy as np
 import pytest
+from estimator_coverage import coverage
 
 from granular_shaker.patterns import growth
 from granular_shaker.patterns import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
@@ -48,12 +49,8 @@ def test_a_clean_exponential_gives_its_rate_and_the_linear_stage_ends_before_sat
 def rate_fits(rate, saturation, relative):
     fits = [fit_growth_rate(CYCLES, scattered(growing(rate, saturation), relative, seed))
             for seed in range(REALISATIONS)]
-    deviation = np.array([f.rate for f in fits]) - rate
-    error = np.array([f.rate_error for f in fits])
-    one, two = np.mean(np.abs(deviation) <= error), np.mean(np.abs(deviation) <= 2 * error)
-    print(f"measured at rate {rate}: bias {deviation.mean():.2e}, mean error {error.mean():.2e}, "
-          f"coverage {one:.3f} (1 error), {two:.3f} (2 errors)")
-    return deviation, error, one, two
+    return coverage([f.rate for f in fits], [f.rate_error for f in fits], rate,
+                    f"measured at rate {rate}")
 
 
 def test_near_onset_the_rate_error_covers_the_truth_as_a_standard_error_should():
@@ -80,11 +77,8 @@ def test_the_onset_error_covers_the_truth():
                  for i, r in enumerate(truth)]
         fits.append(fit_zero_crossing(GAMMA, [f.rate for f in rates],
                                       [f.rate_error for f in rates]))
-    deviation = np.array([f.gamma_c for f in fits]) - ONSET
-    error = np.array([f.gamma_c_error for f in fits])
-    one, two = np.mean(np.abs(deviation) <= error), np.mean(np.abs(deviation) <= 2 * error)
-    print(f"measured: bias {deviation.mean():.2e}, mean error {error.mean():.2e}, coverage "
-          f"{one:.3f} (1 error), {two:.3f} (2 errors)")
+    deviation, error, one, two = coverage([f.gamma_c for f in fits],
+                                          [f.gamma_c_error for f in fits], ONSET)
     assert abs(deviation.mean()) < 0.2 * error.mean()
     assert 0.6 <= one <= 0.8
     assert 0.9 <= two <= 1.0

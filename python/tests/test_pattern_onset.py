@@ -3,6 +3,7 @@ the fitted onset and the coverage of its error, over many independent noisy swee
 relative errors of the order parameter the study measures (a few per cent)."""
 import numpy as np
 import pytest
+from estimator_coverage import coverage
 
 from granular_shaker.patterns import NoOnset, fit_onset, fit_swift_hohenberg
 
@@ -39,11 +40,8 @@ def test_a_noiseless_sweep_gives_the_onset_and_the_coefficients():
 
 def test_the_onset_error_covers_the_truth_as_a_standard_error_should():
     fits = [fit_onset(GAMMA, *noisy(supercritical(GAMMA), 0.03, seed)) for seed in range(SWEEPS)]
-    deviation = np.array([f.gamma_c for f in fits]) - ONSET
-    error = np.array([f.gamma_c_error for f in fits])
-    one, two = np.mean(np.abs(deviation) <= error), np.mean(np.abs(deviation) <= 2 * error)
-    print(f"measured: bias {deviation.mean():.2e}, spread {deviation.std():.2e}, mean error "
-          f"{error.mean():.2e}, coverage {one:.3f} (1 error), {two:.3f} (2 errors)")
+    deviation, error, one, two = coverage([f.gamma_c for f in fits],
+                                          [f.gamma_c_error for f in fits], ONSET)
     assert abs(deviation.mean()) < 0.2 * error.mean()
     assert 0.6 <= one <= 0.8
     assert 0.9 <= two <= 1.0
@@ -52,11 +50,8 @@ def test_the_onset_error_covers_the_truth_as_a_standard_error_should():
 def test_the_mean_field_onset_error_covers_the_truth():
     fits = [fit_swift_hohenberg(BELOW, *noisy(swift_hohenberg(BELOW), 0.03, seed))
             for seed in range(SWEEPS)]
-    deviation = np.array([f.gamma_mf for f in fits]) - MEAN_FIELD
-    error = np.array([f.gamma_mf_error for f in fits])
-    one, two = np.mean(np.abs(deviation) <= error), np.mean(np.abs(deviation) <= 2 * error)
-    print(f"measured: median deviation {np.median(deviation):.2e}, mean error {error.mean():.2e}, "
-          f"coverage {one:.3f} (1 error), {two:.3f} (2 errors)")
+    deviation, error, one, two = coverage([f.gamma_mf for f in fits],
+                                          [f.gamma_mf_error for f in fits], MEAN_FIELD)
     # The interval is skewed (the divergence bounds it from below), so the median is the
     # estimator's centre.
     assert abs(np.median(deviation)) < 0.2 * error.mean()
