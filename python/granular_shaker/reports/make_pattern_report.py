@@ -57,8 +57,8 @@ def figure_order_parameter(cases):
             fine = np.linspace(gamma.min(), gamma.max(), 200)
             ax.plot(fine, onset_curve(case["onset"], fine), color=drawn[0].get_color(), lw=1,
                     label=f"{name}: onset fit, Gamma_c = {case['onset']['gamma_c']:.3f}")
-        elif order_bracket(case):
-            low, high = order_bracket(case)[2:]
+        elif bracket := order_bracket(case):
+            low, high = bracket[2:]
             ax.axvspan(low, high, color=drawn[0].get_color(), alpha=0.15,
                        label=f"{name}: onset of order between Gamma {low:g} and {high:g}")
     ax.set_xlabel("plate acceleration Gamma [g]")
@@ -127,6 +127,11 @@ def stripe_wavelength(case):
     if lengths.size < 2:
         return None
     return float(lengths.mean()), float(lengths.std(ddof=1) / np.sqrt(lengths.size))
+
+
+def onset_of(case, key="onset", parameter="gamma_c"):
+    fit = (case or {}).get(key, {})
+    return (fit[parameter], fit[parameter + "_error"]) if parameter in fit else None
 
 
 def order_bracket(case):
@@ -205,11 +210,6 @@ def md_part(claim, md, parameters, dispersion):
     return None
 
 
-def onset_of(case, key="onset", parameter="gamma_c"):
-    fit = (case or {}).get(key, {})
-    return (fit[parameter], fit[parameter + "_error"]) if parameter in fit else None
-
-
 def ratio_with_error(a, b):
     (x, dx), (y, dy) = a, b
     return x / y, x / y * np.hypot(dx / x, dy / y)
@@ -230,14 +230,13 @@ def continuum_part(claim, continuum, parameters, dispersion):
     if claim["id"] == "P1":
         # In a box a few cells deep every mode along x is a stripe: the planform follows from
         # the geometry, so the part judged is growth above the onset and decay below it.
-        def contrary(case):
-            return [p["gamma"] for p in case["points"]
-                    if (p["rate"] > 0) != (p["gamma"] > onset_of(case)[0])]
-
+        contrary = {n: [p["gamma"] for p in c["points"]
+                        if (p["rate"] > 0) != (p["gamma"] > onset_of(c)[0])]
+                    for n, c in measured.items()}
         return ("; ".join(f"{n}: growth from Gamma_c {rc.fmt(onset_of(c)[0])}" + (
-            "; against it at Gamma " + ", ".join(f"{g:g}" for g in contrary(c))
-            if contrary(c) else "") for n, c in measured.items()),
-                "pass" if not any(contrary(c) for c in measured.values()) else "fail")
+            "; against it at Gamma " + ", ".join(f"{g:g}" for g in contrary[n])
+            if contrary[n] else "") for n, c in measured.items()),
+                "fail" if any(contrary.values()) else "pass")
     first = {n: first_growing_point(c) for n, c in measured.items()}
     if claim["id"] == "P3" and len(first) == 2 and None not in first.values():
         low, high = sorted(first, key=lambda n: parameters[n][0])
