@@ -47,9 +47,17 @@ class Fields:
         return averages
 
 
-def read_fields(path, frame="lab"):
-    """Read a fields file (`RUN.fields.h5`); `frame` "lab" (as stored) or "plate"."""
+def read_fields(path, frame="lab", names=None):
+    """Read a fields file (`RUN.fields.h5`); `frame` "lab" (as stored) or "plate". `names`, if
+    given, the datasets of each snapshot to read (of "points", FIELD_NAMES and
+    OPTIONAL_FIELD_NAMES; the snapshots' attributes always): a reader of one field need not
+    hold the others of a long run in memory."""
     check_frame(frame)
+    every = ("points", *FIELD_NAMES, *OPTIONAL_FIELD_NAMES)
+    wanted = every if names is None else tuple(names)
+    unknown = sorted(set(wanted) - set(every))
+    if unknown:
+        raise ValueError(f"read_fields: unknown datasets {unknown}; allowed: {', '.join(every)}")
     with h5py.File(path, "r") as f:
         check_schema_version(f.attrs, path)
         kind = text(f.attrs.get("kind", "(none)"))
@@ -66,7 +74,7 @@ def read_fields(path, frame="lab"):
         snapshots = Table(
             {key: np.array([float(g.attrs[key]) for g in groups]) for key in _SNAPSHOT_ATTRIBUTES},
             _SNAPSHOT_ATTRIBUTES)
-        for name in ("points", *FIELD_NAMES, *OPTIONAL_FIELD_NAMES):
+        for name in wanted:
             if name in OPTIONAL_FIELD_NAMES and name not in groups[0]:
                 continue
             snapshots[name] = np.stack([g[name][()] for g in groups])
@@ -77,12 +85,14 @@ def read_fields(path, frame="lab"):
         hexahedra = f["hexahedra"][()]
     plate_z = snapshots["plate_z"]
     snapshots["z"] = (np.arange(nz) + 0.5) * h + plate_z[:, None]
-    snapshots.units["z"] = snapshots.units["points"]
+    snapshots.units["z"] = _SNAPSHOT_ATTRIBUTES["plate_z"]
     if frame == "plate":
         snapshots["z"] = snapshots["z"] - plate_z[:, None]
-        snapshots["points"] = snapshots["points"].copy()
-        snapshots["points"][:, :, 2] -= plate_z[:, None]
-        snapshots["uz"] = snapshots["uz"] - snapshots["plate_v"][:, None, None, None]
+        if "points" in snapshots:
+            snapshots["points"] = snapshots["points"].copy()
+            snapshots["points"][:, :, 2] -= plate_z[:, None]
+        if "uz" in snapshots:
+            snapshots["uz"] = snapshots["uz"] - snapshots["plate_v"][:, None, None, None]
         if "velocity" in snapshots:
             snapshots["velocity"] = snapshots["velocity"].copy()
             snapshots["velocity"][..., 2] -= snapshots["plate_v"][:, None, None, None]

@@ -140,6 +140,21 @@ def test_run_refusals(work_dir):
         gs.read_run(path, frame="container")
 
 
+def test_fields_read_only_the_datasets_named(work_dir):
+    path = os.path.join(work_dir, "run.fields.h5")
+    written = synthetic.write_fields(path)
+    for frame in ("lab", "plate"):
+        density = gs.read_fields(path, frame=frame, names=("n",))
+        assert {"n", "z", "phase", "cycle"} <= set(density.snapshots)
+        assert not {"points", "ux", "uz", "T", "velocity"} & set(density.snapshots)
+        whole = gs.read_fields(path, frame=frame)
+        np.testing.assert_array_equal(density.snapshots["z"], whole.snapshots["z"])
+        for s, w in enumerate(written):
+            np.testing.assert_array_equal(density.snapshots["n"][s], w["n"])
+    with pytest.raises(ValueError, match="unknown datasets \\['rho'\\]"):
+        gs.read_fields(path, names=("rho",))
+
+
 def test_fields_frames_and_horizontal_averages(work_dir):
     path = os.path.join(work_dir, "run.fields.h5")
     written = synthetic.write_fields(path)

@@ -28,9 +28,9 @@ synthetic series and sweeps of known rate and onset.
 """
 from dataclasses import dataclass
 
-import h5py
 import numpy as np
 
+from ..fields import read_fields
 from .onset import linear_fit
 
 FIRST_PATTERN_MODE = 2
@@ -150,26 +150,20 @@ def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
 
 
 def column_mass_modes(fields_path, modes=12):
-    """From a continuum fields file (docs/output-schema.md): per snapshot its cycle and phase,
-    the amplitudes |c_m| / c_0 of the Fourier modes m = 1..modes of the column mass along x
-    (n summed over z, averaged over y), and the box's length along x [sigma]."""
-    with h5py.File(fields_path, "r") as fields:
-        length = float(fields.attrs["nx"]) * float(fields.attrs["cell_size"])
-        names = sorted(name for name in fields if name.startswith("snapshot_"))
-        if not names:
-            raise NoGrowthFit(f"{fields_path}: no snapshots")
-        cycles, phases, amplitudes = [], [], []
-        for name in names:
-            snapshot = fields[name]
-            column = snapshot["n"][...].sum(axis=0).mean(axis=0)
-            if column.size <= 2 * modes:
-                raise NoGrowthFit(f"{fields_path}: {column.size} cells along x cannot hold "
-                                  f"{modes} modes")
-            spectrum = np.abs(np.fft.rfft(column))
-            cycles.append(int(snapshot.attrs["cycle"]))
-            phases.append(round(float(snapshot.attrs["phase"]) % 1.0, 6) % 1.0)
-            amplitudes.append(spectrum[1:modes + 1] / spectrum[0])
-    return np.array(cycles), np.array(phases), np.array(amplitudes), length
+    """From a continuum fields file (granular_shaker.read_fields): per snapshot its cycle and
+    phase, the amplitudes |c_m| / c_0 of the Fourier modes m = 1..modes of the column mass along
+    x (n summed over z, averaged over y), and the box's length along x [sigma]."""
+    fields = read_fields(fields_path, names=("n",))
+    snapshots, nx = fields.snapshots, fields.shape[0]
+    if "cycle" not in snapshots:
+        raise NoGrowthFit(f"{fields_path}: its snapshots carry no cycle")
+    if nx <= 2 * modes:
+        raise NoGrowthFit(f"{fields_path}: {nx} cells along x cannot hold {modes} modes")
+    spectrum = np.abs(np.fft.rfft(snapshots["n"].sum(axis=1).mean(axis=1), axis=1))
+    # A frame that closes a cycle may be stored at phase 0.9999999999: it is phase 0.
+    phases = np.round(snapshots["phase"] % 1.0, 6) % 1.0
+    return (snapshots["cycle"], phases, spectrum[:, 1:modes + 1] / spectrum[:, :1],
+            nx * fields.cell_size)
 
 
 def solver_floor(amplitudes):
