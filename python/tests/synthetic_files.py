@@ -199,6 +199,20 @@ def write_h5md(path, seed=3, schema_version=1, observable_steps=OBSERVABLE_STEPS
     position = rng.uniform([0, 0, 0.5], [WIDTH, WIDTH, 20], size=(frames, PARTICLES, 3))
     position[:, :, 2] += particle_plate_z[:, None]
     velocity = rng.normal(0, 1, size=(frames, PARTICLES, 3))
+    observables = {"plate_position": (plate_z, "sigma"),
+                   "plate_velocity": (plate_v, "sqrt(g sigma)"),
+                   "phase": (observable_time * FREQUENCY % 1.0, "1"),
+                   "cycle": (np.floor(observable_time * FREQUENCY), "1")}
+    write_particle_file(path, PARTICLE_STEPS, time, position, velocity, [WIDTH, WIDTH, CEILING],
+                        observable_steps, observable_time, observables, schema_version)
+    return {"position": position, "velocity": velocity, "plate_position": particle_plate_z,
+            "plate_velocity": particle_plate_v, "time": time}
+
+
+def write_particle_file(path, steps, time, position, velocity, edges, observable_steps,
+                        observable_time, observables, schema_version=1):
+    """The H5MD layout of `shaker md`'s particle file from given frames; `observables` maps
+    plate_position, plate_velocity, phase and cycle to (values, units) at observable_steps."""
     with h5py.File(path, "w") as f:
         write_attributes(f, "md", schema_version)
         f.attrs["kind"] = "shaker md particles"
@@ -209,19 +223,33 @@ def write_h5md(path, seed=3, schema_version=1, observable_steps=OBSERVABLE_STEPS
         box = particles.create_group("box")
         box.attrs["dimension"] = np.int32(3)
         box.attrs["boundary"] = np.array([b"periodic", b"periodic", b"none"])
-        _dataset(box, "edges", np.array([WIDTH, WIDTH, CEILING]), "sigma")
+        _dataset(box, "edges", np.asarray(edges, float), "sigma")
         for name, value, units in (("position", position, "sigma"),
                                    ("velocity", velocity, "sqrt(g sigma)")):
-            _time_element(particles.create_group(name), PARTICLE_STEPS, time, value, units)
-        observables = {"plate_position": (plate_z, "sigma"),
-                       "plate_velocity": (plate_v, "sqrt(g sigma)"),
-                       "phase": (observable_time * FREQUENCY % 1.0, "1"),
-                       "cycle": (np.floor(observable_time * FREQUENCY), "1")}
+            _time_element(particles.create_group(name), steps, time, value, units)
         for name, (value, units) in observables.items():
             _time_element(f.create_group(f"observables/{name}"), observable_steps,
                           observable_time, value, units)
-    return {"position": position, "velocity": velocity, "plate_position": particle_plate_z,
-            "plate_velocity": particle_plate_v, "time": time}
+
+
+def write_pattern_fields(path, frames, nx=64, cell=2.0, ny=4, nz=10):
+    """A continuum fields file of the schema (docs/output-schema.md; its density only) whose
+    column mass carries mode 6 growing by e^0.1 and mode 3 decaying by e^-0.3 per cycle;
+    `frames` are (cycle, phase) pairs."""
+    x = np.arange(nx)
+    with h5py.File(path, "w") as f:
+        write_attributes(f, "continuum")
+        f.attrs["kind"], f.attrs["cell_size"] = "shaker continuum fields", cell
+        for key, value in (("nx", nx), ("ny", ny), ("nz", nz)):
+            f.attrs[key] = np.int64(value)
+        _dataset(f, "hexahedra", np.zeros((nx * ny * nz, 8), dtype=np.int64), "1")
+        for index, (cycle, phase) in enumerate(frames):
+            column = 1.0 + 1e-4 * np.exp(0.1 * cycle) * np.cos(2 * np.pi * 6 * x / nx) \
+                + 1e-3 * np.exp(-0.3 * cycle) * np.sin(2 * np.pi * 3 * x / nx)
+            group = f.create_group(f"snapshot_{index:03d}")
+            _dataset(group, "n", np.broadcast_to(column / nz, (nz, ny, nx)), "1/sigma^3")
+            group.attrs.update({"time": cycle + phase, "phase": phase, "plate_z": 0.0,
+                                "plate_v": 0.0, "cycle": np.int64(cycle)})
 
 
 def _time_element(group, step, time, value, units):

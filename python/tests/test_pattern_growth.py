@@ -2,7 +2,6 @@
 sweeps of known rate and onset: the bias of the fitted values and the coverage of their errors
 over many independent noisy realisations, at the scatter the continuum's series show (a few per
 cent in M from cycle to cycle)."""
-import h5py
 import numpy as np
 import pytest
 import synthetic_files as synthetic
@@ -94,6 +93,8 @@ def test_a_sweep_without_a_change_of_sign_is_refused():
         fit_zero_crossing(GAMMA, np.ones(GAMMA.size), 0.1 * np.ones(GAMMA.size))
     with pytest.raises(NoGrowthFit, match="linear stage"):
         fit_growth_rate(CYCLES[:8], growing(RATE)[:8])
+    with pytest.raises(NoGrowthFit, match="no growth rate measured"):
+        fit_zero_crossing([], [], [])
 
 
 @pytest.mark.parametrize("gamma, rate, error, message", [
@@ -106,31 +107,11 @@ def test_bad_input_is_refused_with_what_is_wrong(gamma, rate, error, message):
         fit_zero_crossing(gamma, rate, error)
 
 
-def write_fields(path, frames, nx=64, cell=2.0, ny=4, nz=10):
-    """A fields file of the schema (docs/output-schema.md; its density only) whose column mass
-    carries mode 6 growing by e^0.1 and mode 3 decaying by e^-0.3 per cycle."""
-    x = np.arange(nx)
-    with h5py.File(path, "w") as f:
-        synthetic.write_attributes(f, "continuum")
-        f.attrs["kind"], f.attrs["cell_size"] = "shaker continuum fields", cell
-        for key, value in (("nx", nx), ("ny", ny), ("nz", nz)):
-            f.attrs[key] = np.int64(value)
-        synthetic._dataset(f, "hexahedra", np.zeros((nx * ny * nz, 8), dtype=np.int64), "1")
-        for index, (cycle, phase) in enumerate(frames):
-            column = 1.0 + 1e-4 * np.exp(0.1 * cycle) * np.cos(2 * np.pi * 6 * x / nx) \
-                + 1e-3 * np.exp(-0.3 * cycle) * np.sin(2 * np.pi * 3 * x / nx)
-            group = f.create_group(f"snapshot_{index:03d}")
-            synthetic._dataset(group, "n", np.broadcast_to(column / nz, (nz, ny, nx)),
-                               "1/sigma^3")
-            group.attrs.update({"time": cycle + phase, "phase": phase, "plate_z": 0.0,
-                                "plate_v": 0.0, "cycle": np.int64(cycle)})
-
-
 def test_the_modes_of_a_fields_file_and_the_fastest_pattern_mode(tmp_path):
     # the phase of the frame closing a cycle may be stored as 0.9999999999: it is phase 0
     frames = [(c, p) for c in range(30) for p in (0.0, 0.5)]
     frames = [(c, 0.9999999999 if p == 0.0 and c % 3 else p) for c, p in frames]
-    write_fields(tmp_path / "run.fields.h5", frames)
+    synthetic.write_pattern_fields(tmp_path / "run.fields.h5", frames)
     cycles, phases, amplitudes, length = column_mass_modes(tmp_path / "run.fields.h5")
     assert length == 128.0
     assert sorted(set(phases)) == [0.0, 0.5]

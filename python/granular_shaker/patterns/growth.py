@@ -119,6 +119,8 @@ def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
         raise ValueError("one growth rate and one error per acceleration")
     if not (np.all(np.isfinite(rate)) and np.all(error > 0)):
         raise ValueError("growth rates must be finite and their errors > 0")
+    if gamma.size == 0:
+        raise NoGrowthFit("no growth rate measured (no finished run)")
     order = np.argsort(gamma)
     gamma, rate, error = gamma[order], rate[order], error[order]
     positive = np.flatnonzero(rate > 0)

@@ -22,6 +22,9 @@ wavelength, the angular moments and the cycle-to-cycle correlation. With several
 point's value is the mean over seeds and its error their standard error (independent runs);
 with one seed, the standard error over its frames. Per case: the onset fit
 (granular_shaker.patterns.onset.fit_onset) and, below that onset, the Swift-Hohenberg fit.
+Each point also keeps its first seed's view (granular_shaker.patterns.views): the layer seen
+from above at the stored phases of one cycle and the spectrum of its column mass along x, which
+the report draws.
 
 Exit status 0 when the results are written; 1 if a run or an analysis failed; 2 for bad
 arguments.
@@ -37,6 +40,7 @@ import numpy as np
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                              fit_zero_crossing)
 from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg
+from granular_shaker.patterns.views import run_view
 from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
                                         repository_argument)
@@ -213,6 +217,8 @@ def case_points(plan, case):
         point = dict(gamma=gamma, **point_summary([r["summary"] for r in runs]))
         if "growth" in runs[0]:
             point.update(runs[0]["growth"], final_order=runs[0]["summary"]["final_order"])
+        if "view" in runs[0]:
+            point["view"] = runs[0]["view"]
         points.append(point)
     return points
 
@@ -235,6 +241,13 @@ def collect(shaker, plan):
             except (NoGrowthFit, OSError, KeyError) as error:
                 failures.append(f"{where}: no growth rate: {error}")
                 del run["summary"]
+                continue
+        try:
+            # The continuum's runs grow or decay to their end: their last frame is the view.
+            run["view"] = run_view(run["record"]["path"],
+                                   "last" if run["solver"] == "continuum" else "all")
+        except (OSError, KeyError, ValueError) as error:
+            failures.append(f"{where}: no top view or spectrum: {error}")
     for case in dict.fromkeys(r["case"] for r in plan):
         solver = next(r["solver"] for r in plan if r["case"] == case)
         points = case_points(plan, case)

@@ -395,6 +395,130 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_no
     return rows
 
 
+def shown_points(case):
+    """(below, above) onset points of a case whose views the figures show: in MD the ordered
+    point of largest order parameter and the highest disordered point below the first ordered
+    one; in the continuum the point of fastest growth and the highest decaying point below
+    it. Either may be None."""
+    points = [p for p in sorted(case["points"], key=lambda p: p["gamma"]) if "view" in p]
+    if case.get("solver") == "continuum":
+        growing = [p for p in points if p["rate"] > 0.0]
+        above = max(growing, key=lambda p: p["rate"]) if growing else None
+        below = [p for p in points
+                 if p["rate"] < 0.0 and (above is None or p["gamma"] < above["gamma"])]
+    else:
+        shown = [p for p in points if ordered(p)]
+        above = max(shown, key=lambda p: p["order"]) if shown else None
+        below = [p for p in points if not ordered(p)
+                 and (not shown or p["gamma"] < shown[0]["gamma"])]
+    return (below[-1] if below else None), above
+
+
+def first_case(cases, solver):
+    """The first case of a solver whose points carry views, or (None, None)."""
+    for name, case in solver_cases(cases, solver).items():
+        if any("view" in p for p in case["points"]):
+            return name, case
+    return None, None
+
+
+def figure_top_views(cases):
+    """The column mass seen from above at the stored phases of one cycle, relative to its
+    mean (column mass / mean - 1), at a point above onset of the first MD and the first
+    continuum case."""
+    import matplotlib.pyplot as plt
+    rows = []
+    for solver in ("md", "continuum"):
+        name, case = first_case(cases, solver)
+        point = shown_points(case)[1] if case else None
+        if point is not None:
+            rows += [(solver, name, point, phase) for phase in point["view"]["fields"]]
+    fig, axes = plt.subplots(len(rows), 1, figsize=(7.0, 0.9 + 1.4 * len(rows)), squeeze=False,
+                             sharex=True)
+    for ax, (solver, name, point, phase) in zip(axes[:, 0], rows):
+        view = point["view"]
+        field = np.array(view["fields"][phase], dtype=float)
+        limit = float(np.nanmax(np.abs(field))) or 1.0
+        image = ax.imshow(field.T, origin="lower", aspect="auto", cmap="RdBu_r", vmin=-limit,
+                          vmax=limit, extent=(0.0, view["box"][0], 0.0, view["box"][1]))
+        ax.set_title(f"{'MD' if solver == 'md' else 'continuum'} {name}, Gamma "
+                     f"{point['gamma']:g}, cycle {view['cycle']:g}, f t = {phase}", fontsize=8)
+        ax.set_ylabel("y [sigma]", fontsize=8)
+        ax.tick_params(labelsize=7)
+        fig.colorbar(image, ax=ax, pad=0.01).set_label("relative [1]", fontsize=7)
+    axes[-1, 0].set_xlabel("x [sigma]")
+    fig.tight_layout()
+    return fig
+
+
+def figure_spectra(cases):
+    """The power of the column mass's Fourier modes along x, below and above onset: the MD's
+    mean over its sampled frames with standard errors, the continuum's last frame."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    for solver in ("md", "continuum"):
+        name, case = first_case(cases, solver)
+        if case is None:
+            continue
+        for where, point in zip(("below onset", "above onset"), shown_points(case)):
+            if point is None:
+                continue
+            view = point["view"]
+            modes = np.arange(1, len(view["power"]) + 1)
+            power = np.array(view["power"], dtype=float)
+            if solver == "md":
+                ax.errorbar(modes, power, yerr=np.array(view["power_error"], dtype=float),
+                            label=f"MD {name}, Gamma {point['gamma']:g} ({where}; "
+                                  f"{view['frames']} frames, ± standard error)", **rc.MD_STYLE)
+            else:
+                ax.plot(modes, power, marker="s", ms=3, **rc.CONTINUUM_STYLE,
+                        label=f"continuum {name}, Gamma {point['gamma']:g} ({where}; cycle "
+                              f"{view['cycle']:g})")
+    ax.set_yscale("log")
+    ax.set_xlabel("mode m along x (wavelength Lx / m) [1]")
+    ax.set_ylabel("|c_m|^2 / c_0^2 of the column mass [1]")
+    rc.legend_above(fig, columns=1)
+    return fig
+
+
+def figure_wavelength(cases, parameters, dispersion):
+    """The stripes' wavelength against the drive frequency: the MD's mean over its ordered
+    points, the continuum's fastest mode at its first point above onset, and the experiments'
+    dispersion relation at the cases' layer depth."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    md = [(parameters[n][0], stripe_wavelength(c)) for n, c in solver_cases(cases, "md").items()]
+    md = [(f, w) for f, w in md if w is not None]
+    if md:
+        ax.errorbar([f for f, _ in md], [w[0] for _, w in md], yerr=[w[1] for _, w in md],
+                    label="MD: mean over ordered points (± standard error)", **rc.MD_STYLE)
+    continuum = [(parameters[n][0], first_growing_point(c))
+                 for n, c in solver_cases(cases, "continuum").items() if onset_of(c)]
+    continuum = sorted((f, p["mode_wavelength"]) for f, p in continuum if p is not None)
+    if continuum:
+        ax.plot(*zip(*continuum), marker="s", ms=4, **rc.CONTINUUM_STYLE,
+                label="continuum: fastest mode at its first point above onset")
+    frequencies = [parameters[n][0] for n in cases if n in parameters]
+    if dispersion is not None and frequencies:
+        depth = parameters[next(iter(cases))][1]
+        fine = np.linspace(0.8 * min(frequencies), 1.2 * max(frequencies), 100)
+        ax.plot(fine, [experiment_wavelength(dispersion, f, depth) for f in fine], color="0.4",
+                lw=1, ls="--", label=f"experiments' dispersion relation at H = {depth:.3g} sigma")
+    boxes = [p["view"]["box"][0] for c in cases.values() for p in c["points"] if "view" in p]
+    if boxes:
+        (left, right), (low, high) = ax.get_xlim(), ax.get_ylim()
+        allowed = [boxes[0] / m for m in range(1, 64) if low <= boxes[0] / m <= high]
+        # One line of separate segments, so that the legend names it once.
+        ax.plot(np.tile([left, right, np.nan], len(allowed)), np.repeat(allowed, 3),
+                color="0.6", lw=0.6, ls=":",
+                label=f"wavelengths the box allows (Lx / m, Lx = {boxes[0]:g} sigma)")
+        ax.set_xlim(left, right)
+    ax.set_xlabel("drive frequency f [sqrt(g/sigma)]")
+    ax.set_ylabel("wavelength [sigma]")
+    rc.legend_above(fig, columns=1)
+    return fig
+
+
 def continuum_case_lines(name, case):
     lines = [f"### {name} (continuum)", "", "| Gamma [g] | growth rate [1/cycle] | fastest pattern "
              "mode m | its wavelength [sigma] | cycles fitted | order parameter, last frame "
@@ -455,7 +579,9 @@ def case_lines(name, case):
     return lines + [""]
 
 
-def report_text(results, claims, figure, parameters=None, dispersion=None, growth_figure=None):
+def report_text(results, claims, figures, parameters=None, dispersion=None):
+    """The report; `figures` maps order_parameter, growth_rate, top_views, spectra and
+    wavelength to their paths (any but the first may be missing)."""
     sweep, runs = results["sweep"], results["runs"]
     continuum = sweep.get("continuum")
     lines = ["# Onset of patterns: " + ("MD and continuum sweeps" if continuum else "MD sweep"),
@@ -475,7 +601,8 @@ def report_text(results, claims, figure, parameters=None, dispersion=None, growt
              "pattern's power, M^2 = floor + slope max(Gamma - Gamma_c, 0); below it the "
              "Swift-Hohenberg form floor + strength / sqrt((Gamma_mf - Gamma)/Gamma_mf) "
              "(python/granular_shaker/patterns/onset.py, whose tests measure the bias and "
-             "coverage of both fits' errors).", "", f"![order parameter]({figure})", ""]
+             "coverage of both fits' errors).", "",
+             f"![order parameter]({figures['order_parameter']})", ""]
     if continuum:
         lines += [f"The continuum: cases {', '.join(continuum['cases'])}; Gamma "
                   f"{continuum['gamma'][0]:g} to {continuum['gamma'][-1]:g} "
@@ -486,7 +613,19 @@ def report_text(results, claims, figure, parameters=None, dispersion=None, growt
                   "the modes' linear stage, and the onset is where the fastest pattern mode's "
                   "rate changes sign (python/granular_shaker/patterns/growth.py, whose tests "
                   "measure the bias and coverage of its errors).", "",
-                  f"![growth rate]({growth_figure})", ""]
+                  f"![growth rate]({figures['growth_rate']})", ""]
+    if "top_views" in figures:
+        lines += ["The layer seen from above at the stored phases of one cycle (its column mass "
+                  "relative to the mean; the MD's last sampled cycle, the continuum's last "
+                  "cycle), above each solver's onset, and the spectra of the column mass along "
+                  "the box below and above it (python/granular_shaker/patterns/views.py):", "",
+                  f"![top views]({figures['top_views']})", "",
+                  f"![spectra]({figures['spectra']})", ""]
+    if "wavelength" in figures:
+        lines += ["The stripes' wavelength against the drive frequency, with the experiments' "
+                  "dispersion relation (reference-data/pattern-claims.toml, "
+                  "`[experiment_dispersion]`):", "", f"![wavelength]({figures['wavelength']})",
+                  ""]
     for name, case in results["cases"].items():
         lines += case_lines(name, case)
     lines += ["## Claims (reference-data/pattern-claims.toml)", "",
@@ -503,16 +642,21 @@ def report_text(results, claims, figure, parameters=None, dispersion=None, growt
 def write(results, repository, output):
     with open(os.path.join(repository, CLAIMS), "rb") as f:
         reference = tomllib.load(f)
+    dispersion = reference.get("experiment_dispersion")
     parameters = {name: case_parameters(repository, name) for name in results["cases"]}
-    figures = os.path.join(os.path.dirname(os.path.abspath(output)), FIGURES)
-    name = rc.write_figure(figure_order_parameter(results["cases"]), figures,
-                           "order_parameter.png")
-    continuum = solver_cases(results["cases"], "continuum")
-    growth = rc.write_figure(figure_growth_rate(continuum), figures, "growth_rate.png") \
-        if continuum else None
-    text = report_text(results, reference["claim"], f"{FIGURES}/{name}", parameters,
-                       reference.get("experiment_dispersion"),
-                       growth and f"{FIGURES}/{growth}")
+    directory = os.path.join(os.path.dirname(os.path.abspath(output)), FIGURES)
+    cases, continuum = results["cases"], solver_cases(results["cases"], "continuum")
+    drawn = {"order_parameter": lambda: figure_order_parameter(cases)}
+    if continuum:
+        drawn["growth_rate"] = lambda: figure_growth_rate(continuum)
+    if any("view" in p for case in cases.values() for p in case["points"]):
+        drawn["top_views"] = lambda: figure_top_views(cases)
+        drawn["spectra"] = lambda: figure_spectra(cases)
+    if dispersion is not None:
+        drawn["wavelength"] = lambda: figure_wavelength(cases, parameters, dispersion)
+    figures = {key: f"{FIGURES}/" + rc.write_figure(draw(), directory, f"{key}.png")
+               for key, draw in drawn.items()}
+    text = report_text(results, reference["claim"], figures, parameters, dispersion)
     rc.write_text_atomically(output, text)
 
 

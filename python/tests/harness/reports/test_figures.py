@@ -213,6 +213,30 @@ def convergence_figures(name):
     return make
 
 
+def pattern_views():
+    """Pattern sweep results whose points carry views: MD stripes of mode 6 from Gamma 2.2,
+    the continuum growing from Gamma 3 (granular_shaker.patterns.views)."""
+    x = np.arange(64) * 2.0
+
+    def view(amplitude, cells, frames):
+        field = amplitude * np.cos(2 * np.pi * 6 * x / 128.0)[:, None] * np.ones((1, cells))
+        power = [1e-4] * 5 + [amplitude ** 2 / 4] + [1e-4] * 10
+        return dict(box=[128.0, 2.0 * cells], cycle=129.0, spectrum_phase=0.0, frames=frames,
+                    power=power, power_error=[p / 10 for p in power] if frames > 1 else
+                    [None] * 16, fields={"0": field.tolist(), "0.5": (-0.3 * field).tolist()})
+
+    md = [dict(gamma=g, order=o, order_error=0.02, a2=1.0, correlation_previous_cycle=c,
+               wavelength=w, view=view(a, 4, 10)) for g, o, c, w, a in
+          zip((2.0, 2.1, 2.2, 2.6), (0.6, 0.7, 1.2, 1.9), (0.0, -0.2, -0.7, -0.8),
+              (42.0, 40.0, 21.2, 21.3), (0.05, 0.06, 0.3, 0.5))]
+    continuum = [dict(gamma=g, rate=r, rate_error=0.01, mode=6, mode_wavelength=21.33,
+                      view=view(a, 2, 1)) for g, r, a in
+                 zip((2.6, 3.0, 3.4), (-0.1, -0.01, 0.06), (1e-5, 1e-4, 1e-3))]
+    return {"pattern_md_f0p18": dict(solver="md", points=md, onset=dict(reason="none")),
+            "pattern_continuum_f0p18": dict(solver="continuum", points=continuum,
+                                            onset=dict(gamma_c=3.05, gamma_c_error=0.05))}
+
+
 FIGURE_CASES = {
     **{f"make_validation_report.{n}": validation_figures(n) for n in (
         "figure_profiles", "figure_single_shock", "figure_mach", "figure_mach_width",
@@ -244,6 +268,13 @@ FIGURE_CASES = {
         "pattern_continuum_f0p14": {"points": [dict(gamma=g, rate=-0.2, rate_error=0.02)
                                                for g in (2.2, 3.0, 3.8, 4.2)],
                                     "onset": dict(reason="no change of sign")}})],
+    "make_pattern_report.figure_top_views": lambda i: [
+        patterns.figure_top_views(pattern_views()),
+        patterns.figure_top_views({"pattern_md_f0p18": pattern_views()["pattern_md_f0p18"]})],
+    "make_pattern_report.figure_spectra": lambda i: [patterns.figure_spectra(pattern_views())],
+    "make_pattern_report.figure_wavelength": lambda i: [patterns.figure_wavelength(
+        pattern_views(), {"pattern_md_f0p18": (0.18, 5.0), "pattern_continuum_f0p18": (0.18, 5.0)},
+        dict(offset=1.0, amplitude=1.1, exponent=1.32))],
     "make_sensitivity_report.figure_variants":
         lambda i: [sens.figure_variants(i.sensitivity[0])],
     "make_sensitivity_report.figure_knudsen_maps":
