@@ -86,6 +86,20 @@ def test_the_onset_error_covers_the_truth():
     assert all(f.points == 4 for f in fits)
 
 
+def test_a_rate_within_its_errors_of_zero_does_not_place_the_onset():
+    # +0.03 +- 0.03 at Gamma 2.6 is no evidence of growth: the onset is where the rates turn
+    # positive beyond their errors, between 3.0 and 3.2 (the line through 2.8, 3.0, 3.2, 3.4).
+    gamma = [2.2, 2.6, 2.8, 3.0, 3.2, 3.4]
+    rate = [-0.18, 0.03, -0.05, -0.01, 0.02, 0.06]
+    error = [0.02, 0.03, 0.01, 0.002, 0.003, 0.003]
+    crossing = fit_zero_crossing(gamma, rate, error)
+    assert crossing.points == 4 and 3.0 < crossing.gamma_c < 3.2
+    # Without the test of significance the sign at 2.6 would put the onset below it.
+    assert fit_zero_crossing(gamma, rate, error, significance=0.0).gamma_c < 2.6
+    with pytest.raises(NoGrowthFit, match="by 2 standard errors"):
+        fit_zero_crossing(gamma[:2], rate[:2], error[:2])
+
+
 def test_a_sweep_without_a_change_of_sign_is_refused():
     with pytest.raises(NoGrowthFit, match="do not change sign"):
         fit_zero_crossing(GAMMA, -np.ones(GAMMA.size), 0.1 * np.ones(GAMMA.size))

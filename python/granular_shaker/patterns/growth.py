@@ -42,6 +42,10 @@ FLOOR_MARGIN = 10.0
 FLOOR_FRAMES = 10
 
 
+# A growth rate places the onset by its sign when it lies this many standard errors above 0.
+SIGNIFICANT_GROWTH = 2.0
+
+
 class NoGrowthFit(ValueError):
     """The series or the sweep cannot give the quantity asked for."""
 
@@ -110,10 +114,13 @@ def _end_of_linear_stage(order, fraction):
     return int(np.argmax(beyond)) if spans else order.size
 
 
-def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
+def fit_zero_crossing(gamma, rate, rate_error, neighbours=2, significance=SIGNIFICANT_GROWTH):
     """Gamma_c where the growth rate first changes sign from negative to positive: a weighted
     straight line through the `neighbours` points below the change and up to `neighbours`
-    growing points from it. Raises NoGrowthFit when the rates do not change sign so."""
+    growing points from it. The change is at the first rate above zero by `significance` of
+    its standard errors, with a negative rate below it: a rate within its errors of zero does
+    not place the onset by its sign alone (it still enters the line as a neighbour). Raises
+    NoGrowthFit when the rates do not change sign so."""
     gamma, rate, error = (np.asarray(a, float) for a in (gamma, rate, rate_error))
     if not (gamma.shape == rate.shape == error.shape) or gamma.ndim != 1:
         raise ValueError("one growth rate and one error per acceleration")
@@ -123,11 +130,12 @@ def fit_zero_crossing(gamma, rate, rate_error, neighbours=2):
         raise NoGrowthFit("no growth rate measured (no finished run)")
     order = np.argsort(gamma)
     gamma, rate, error = gamma[order], rate[order], error[order]
-    positive = np.flatnonzero(rate > 0)
-    if positive.size == 0 or positive[0] == 0:
+    growing = np.flatnonzero(rate > significance * error)
+    if growing.size == 0 or not np.any(rate[:growing[0]] < 0):
         raise NoGrowthFit("the growth rates do not change sign from negative to positive "
-                          f"over Gamma {gamma[0]:.4g} to {gamma[-1]:.4g}")
-    change = positive[0]
+                          f"(by {significance:g} standard errors) over Gamma {gamma[0]:.4g} to "
+                          f"{gamma[-1]:.4g}")
+    change = growing[0]
     # Only the rising side of the first change of sign: a rate that falls below zero again
     # further up (a band of instability) does not belong to this onset's line.
     rising = change

@@ -14,6 +14,7 @@ import tomllib
 
 import numpy as np
 
+from granular_shaker.patterns.growth import SIGNIFICANT_GROWTH
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
@@ -229,9 +230,12 @@ def continuum_part(claim, continuum, parameters, dispersion):
         return None
     if claim["id"] == "P1":
         # In a box a few cells deep every mode along x is a stripe: the planform follows from
-        # the geometry, so the part judged is growth above the onset and decay below it.
+        # the geometry, so the part judged is growth above the onset and decay below it; a
+        # point goes against it when its rate has the wrong sign beyond its errors (the test
+        # of significance that places the onset).
         contrary = {n: [p["gamma"] for p in c["points"]
-                        if (p["rate"] > 0) != (p["gamma"] > onset_of(c)[0])]
+                        if abs(p["rate"]) > SIGNIFICANT_GROWTH * p["rate_error"]
+                        and (p["rate"] > 0) != (p["gamma"] > onset_of(c)[0])]
                     for n, c in measured.items()}
         return ("; ".join(f"{n}: growth from Gamma_c {rc.fmt(onset_of(c)[0])}" + (
             "; against it at Gamma " + ", ".join(f"{g:g}" for g in contrary[n])

@@ -236,6 +236,12 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
                         "pattern_md_f0p18": (0.18, 5.0)}, relation)}
     assert rows["P1"]["verdict"] == "fail"
     assert "growth from Gamma_c 2.3; against it at Gamma 2.6" in rows["P1"]["value"]
+    # ... but not when that rate is within two of its errors of zero (-0.015 +- 0.01)
+    bent["points"][3]["rate"] = -0.015
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P1"]["verdict"] == "pass" and "against it" not in rows["P1"]["value"]
 
 
 def test_a_report_with_the_continuum_shows_its_growth_rates(work_dir):
