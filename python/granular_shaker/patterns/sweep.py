@@ -22,6 +22,9 @@ wavelength, the angular moments and the cycle-to-cycle correlation. With several
 point's value is the mean over seeds and its error their standard error (independent runs);
 with one seed, the standard error over its frames. Per case: the onset fit
 (granular_shaker.patterns.onset.fit_onset) and, below that onset, the Swift-Hohenberg fit.
+A continuum part may hold a `saturation` table (gamma, cycles, frames, timeout): runs of
+`cycles` cycles whose last `frames` hold the fields, summarised as the MD's are (the
+saturated order parameter over those frames), the amplitude the claims compare with MD's.
 Each point also keeps its first seed's view (granular_shaker.patterns.views): the layer seen
 from above at the stored phases of one cycle and the spectrum of its column mass along x, which
 the report draws.
@@ -64,6 +67,28 @@ def check_part(repository, part, where):
         raise ValueError(f"{where}: gamma must be increasing, at least 5")
 
 
+def check_saturation(part, where):
+    """ValueError naming what is wrong with a continuum part's saturation table."""
+    for key in ("gamma", "cycles", "frames", "timeout"):
+        if key not in part:
+            raise ValueError(f"{where} has no '{key}'")
+    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
+        raise ValueError(f"{where}: gamma must be increasing, at least 1")
+    if not (isinstance(part["frames"], int) and isinstance(part["cycles"], int)
+            and 2 <= part["frames"] < part["cycles"]):
+        raise ValueError(f"{where}: frames {part['frames']!r} and cycles {part['cycles']!r}: "
+                         "allowed: whole numbers, 2 <= frames < cycles")
+
+
+def saturation_overrides(part):
+    """The --set values of a saturation run: `cycles` cycles, the fields at the case's phases
+    of the last `frames` of them (all saturated, when `cycles` is long enough)."""
+    first = part["cycles"] - part["frames"]
+    return [f"run.transient_cycles={first}", f"run.sampled_cycles={part['frames']}",
+            "continuum.field_cycles=[" + ", ".join(str(c) for c in range(first, part["cycles"]))
+            + "]"]
+
+
 def load_sweep(repository, name):
     """The named sweep of validation/patterns.toml; ValueError names what is wrong."""
     studies = load_toml(os.path.join(repository, SWEEP_FILE))["study"]
@@ -74,6 +99,9 @@ def load_sweep(repository, name):
     check_part(repository, sweep, f"{SWEEP_FILE} [study.{name}]")
     if "continuum" in sweep:
         check_part(repository, sweep["continuum"], f"{SWEEP_FILE} [study.{name}.continuum]")
+        if "saturation" in sweep["continuum"]:
+            check_saturation(sweep["continuum"]["saturation"],
+                             f"{SWEEP_FILE} [study.{name}.continuum.saturation]")
     return sweep
 
 
@@ -86,16 +114,24 @@ def solver_parts(sweep):
 
 
 def plan_points(repository, sweep):
-    """One run per solver, case, Gamma and seed, in the run dicts of the validation study."""
+    """One run per solver, case, Gamma and seed, in the run dicts of the validation study; the
+    continuum's saturation runs (kind "saturation") after its growth runs."""
+    parts = [(solver, part, [], "sweep") for solver, part in solver_parts(sweep)]
+    saturation = (sweep.get("continuum") or {}).get("saturation")
+    if saturation:
+        parts.append(("continuum", dict(sweep["continuum"], gamma=saturation["gamma"],
+                                        timeout=saturation["timeout"]),
+                      saturation_overrides(saturation), "saturation"))
     plan = []
-    for solver, part in solver_parts(sweep):
+    for solver, part, extra, kind in parts:
         for case in part["cases"]:
             for gamma in part["gamma"]:
                 for seed in part["seeds"]:
                     plan.append(dict(case=case, case_file=case_file(repository, case),
-                                     solver=solver, replicas=1, gamma=gamma, seed=seed,
-                                     overrides=[f"shaker.gamma={gamma}", f"run.seed={seed}",
-                                                *part["overrides"]],
+                                     solver=solver, kind=kind, replicas=1, gamma=gamma,
+                                     seed=seed, overrides=[f"shaker.gamma={gamma}",
+                                                           f"run.seed={seed}",
+                                                           *part["overrides"], *extra],
                                      timeout=part["timeout"], fallback=[],
                                      expect_failure=False))
     return plan
@@ -207,11 +243,13 @@ def growth_fits(points):
         return dict(onset=dict(reason=str(reason)))
 
 
-def case_points(plan, case):
-    """A case's points, one per Gamma, from its runs' summaries."""
+def case_points(plan, case, kind="sweep"):
+    """A case's points of one kind of run (the sweep's, or the continuum's saturation runs),
+    one per Gamma, from its runs' summaries."""
     points = []
-    for gamma in dict.fromkeys(r["gamma"] for r in plan if r["case"] == case):
-        runs = [r for r in plan if r["case"] == case and r["gamma"] == gamma and "summary" in r]
+    mine = [r for r in plan if r["case"] == case and r.get("kind", "sweep") == kind]
+    for gamma in dict.fromkeys(r["gamma"] for r in mine):
+        runs = [r for r in mine if r["gamma"] == gamma and "summary" in r]
         if not runs:
             continue
         point = dict(gamma=gamma, **point_summary([r["summary"] for r in runs]))
@@ -234,7 +272,7 @@ def collect(shaker, plan):
             continue
         columns = read_shaker_csv(table)[0]
         run["summary"] = frame_summary(columns)
-        if run["solver"] == "continuum":
+        if run["solver"] == "continuum" and run.get("kind") != "saturation":
             run["summary"]["final_order"] = float(columns[f"{FIELD}_order_parameter"][-1])
             try:
                 run["growth"] = growth_summary(run["record"]["path"])
@@ -244,8 +282,8 @@ def collect(shaker, plan):
                 continue
         try:
             # The continuum's runs grow or decay to their end: their last frame is the view.
-            run["view"] = run_view(run["record"]["path"],
-                                   "last" if run["solver"] == "continuum" else "all")
+            growing = run["solver"] == "continuum" and run.get("kind") != "saturation"
+            run["view"] = run_view(run["record"]["path"], "last" if growing else "all")
         except (OSError, KeyError, ValueError) as error:
             failures.append(f"{where}: no top view or spectrum: {error}")
     for case in dict.fromkeys(r["case"] for r in plan):
@@ -253,6 +291,9 @@ def collect(shaker, plan):
         points = case_points(plan, case)
         found = growth_fits(points) if solver == "continuum" else fits(points)
         cases[case] = dict(solver=solver, points=points, **found)
+        saturated = case_points(plan, case, "saturation")
+        if saturated:
+            cases[case]["saturation"] = saturated
     return cases, failures
 
 

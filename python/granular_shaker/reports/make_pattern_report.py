@@ -95,9 +95,9 @@ def figure_growth_rate(cases):
 PARTICLES_PER_AREA_AND_DEPTH = 9.8425 / 9.0
 NOT_RUN = ("the continuum's sweep is not part of this study (a point of its full design costs "
            "hours on 2 cores: docs/patterns.md, Cost)")
-NO_SATURATION = ("the continuum's runs end in the linear stage of the pattern's growth (its onset "
-                 "is the change of sign of the growth rate), so it has no saturated amplitude "
-                 "to compare")
+NO_SATURATION = ("the continuum has no saturation run above its onset in this study (its growth "
+                 "runs end in the linear stage of the pattern's growth; a continuum part's "
+                 "`saturation` table runs them to saturation)")
 
 
 def case_parameters(repository, name):
@@ -178,6 +178,8 @@ def judge(value, claim):
         return "pass" if value > lo_hi[0] else "fail"
     if claim["comparison"] == "less_than":
         return "pass" if value < lo_hi[0] else "fail"
+    if claim["comparison"] == "outside":
+        return "pass" if not lo_hi[0] <= value <= lo_hi[1] else "fail"
     raise ValueError(f"claim {claim['id']}: comparison {claim['comparison']} not judged here")
 
 
@@ -277,6 +279,27 @@ def combined(md, continuum):
     return "; ".join(parts), verdict
 
 
+def amplitude_ratio(claim, md, continuum):
+    """((value, verdict), "") of P5: the MD's saturated order parameter over the continuum's
+    at the first Gamma of the continuum's saturation runs above its onset where the MD's
+    stripes are ordered; (None, reason) when there is none."""
+    onset = onset_of(continuum)[0]
+    saturated = [p for p in continuum.get("saturation", []) if p["gamma"] > onset]
+    if not saturated:
+        return None, NO_SATURATION
+    ordered_md = {p["gamma"]: p for p in (md or {}).get("points", []) if ordered(p)}
+    pairs = [(ordered_md[p["gamma"]], p) for p in saturated if p["gamma"] in ordered_md]
+    if not pairs:
+        return None, ("no ordered MD point at the Gamma of the continuum's saturation runs ("
+                      + ", ".join(f"{p['gamma']:g}" for p in saturated) + ")")
+    mine, theirs = pairs[0]
+    value, error = ratio_with_error((mine["order"], mine["order_error"]),
+                                    (theirs["order"], theirs["order_error"]))
+    return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)} (MD {rc.fmt(mine['order'])}, continuum "
+            f"{rc.fmt(theirs['order'])} saturated, at Gamma {mine['gamma']:g} [1/sigma^2])",
+            judge(value, claim)), ""
+
+
 def continuum_missing(claim, continuum):
     """Why the continuum does not measure a claim's part: cases not run, or no onset."""
     if not continuum:
@@ -303,7 +326,7 @@ def md_against_continuum(claim, md, continuum):
     case_md, case_continuum = md.get(name_md), continuum[name_continuum]
     onset_continuum = onset_of(case_continuum)
     if claim["id"] == "P5":
-        return None, NO_SATURATION
+        return amplitude_ratio(claim, case_md, case_continuum)
     if claim["id"] == "P2":
         if md_onset(case_md) is None:
             return None, "the MD's onset is neither fitted nor bracketed by ordered points"
@@ -408,6 +431,9 @@ def shown_points(case):
     if case.get("solver") == "continuum":
         growing = [p for p in points if p["rate"] > 0.0]
         above = max(growing, key=lambda p: p["rate"]) if growing else None
+        saturated = [p for p in case.get("saturation", []) if "view" in p]
+        if saturated:
+            above = max(saturated, key=lambda p: p["order"])
         below = [p for p in points
                  if p["rate"] < 0.0 and (above is None or p["gamma"] < above["gamma"])]
     else:
@@ -539,6 +565,12 @@ def continuum_case_lines(name, case):
                   f"{onset['chi2_per_dof']:.3g})"]
     else:
         lines += ["", f"- onset: none: {onset.get('reason', 'not fitted')}"]
+    for p in case.get("saturation", []):
+        lines.append(f"- saturated at Gamma {p['gamma']:g} (over the last frames of a long "
+                     f"run): order parameter {rc.fmt(p['order'])} ± "
+                     f"{rc.fmt(p['order_error'], 2)} [1/sigma^2], wavelength "
+                     f"{rc.fmt(p['wavelength'])} sigma, A2 {rc.fmt(p['a2'], 3)}, cycle-to-cycle "
+                     f"correlation {rc.fmt(p['correlation_previous_cycle'], 3)}")
     return lines + [""]
 
 

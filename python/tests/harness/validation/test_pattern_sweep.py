@@ -14,13 +14,29 @@ from granular_shaker.reports import make_pattern_report
 
 from .. import REPOSITORY
 
-TINY_SWEEP = """
-[study.tiny]
+TINY_MD = """
 cases = ["pattern_md_f0p18"]
 gamma = [2.0, 2.4, 2.8, 3.2, 3.6]
 seeds = [1]
 overrides = ["layer.particles=300", "md.box_width=16.0", "md.box_depth=8.0",
              "run.transient_cycles=6", "run.sampled_cycles=4", "md.snapshot_cycles=[6, 7, 8, 9]"]
+timeout = 300
+"""
+TINY_SWEEP = "[study.tiny]\n" + TINY_MD + "\n[study.tinyc]\n" + TINY_MD + """
+[study.tinyc.continuum]
+cases = ["pattern_continuum_f0p18"]
+gamma = [2.2, 2.6, 3.0, 3.4, 3.8]
+seeds = [1]
+overrides = ["layer.particles=2800", "md.box_width=64.0", "md.box_depth=8.0",
+             "continuum.box_width=64.0", "continuum.box_depth=8.0", "continuum.cell_size=2.0",
+             "continuum.ceiling=20.0", "run.transient_cycles=18", "run.sampled_cycles=2",
+             "continuum.field_cycles=[0,1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19]"]
+timeout = 300
+
+[study.tinyc.continuum.saturation]
+gamma = [3.4]
+cycles = 12
+frames = 3
 timeout = 300
 """
 
@@ -30,6 +46,7 @@ def tiny_repository(path):
     for folder in ("validation/cases", "reference-data"):
         os.makedirs(os.path.join(path, folder))
     for name in ("validation/studies.toml", "validation/cases/pattern_md_f0p18.toml",
+                 "validation/cases/pattern_continuum_f0p18.toml",
                  "reference-data/claims.toml", "reference-data/pattern-claims.toml"):
         shutil.copy(os.path.join(REPOSITORY, name), os.path.join(path, name))
     with open(os.path.join(path, sweep.SWEEP_FILE), "w") as f:
@@ -221,6 +238,28 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
     assert rows["P4"]["verdict"] == "pass" and "continuum: pattern_continuum_f0p18: 1 " in \
         rows["P4"]["value"]
     assert rows["P5"]["verdict"] == "not measured" and "linear stage" in rows["P5"]["reason"]
+    # P5 with a saturation run at Gamma 2.8, above both onsets: MD 0.2 (2.8 is ordered in the
+    # synthetic MD case) against 0.1 saturated: 2.0, outside [0.8, 1.25]
+    saturated = dict(gamma=2.8, order=0.1, order_error=0.002, wavelength=17.0, a2=1.0,
+                     correlation_previous_cycle=-0.9)
+    cases["pattern_continuum_f0p18"]["saturation"] = [saturated]
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    md_order = next(p["order"] for p in md["points"] if p["gamma"] == 2.8)
+    assert rows["P5"]["verdict"] == ("pass" if not 0.8 <= md_order / 0.1 <= 1.25 else "fail")
+    assert rows["P5"]["value"].startswith(f"{md_order / 0.1:.4g} ± ")
+    saturated["order"] = md_order  # the same amplitude in both: P5 fails
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P5"]["verdict"] == "fail" and rows["P5"]["value"].startswith("1 ± ")
+    saturated["gamma"] = 3.3  # no MD point there
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P5"]["verdict"] == "not measured" and "3.3" in rows["P5"]["reason"]
+    del cases["pattern_continuum_f0p18"]["saturation"]
     # the continuum's wavelength far from the experiments' fails P4 as a whole
     cases["pattern_continuum_f0p18"] = synthetic_continuum(2.3, mode_wavelength=64.0)
     rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
@@ -323,3 +362,50 @@ def test_without_an_onset_fit_the_md_onset_is_the_bracket_of_ordered_points():
     mixed = synthetic_case(21.3, 2.5, ordered_below=True)  # ordered at 2.0 too: no bracket
     mixed["onset"] = {}
     assert make_pattern_report.order_bracket(mixed) is None
+
+
+def test_a_saturation_table_is_checked_and_planned():
+    where = "[study.x.continuum.saturation]"
+    good = dict(gamma=[3.4], cycles=300, frames=10, timeout=3600)
+    sweep.check_saturation(good, where)
+    for bad, message in ((dict(good, gamma=[]), "at least 1"),
+                         (dict(good, gamma=[3.4, 3.0]), "increasing"),
+                         (dict(good, frames=300), "2 <= frames < cycles"),
+                         (dict(good, frames=1), "2 <= frames < cycles"),
+                         (dict(good, cycles=300.5), "whole numbers")):
+        with pytest.raises(ValueError, match=message):
+            sweep.check_saturation(bad, where)
+    with pytest.raises(ValueError, match="no 'cycles'"):
+        sweep.check_saturation({k: v for k, v in good.items() if k != "cycles"}, where)
+    assert sweep.saturation_overrides(dict(good, cycles=12, frames=3)) == [
+        "run.transient_cycles=9", "run.sampled_cycles=3", "continuum.field_cycles=[9, 10, 11]"]
+    continuum = dict(cases=["pattern_continuum_f0p18"], gamma=[2.2, 2.6, 3.0, 3.4, 3.8],
+                     seeds=[1, 2], overrides=["continuum.cell_size=2.0"], timeout=60,
+                     saturation=good)
+    study = dict(cases=["pattern_md_f0p18"], gamma=[2.0, 2.4, 2.8, 3.2, 3.6], seeds=[1],
+                 overrides=[], timeout=60, continuum=continuum)
+    plan = sweep.plan_points(REPOSITORY, study)
+    saturation = [r for r in plan if r["kind"] == "saturation"]
+    assert len(plan) == 5 + 10 + 2 and len(saturation) == 2
+    assert all(r["solver"] == "continuum" and r["gamma"] == 3.4 and r["timeout"] == 3600
+               and "continuum.cell_size=2.0" in r["overrides"]
+               and "run.transient_cycles=290" in r["overrides"] for r in saturation)
+
+
+def test_a_sweep_with_the_continuum_runs_its_saturation_runs(work_dir, shaker):
+    repository = tiny_repository(os.path.join(work_dir, "repository"))
+    workdir, report = os.path.join(work_dir, "work"), os.path.join(work_dir, "patterns.md")
+    assert sweep.main(["--shaker", shaker, "--study", "tinyc", "--repository", repository,
+                       "--workdir", workdir, "--jobs", "2", "--report", report]) == 0
+    with open(os.path.join(workdir, "patterns.json")) as f:
+        results = json.load(f)
+    case = results["cases"]["pattern_continuum_f0p18"]
+    assert [p["gamma"] for p in case["points"]] == [2.2, 2.6, 3.0, 3.4, 3.8]
+    assert all(np.isfinite(p["rate"]) and "view" in p for p in case["points"])
+    # The growth runs' view is their last frame; the saturation run's its last 3 cycles.
+    assert all(p["view"]["frames"] == 1 for p in case["points"])
+    (saturated,) = case["saturation"]
+    assert saturated["gamma"] == 3.4 and saturated["view"]["cycle"] == 11.0
+    assert saturated["view"]["frames"] == 3 and saturated["order"] > 0.0
+    assert "rate" not in saturated and len(results["runs"]) == 5 + 5 + 1
+    assert "- saturated at Gamma 3.4" in open(report).read()
