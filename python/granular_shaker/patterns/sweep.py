@@ -22,9 +22,12 @@ wavelength, the angular moments and the cycle-to-cycle correlation. With several
 point's value is the mean over seeds and its error their standard error (independent runs);
 with one seed, the standard error over its frames. Per case: the onset fit
 (granular_shaker.patterns.onset.fit_onset) and, below that onset, the Swift-Hohenberg fit.
-A continuum part may hold a `saturation` table (gamma, cycles, frames, timeout): runs of
-`cycles` cycles whose last `frames` hold the fields, summarised as the MD's are (the
-saturated order parameter over those frames), the amplitude the claims compare with MD's.
+A continuum part may hold a `grid` table (gamma, cells, timeout): its growth runs repeated at
+each cell (the box GRID_DEPTH_CELLS cells deep), whose rates tell whether the onset found at
+the case files' cell survives refinement; and a `saturation` table (gamma, cycles, frames,
+timeout): runs of `cycles` cycles whose last `frames` hold the fields, summarised as the MD's
+are (the saturated order parameter over those frames), the amplitude the claims compare with
+MD's.
 Each point also keeps its first seed's view (granular_shaker.patterns.views): the layer seen
 from above at the stored phases of one cycle and the spectrum of its column mass along x, which
 the report draws.
@@ -53,6 +56,7 @@ from granular_shaker.validation.summary import git, write_json_atomically
 
 SWEEP_FILE = os.path.join("validation", "patterns.toml")
 FIELD = "mass"  # the column mass: its noise is the counts' (docs/analysis.md "Patterns")
+GRID_DEPTH_CELLS = 4  # the fewest cells across y that the continuum accepts
 
 
 def check_part(repository, part, where):
@@ -80,6 +84,24 @@ def check_saturation(part, where):
                          "allowed: whole numbers, 2 <= frames < cycles")
 
 
+def check_grid(part, where):
+    """ValueError naming what is wrong with a continuum part's grid table."""
+    for key in ("gamma", "cells", "timeout"):
+        if key not in part:
+            raise ValueError(f"{where} has no '{key}'")
+    cells = part["cells"]
+    if len(cells) < 3 or sorted(set(cells), reverse=True) != list(cells) or cells[-1] <= 0:
+        raise ValueError(f"{where}: cells {cells!r}: allowed: at least 3, decreasing, > 0")
+    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
+        raise ValueError(f"{where}: gamma must be increasing, at least 1")
+
+
+def grid_overrides(cell):
+    """The --set values of a grid-check run: the cell, and a box GRID_DEPTH_CELLS cells deep
+    (the stripes lie across y, so its depth only needs to hold a few cells)."""
+    return [f"continuum.cell_size={cell:g}", f"continuum.box_depth={GRID_DEPTH_CELLS * cell:g}"]
+
+
 def saturation_overrides(part):
     """The --set values of a saturation run: `cycles` cycles, the fields at the case's phases
     of the last `frames` of them (all saturated, when `cycles` is long enough)."""
@@ -102,6 +124,8 @@ def load_sweep(repository, name):
         if "saturation" in sweep["continuum"]:
             check_saturation(sweep["continuum"]["saturation"],
                              f"{SWEEP_FILE} [study.{name}.continuum.saturation]")
+        if "grid" in sweep["continuum"]:
+            check_grid(sweep["continuum"]["grid"], f"{SWEEP_FILE} [study.{name}.continuum.grid]")
     return sweep
 
 
@@ -115,23 +139,29 @@ def solver_parts(sweep):
 
 def plan_points(repository, sweep):
     """One run per solver, case, Gamma and seed, in the run dicts of the validation study; the
-    continuum's saturation runs (kind "saturation") after its growth runs."""
-    parts = [(solver, part, [], "sweep") for solver, part in solver_parts(sweep)]
-    saturation = (sweep.get("continuum") or {}).get("saturation")
-    if saturation:
-        parts.append(("continuum", dict(sweep["continuum"], gamma=saturation["gamma"],
+    continuum's saturation runs (kind "saturation") and grid-check runs (kind "grid", one per
+    cell, key "cell") after its growth runs."""
+    parts = [(solver, part, [], "sweep", None) for solver, part in solver_parts(sweep)]
+    continuum = sweep.get("continuum") or {}
+    if "saturation" in continuum:
+        saturation = continuum["saturation"]
+        parts.append(("continuum", dict(continuum, gamma=saturation["gamma"],
                                         timeout=saturation["timeout"]),
-                      saturation_overrides(saturation), "saturation"))
+                      saturation_overrides(saturation), "saturation", None))
+    if "grid" in continuum:
+        grid = continuum["grid"]
+        parts += [("continuum", dict(continuum, gamma=grid["gamma"], timeout=grid["timeout"]),
+                   grid_overrides(cell), "grid", cell) for cell in grid["cells"]]
     plan = []
-    for solver, part, extra, kind in parts:
+    for solver, part, extra, kind, cell in parts:
         for case in part["cases"]:
             for gamma in part["gamma"]:
                 for seed in part["seeds"]:
                     plan.append(dict(case=case, case_file=case_file(repository, case),
-                                     solver=solver, kind=kind, replicas=1, gamma=gamma,
-                                     seed=seed, overrides=[f"shaker.gamma={gamma}",
-                                                           f"run.seed={seed}",
-                                                           *part["overrides"], *extra],
+                                     solver=solver, kind=kind, cell=cell, replicas=1,
+                                     gamma=gamma, seed=seed,
+                                     overrides=[f"shaker.gamma={gamma}", f"run.seed={seed}",
+                                                *part["overrides"], *extra],
                                      timeout=part["timeout"], fallback=[],
                                      expect_failure=False))
     return plan
@@ -261,6 +291,17 @@ def case_points(plan, case, kind="sweep"):
     return points
 
 
+def grid_points(plan, case):
+    """A case's grid check: per cell and Gamma, its first seed's growth of the fastest
+    pattern mode."""
+    points = {}
+    for run in plan:
+        if run["case"] == case and run.get("kind") == "grid" and "growth" in run:
+            points.setdefault((run["cell"], run["gamma"]),
+                              dict(cell=run["cell"], gamma=run["gamma"], **run["growth"]))
+    return list(points.values())
+
+
 def collect(shaker, plan):
     """Every case's points and fits from the finished runs; the failures met."""
     failures, cases = [], {}
@@ -294,6 +335,9 @@ def collect(shaker, plan):
         saturated = case_points(plan, case, "saturation")
         if saturated:
             cases[case]["saturation"] = saturated
+        grid = grid_points(plan, case)
+        if grid:
+            cases[case]["grid"] = grid
     return cases, failures
 
 

@@ -371,6 +371,33 @@ def coarse_continuum_note(sweep):
             "continuum's onset', compares them with the case files' cell)")
 
 
+def refinement_changes(case):
+    """The grid check's (Gamma, the sweep's rate, the finest cell, its rate) where refinement
+    reverses a growth rate significant at both cells (the test that places the onset)."""
+    sweep_rate = {p["gamma"]: p for p in case["points"]}
+    changes = []
+    for gamma in sorted({p["gamma"] for p in case.get("grid", [])}):
+        finest = min((p for p in case["grid"] if p["gamma"] == gamma), key=lambda p: p["cell"])
+        mine = sweep_rate.get(gamma)
+        if mine is None:
+            continue
+        significant = [abs(p["rate"]) > SIGNIFICANT_GROWTH * p["rate_error"]
+                       for p in (mine, finest)]
+        if all(significant) and (mine["rate"] > 0) != (finest["rate"] > 0):
+            changes.append((gamma, mine["rate"], finest["cell"], finest["rate"]))
+    return changes
+
+
+def grid_note(cases):
+    """The caveat of continuum cases whose growth the grid check reverses, or ""."""
+    notes = [f"{name}: refinement reverses its growth at Gamma {g:g} ({rc.fmt(r, 3)} per cycle "
+             f"at the sweep's cell, {rc.fmt(fine, 3)} at cell {cell:g}), so its onset there is "
+             "not the converged continuum's"
+             for name, case in solver_cases(cases, "continuum").items()
+             for g, r, cell, fine in refinement_changes(case)]
+    return "; ".join(notes)
+
+
 def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_note=""):
     """Every claim with its verdict: measured by the sweep, or not measured and why. A claim on
     both solvers that only one of them measures gets that one's verdict, marked as its alone.
@@ -565,6 +592,19 @@ def continuum_case_lines(name, case):
                   f"{onset['chi2_per_dof']:.3g})"]
     else:
         lines += ["", f"- onset: none: {onset.get('reason', 'not fitted')}"]
+    grid = sorted(case.get("grid", []), key=lambda p: (p["gamma"], -p["cell"]))
+    if grid:
+        lines += ["", "Grid check (the same run at each cell, the box 4 cells deep):", "",
+                  "| Gamma [g] | cell [sigma] | growth rate [1/cycle] | fastest pattern mode m "
+                  "| cycles fitted |", "| --- | --- | --- | --- | --- |"]
+        lines += [f"| {p['gamma']:g} | {p['cell']:g} | {rc.fmt(p['rate'])} ± "
+                  f"{rc.fmt(p['rate_error'], 2)} | {p['mode']} | {p['fit_cycles'][0]:g} to "
+                  f"{p['fit_cycles'][1]:g} |" for p in grid]
+        lines += [f"- refinement reverses the growth at Gamma {g:g}: {rc.fmt(r, 3)} per cycle "
+                  f"at the sweep's cell, {rc.fmt(fine, 3)} at cell {cell:g}"
+                  for g, r, cell, fine in refinement_changes(case)] or [
+            "- refinement keeps the sign of every growth rate checked"]
+        lines.append("")
     for p in case.get("saturation", []):
         lines.append(f"- saturated at Gamma {p['gamma']:g} (over the last frames of a long "
                      f"run): order parameter {rc.fmt(p['order'])} ± "
@@ -666,8 +706,8 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
         lines += case_lines(name, case)
     lines += ["## Claims (reference-data/pattern-claims.toml)", "",
               "| claim | statement | value | verdict | why |", "| --- | --- | --- | --- | --- |"]
-    for row in claim_verdicts(claims, results["cases"], parameters, dispersion,
-                              coarse_continuum_note(sweep)):
+    note = "; ".join(n for n in (coarse_continuum_note(sweep), grid_note(results["cases"])) if n)
+    for row in claim_verdicts(claims, results["cases"], parameters, dispersion, note):
         lines.append(f"| {row['id']} ({row['status']}) | {row['statement']} | {row['value']} | "
                      f"{row['verdict']} | {row['reason']} |")
     if results["failures"]:

@@ -38,6 +38,11 @@ gamma = [3.4]
 cycles = 12
 frames = 3
 timeout = 300
+
+[study.tinyc.continuum.grid]
+gamma = [3.4]
+cells = [2.0, 1.0, 0.8]
+timeout = 300
 """
 
 
@@ -407,5 +412,35 @@ def test_a_sweep_with_the_continuum_runs_its_saturation_runs(work_dir, shaker):
     (saturated,) = case["saturation"]
     assert saturated["gamma"] == 3.4 and saturated["view"]["cycle"] == 11.0
     assert saturated["view"]["frames"] == 3 and saturated["order"] > 0.0
-    assert "rate" not in saturated and len(results["runs"]) == 5 + 5 + 1
-    assert "- saturated at Gamma 3.4" in open(report).read()
+    assert "rate" not in saturated and len(results["runs"]) == 5 + 5 + 1 + 3
+    # The grid check's run at the sweep's own cell (2, the box 8 deep) is its growth run.
+    assert sum(r["reused"] for r in results["runs"]) == 1
+    grid = {p["cell"]: p for p in case["grid"]}
+    assert sorted(grid) == [0.8, 1.0, 2.0] and all(p["gamma"] == 3.4 for p in grid.values())
+    assert grid[2.0]["rate"] == next(p["rate"] for p in case["points"] if p["gamma"] == 3.4)
+    text = open(report).read()
+    assert "- saturated at Gamma 3.4" in text and "Grid check" in text
+    assert "| 3.4 | 0.8 | " in text
+
+
+def test_a_grid_table_is_checked_and_a_reversed_growth_is_noted():
+    where = "[study.x.continuum.grid]"
+    good = dict(gamma=[3.4], cells=[2.0, 1.0, 0.5], timeout=60)
+    sweep.check_grid(good, where)
+    for bad, message in ((dict(good, cells=[2.0, 1.0]), "at least 3"),
+                         (dict(good, cells=[1.0, 2.0, 0.5]), "decreasing"),
+                         (dict(good, cells=[2.0, 1.0, 0.0]), "> 0"),
+                         (dict(good, gamma=[]), "at least 1")):
+        with pytest.raises(ValueError, match=message):
+            sweep.check_grid(bad, where)
+    assert sweep.grid_overrides(0.8) == ["continuum.cell_size=0.8", "continuum.box_depth=3.2"]
+    case = synthetic_continuum(2.3)   # grows at 2.6 at +0.15 +- 0.01
+    case["grid"] = [dict(cell=c, gamma=2.6, rate=r, rate_error=0.01, mode=6, fit_cycles=[5, 39])
+                    for c, r in ((2.0, 0.05), (1.0, 0.03), (0.5, -0.04))]
+    assert make_pattern_report.refinement_changes(case) == [(2.6, pytest.approx(0.15), 0.5,
+                                                             -0.04)]
+    note = make_pattern_report.grid_note({"pattern_continuum_f0p18": case})
+    assert "refinement reverses its growth at Gamma 2.6" in note and "cell 0.5" in note
+    case["grid"][-1]["rate"] = -0.015   # within two errors of zero: no reversal
+    assert make_pattern_report.refinement_changes(case) == []
+    assert make_pattern_report.grid_note({"pattern_continuum_f0p18": case}) == ""
