@@ -186,12 +186,17 @@ def judge(value, claim):
 def md_part(claim, md, parameters, dispersion):
     """(value, MD verdict) of a claim on both solvers, from the MD cases alone, or None."""
     if claim["id"] == "P1":
+        # A case whose ordered points do not all lie above its disordered ones has no onset
+        # of order, and so does not show stripes above one: it fails the part.
         found = {name: stripes_above_onset_only(case) for name, case in md.items()}
-        if None in found.values():
+        if all(f is None for f in found.values()):
             return None
-        return ("; ".join(f"{n}: ordered at Gamma " + ", ".join(
-            f"{g:g}" for g in ordered_gammas(md[n])) for n in md),
-                "pass" if all(found.values()) else "fail")
+        return ("; ".join(f"{n}: ordered at Gamma " + (", ".join(
+            f"{g:g}" for g in ordered_gammas(md[n])) or "none") + (
+                "" if found[n] is not None else
+                " (no onset of order: ordered and disordered points alternate)"
+                if ordered_gammas(md[n]) else " (no ordered point)") for n in md),
+                "pass" if all(f is True for f in found.values()) else "fail")
     wavelengths = {name: stripe_wavelength(case) for name, case in md.items()}
     if claim["id"] == "P3" and len(md) == 2 and None not in wavelengths.values():
         low, high = sorted(md, key=lambda n: parameters[n][0])

@@ -186,6 +186,19 @@ def test_stripes_below_the_onset_fail_the_md_part_of_p1():
              "pattern_md_f0p14": synthetic_case(25.6, 2.3)}
     assert verdicts(cases, None)["P1"]["verdict"] == "MD fail; continuum not measured"
     assert verdicts(cases, None)["P4"]["verdict"] == "not measured"  # no dispersion relation
+    # Without an onset fit, ordered points that alternate with disordered ones bracket no
+    # onset of order: that case fails the part, named; the other still measures it.
+    alternating = synthetic_case(25.6, 2.3, ordered_below=True)
+    alternating["onset"] = dict(reason="the best onset is at the end of the sweep")
+    cases = {"pattern_md_f0p18": synthetic_case(21.3, 2.5), "pattern_md_f0p14": alternating}
+    row = verdicts(cases, None)["P1"]
+    assert row["verdict"] == "MD fail; continuum not measured"
+    assert "pattern_md_f0p14: ordered at Gamma 2, 2.4, 2.6, 2.8, 3 (no onset of order" in \
+        row["value"] and "pattern_md_f0p18: ordered at Gamma 2.6, 2.8, 3;" in row["value"]
+    for point in alternating["points"]:
+        point["a2"] = 0.2
+    assert "pattern_md_f0p14: ordered at Gamma none (no ordered point)" in \
+        verdicts(cases, None)["P1"]["value"]
 
 
 def test_reports_and_figures_are_written_readable_by_others(work_dir):
