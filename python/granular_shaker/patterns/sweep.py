@@ -22,12 +22,12 @@ wavelength, the angular moments and the cycle-to-cycle correlation. With several
 point's value is the mean over seeds and its error their standard error (independent runs);
 with one seed, the standard error over its frames. Per case: the onset fit
 (granular_shaker.patterns.onset.fit_onset) and, below that onset, the Swift-Hohenberg fit.
-A continuum part may hold a `grid` table (gamma, cells, timeout): its growth runs repeated at
-each cell (the box GRID_DEPTH_CELLS cells deep), whose rates tell whether the onset found at
-the case files' cell survives refinement; and a `saturation` table (gamma, cycles, frames,
-timeout): runs of `cycles` cycles whose last `frames` hold the fields, summarised as the MD's
-are (the saturated order parameter over those frames), the amplitude the claims compare with
-MD's.
+A continuum part may hold a `grid` table (gamma, cells, timeout, optionally cases: some of the
+part's): its growth runs repeated at each cell (the box GRID_DEPTH_CELLS cells deep), whose
+rates tell whether the onset found at the case files' cell survives refinement; and a
+`saturation` table (gamma, cycles, frames, timeout, optionally cases): runs of `cycles` cycles
+whose last `frames` hold the fields, summarised as the MD's are (the saturated order parameter
+over those frames), the amplitude the claims compare with MD's.
 Each point also keeps its first seed's view (granular_shaker.patterns.views): the layer seen
 from above at the stored phases of one cycle and the spectrum of its column mass along x, which
 the report draws.
@@ -126,6 +126,12 @@ def load_sweep(repository, name):
                              f"{SWEEP_FILE} [study.{name}.continuum.saturation]")
         if "grid" in sweep["continuum"]:
             check_grid(sweep["continuum"]["grid"], f"{SWEEP_FILE} [study.{name}.continuum.grid]")
+        for table in ("saturation", "grid"):
+            unknown = set(sweep["continuum"].get(table, {}).get("cases", [])) \
+                - set(sweep["continuum"]["cases"])
+            if unknown:
+                raise ValueError(f"{SWEEP_FILE} [study.{name}.continuum.{table}]: cases "
+                                 f"{sorted(unknown)} are not the continuum part's")
     return sweep
 
 
@@ -137,6 +143,13 @@ def solver_parts(sweep):
     return parts
 
 
+def within(part, table):
+    """The gamma, timeout and cases of a continuum part's saturation or grid table (its cases:
+    the part's unless the table names some of them)."""
+    return dict(gamma=table["gamma"], timeout=table["timeout"],
+                cases=table.get("cases", part["cases"]))
+
+
 def plan_points(repository, sweep):
     """One run per solver, case, Gamma and seed, in the run dicts of the validation study; the
     continuum's saturation runs (kind "saturation") and grid-check runs (kind "grid", one per
@@ -145,13 +158,12 @@ def plan_points(repository, sweep):
     continuum = sweep.get("continuum") or {}
     if "saturation" in continuum:
         saturation = continuum["saturation"]
-        parts.append(("continuum", dict(continuum, gamma=saturation["gamma"],
-                                        timeout=saturation["timeout"]),
+        parts.append(("continuum", dict(continuum, **within(continuum, saturation)),
                       saturation_overrides(saturation), "saturation", None))
     if "grid" in continuum:
         grid = continuum["grid"]
-        parts += [("continuum", dict(continuum, gamma=grid["gamma"], timeout=grid["timeout"]),
-                   grid_overrides(cell), "grid", cell) for cell in grid["cells"]]
+        parts += [("continuum", dict(continuum, **within(continuum, grid)), grid_overrides(cell),
+                   "grid", cell) for cell in grid["cells"]]
     plan = []
     for solver, part, extra, kind, cell in parts:
         for case in part["cases"]:

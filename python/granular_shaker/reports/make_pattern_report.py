@@ -286,17 +286,19 @@ def combined(md, continuum):
 
 def amplitude_ratio(claim, md, continuum):
     """((value, verdict), "") of P5: the MD's saturated order parameter over the continuum's
-    at the first Gamma of the continuum's saturation runs above its onset where the MD's
-    stripes are ordered; (None, reason) when there is none."""
+    at the first Gamma of the continuum's saturation runs above both solvers' onsets; (None,
+    reason) when there is none."""
     onset = onset_of(continuum)[0]
     saturated = [p for p in continuum.get("saturation", []) if p["gamma"] > onset]
     if not saturated:
         return None, NO_SATURATION
-    ordered_md = {p["gamma"]: p for p in (md or {}).get("points", []) if ordered(p)}
-    pairs = [(ordered_md[p["gamma"]], p) for p in saturated if p["gamma"] in ordered_md]
+    onset_md = md_onset(md)
+    above_md = {p["gamma"]: p for p in (md or {}).get("points", [])
+                if onset_md is not None and p["gamma"] > onset_md[0]}
+    pairs = [(above_md[p["gamma"]], p) for p in saturated if p["gamma"] in above_md]
     if not pairs:
-        return None, ("no ordered MD point at the Gamma of the continuum's saturation runs ("
-                      + ", ".join(f"{p['gamma']:g}" for p in saturated) + ")")
+        return None, ("no MD point above its onset at the Gamma of the continuum's saturation "
+                      "runs (" + ", ".join(f"{p['gamma']:g}" for p in saturated) + ")")
     mine, theirs = pairs[0]
     value, error = ratio_with_error((mine["order"], mine["order_error"]),
                                     (theirs["order"], theirs["order_error"]))

@@ -256,8 +256,8 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
     assert rows["P4"]["verdict"] == "pass" and "continuum: pattern_continuum_f0p18: 1 " in \
         rows["P4"]["value"]
     assert rows["P5"]["verdict"] == "not measured" and "linear stage" in rows["P5"]["reason"]
-    # P5 with a saturation run at Gamma 2.8, above both onsets: MD 0.2 (2.8 is ordered in the
-    # synthetic MD case) against 0.1 saturated: 2.0, outside [0.8, 1.25]
+    # P5 with a saturation run at Gamma 2.8, above both onsets (the MD's 2.5): the MD's order
+    # parameter there against 0.1 saturated
     saturated = dict(gamma=2.8, order=0.1, order_error=0.002, wavelength=17.0, a2=1.0,
                      correlation_previous_cycle=-0.9)
     cases["pattern_continuum_f0p18"]["saturation"] = [saturated]
@@ -272,11 +272,16 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
         claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
                         "pattern_md_f0p18": (0.18, 5.0)}, relation)}
     assert rows["P5"]["verdict"] == "fail" and rows["P5"]["value"].startswith("1 ± ")
-    saturated["gamma"] = 3.3  # no MD point there
+    saturated["gamma"] = 3.3  # no MD point there ...
     rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
         claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
                         "pattern_md_f0p18": (0.18, 5.0)}, relation)}
     assert rows["P5"]["verdict"] == "not measured" and "3.3" in rows["P5"]["reason"]
+    saturated["gamma"] = 2.4  # ... nor above the MD's onset here (2.4 < 2.5)
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P5"]["verdict"] == "not measured" and "above its onset" in rows["P5"]["reason"]
     del cases["pattern_continuum_f0p18"]["saturation"]
     # the continuum's wavelength far from the experiments' fails P4 as a whole
     cases["pattern_continuum_f0p18"] = synthetic_continuum(2.3, mode_wavelength=64.0)
@@ -457,3 +462,16 @@ def test_a_grid_table_is_checked_and_a_reversed_growth_is_noted():
     case["grid"][-1]["rate"] = -0.015   # within two errors of zero: no reversal
     assert make_pattern_report.refinement_changes(case) == []
     assert make_pattern_report.grid_note({"pattern_continuum_f0p18": case}) == ""
+
+
+def test_a_grid_or_saturation_table_may_name_some_of_the_continuums_cases(work_dir):
+    repository = tiny_repository(os.path.join(work_dir, "repository"))
+    study = tomllib.loads(TINY_SWEEP)["study"]["tinyc"]
+    study["continuum"]["grid"]["cases"] = []
+    assert all(r["kind"] != "grid" for r in sweep.plan_points(repository, study))
+    with open(os.path.join(repository, sweep.SWEEP_FILE), "a") as f:
+        continuum = TINY_SWEEP.split("[study.tinyc.continuum]")[1].replace("tinyc", "wrong")
+        f.write("\n[study.wrong]\n" + TINY_MD + "\n[study.wrong.continuum]" + continuum.replace(
+            "cells = [2.0, 1.0, 0.8]", 'cases = ["pattern_md_f0p18"]\ncells = [2.0, 1.0, 0.8]'))
+    with pytest.raises(ValueError, match=r"continuum.grid\]: cases \['pattern_md_f0p18'\]"):
+        sweep.load_sweep(repository, "wrong")
