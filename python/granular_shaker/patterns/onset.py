@@ -169,3 +169,13 @@ def fit_swift_hohenberg(gamma, order, error, onset_at_most=None):
         "the fluctuations below onset do not grow towards an onset (strength")
     return SwiftHohenbergFit(onset, onset_error, float(strength), float(errors[1]), float(floor),
                              float(errors[0]), chi2_per_dof, int(gamma.size))
+
+
+def rising_branch(points):
+    """The points up to the one with the largest order parameter. Past it the pattern's
+    amplitude falls again as Gamma grows (the layer's flight lengthens towards the next
+    bifurcation), which the supercritical form near onset does not describe."""
+    if not points:
+        return points
+    top = int(np.argmax([p["order"] for p in points]))
+    return points[:top + 1]

@@ -45,7 +45,7 @@ import numpy as np
 
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                              fit_zero_crossing)
-from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg
+from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg, rising_branch
 from granular_shaker.patterns.views import run_view
 from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
@@ -226,16 +226,6 @@ def point_summary(runs):
     for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
         point[name] = float(np.mean([r[name] for r in runs]))
     return point
-
-
-def rising_branch(points):
-    """The points up to the one with the largest order parameter. Past it the pattern's
-    amplitude falls again as Gamma grows (the layer's flight lengthens towards the next
-    bifurcation), which the supercritical form near onset does not describe."""
-    if not points:
-        return points
-    top = int(np.argmax([p["order"] for p in points]))
-    return points[:top + 1]
 
 
 def fits(points):

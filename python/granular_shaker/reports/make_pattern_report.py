@@ -15,6 +15,7 @@ import tomllib
 import numpy as np
 
 from granular_shaker.patterns.growth import SIGNIFICANT_GROWTH
+from granular_shaker.patterns.onset import rising_branch
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
@@ -138,8 +139,9 @@ def onset_of(case, key="onset", parameter="gamma_c"):
 def order_bracket(case):
     """The onset of ordered standing waves bracketed by the sweep: (midpoint, its standard
     error as a uniform distribution over the bracket, last disordered Gamma, first ordered
-    Gamma), when every point above some Gamma is ordered and none below it; else None."""
-    points = sorted(case["points"], key=lambda p: p["gamma"])
+    Gamma), when on the rising branch of the order parameter (the points the onset fit uses)
+    every point above some Gamma is ordered and none below it; else None."""
+    points = rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))
     flags = [ordered(p) for p in points]
     if True not in flags or False not in flags:
         return None
@@ -160,13 +162,15 @@ def md_onset(case):
 
 
 def stripes_above_onset_only(case):
-    """MD part of P1: ordered stripes at the Gamma above the onset, none below it."""
+    """MD part of P1: ordered stripes at the Gamma above the onset on the rising branch of the
+    order parameter, none below it."""
     onset = (md_onset(case) or (None,))[0]
     shown = ordered_gammas(case)
     if onset is None or not shown:
         return None
     below = [g for g in shown if g < onset]
-    above = [p["gamma"] for p in case["points"] if p["gamma"] > onset]
+    above = [p["gamma"] for p in rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))
+             if p["gamma"] > onset]
     return not below and bool(above) and all(g in shown for g in above)
 
 

@@ -385,6 +385,15 @@ def test_without_an_onset_fit_the_md_onset_is_the_bracket_of_ordered_points():
     mixed = synthetic_case(21.3, 2.5, ordered_below=True)  # ordered at 2.0 too: no bracket
     mixed["onset"] = {}
     assert make_pattern_report.order_bracket(mixed) is None
+    # Past the order parameter's peak (2.8) the stripes may lose their order (3.0, the
+    # measured sweep at f = 0.18 and Gamma 3.4): the bracket and P1 use the rising branch.
+    for point in case["points"]:
+        point["order"] = {2.6: 1.5, 2.8: 2.0, 3.0: 1.2}.get(point["gamma"], point["order"])
+    case["points"][-1]["correlation_previous_cycle"] = -0.3
+    assert make_pattern_report.order_bracket(case)[2:] == (2.4, 2.6)
+    assert make_pattern_report.stripes_above_onset_only(case) is True
+    case["points"][-1]["order"] = 2.5   # a disordered point on the rising branch: no bracket
+    assert make_pattern_report.order_bracket(case) is None
 
 
 def test_a_saturation_table_is_checked_and_planned():
