@@ -612,12 +612,12 @@ def continuum_case_lines(name, case):
                   f"{rc.fmt(p['rate_error'], 2)} | {p['mode']} | {p['fit_cycles'][0]:g} to "
                   f"{p['fit_cycles'][1]:g} |" for p in grid]
         refined = len({p["cell"] for p in grid}) > 1
-        lines += [f"- refinement reverses the growth at Gamma {g:g}: {rc.fmt(r, 3)} per cycle "
-                  f"at the sweep's cell, {rc.fmt(fine, 3)} at cell {cell:g}"
-                  for g, r, cell, fine in refinement_changes(case)] or [
+        verdicts = [f"- refinement reverses the growth at Gamma {g:g}: {rc.fmt(r, 3)} per cycle "
+                    f"at the sweep's cell, {rc.fmt(fine, 3)} at cell {cell:g}"
+                    for g, r, cell, fine in refinement_changes(case)] or [
             "- refinement keeps the sign of every growth rate checked" if refined else
             "- no run at a finer cell has finished: the grid check is incomplete"]
-        lines.append("")
+        lines += [""] + verdicts + [""]
     for p in case.get("saturation", []):
         lines.append(f"- saturated at Gamma {p['gamma']:g} (over the last frames of a long "
                      f"run): order parameter {rc.fmt(p['order'])} ± "

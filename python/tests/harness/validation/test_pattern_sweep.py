@@ -468,9 +468,17 @@ def test_a_grid_table_is_checked_and_a_reversed_growth_is_noted():
                                                              -0.04)]
     note = make_pattern_report.grid_note({"pattern_continuum_f0p18": case})
     assert "refinement reverses its growth at Gamma 2.6" in note and "cell 0.5" in note
+    lines = make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
+    assert "- refinement reverses the growth at Gamma 2.6: 0.15 per cycle at the sweep's " \
+        "cell, -0.04 at cell 0.5" in lines
     case["grid"][-1]["rate"] = -0.015   # within two errors of zero: no reversal
     assert make_pattern_report.refinement_changes(case) == []
     assert make_pattern_report.grid_note({"pattern_continuum_f0p18": case}) == ""
+    assert "- refinement keeps the sign of every growth rate checked" in \
+        make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
+    case["grid"] = case["grid"][:1]   # the sweep's own cell only
+    assert "- no run at a finer cell has finished: the grid check is incomplete" in \
+        make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
 
 
 def test_a_grid_or_saturation_table_may_name_some_of_the_continuums_cases(work_dir):
