@@ -32,6 +32,7 @@ import numpy as np
 
 from ..fields import read_fields
 from .onset import linear_fit
+from .views import mode_amplitudes, phase_of
 
 FIRST_PATTERN_MODE = 2
 # The modes of a run sit on a floor of the solver's when their typical amplitude over the last
@@ -169,10 +170,8 @@ def column_mass_modes(fields_path, modes=12):
         raise NoGrowthFit(f"{fields_path}: its snapshots carry no cycle")
     if nx <= 2 * modes:
         raise NoGrowthFit(f"{fields_path}: {nx} cells along x cannot hold {modes} modes")
-    spectrum = np.abs(np.fft.rfft(snapshots["n"].sum(axis=1).mean(axis=1), axis=1))
-    # A frame that closes a cycle may be stored at phase 0.9999999999: it is phase 0.
-    phases = np.round(snapshots["phase"] % 1.0, 6) % 1.0
-    return (snapshots["cycle"], phases, spectrum[:, 1:modes + 1] / spectrum[:, :1],
+    columns = snapshots["n"].sum(axis=1).transpose(0, 2, 1)   # frame, x, y
+    return (snapshots["cycle"], phase_of(snapshots["phase"]), mode_amplitudes(columns, modes),
             nx * fields.cell_size)
 
 

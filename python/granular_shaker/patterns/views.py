@@ -46,15 +46,20 @@ def phase_of(phases):
     return np.round(np.asarray(phases, float) % 1.0, 6) % 1.0
 
 
+def mode_amplitudes(fields, modes):
+    """|c_m| / c_0 of each frame's column mass (fields [frame, x, y]) averaged over y, the
+    Fourier modes m = 1..modes along x."""
+    spectrum = np.abs(np.fft.rfft(fields.mean(axis=2), axis=1))
+    return spectrum[:, 1:modes + 1] / spectrum[:, :1]
+
+
 def mode_power(fields, modes=MODES):
     """|c_m|^2 / c_0^2 of each frame's column mass averaged over y, m = 1..modes, or up to the
     last mode below the grid's Nyquist mode when it holds fewer."""
-    profile = fields.mean(axis=2)
-    if profile.shape[1] < 4:
-        raise ValueError(f"{profile.shape[1]} cells along x cannot hold a mode")
-    spectrum = np.abs(np.fft.rfft(profile, axis=1))
-    modes = min(modes, (profile.shape[1] - 1) // 2)
-    return (spectrum[:, 1:modes + 1] / spectrum[:, :1]) ** 2
+    cells = fields.shape[1]
+    if cells < 4:
+        raise ValueError(f"{cells} cells along x cannot hold a mode")
+    return mode_amplitudes(fields, min(modes, (cells - 1) // 2)) ** 2
 
 
 def last_cycle_views(cycle, phase, fields):
