@@ -9,7 +9,7 @@ from estimator_coverage import coverage
 
 from granular_shaker.patterns import growth
 from granular_shaker.patterns import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
-                                      fit_growth_rate, fit_zero_crossing)
+                                      fit_growth_rate, fit_zero_crossing, growth_bands)
 
 CYCLES = np.arange(40.0)
 RATE, START = 0.15, 1e-4
@@ -84,6 +84,55 @@ def test_the_onset_error_covers_the_truth():
     assert 0.6 <= one <= 0.8
     assert 0.9 <= two <= 1.0
     assert all(f.points == 4 for f in fits)
+
+
+def test_the_upper_edge_error_of_a_band_covers_the_truth():
+    # A tent: the rate rises through 2.72 at 0.5 per unit Gamma, peaks at 3.42 and falls
+    # through 3.86 at 0.8; the upper edge's two points (3.8, 3.9) lie on the falling side.
+    gamma = np.round(np.arange(2.4, 4.21, 0.1), 10)
+    truth = np.minimum(DRATE * (gamma - ONSET), -0.8 * (gamma - 3.86))
+    uppers = []
+    for seed in range(REALISATIONS):
+        rates = [fit_growth_rate(CYCLES, scattered(growing(r), 0.05, seed * 100 + i))
+                 for i, r in enumerate(truth)]
+        (band,) = growth_bands(gamma, [f.rate for f in rates], [f.rate_error for f in rates])
+        uppers.append(band.upper)
+    deviation, error, one, two = coverage([u.gamma_c for u in uppers],
+                                          [u.gamma_c_error for u in uppers], 3.86)
+    assert abs(deviation.mean()) < 0.2 * error.mean()
+    assert 0.6 <= one <= 0.8
+    assert 0.9 <= two <= 1.0
+    assert all(u.points == 2 for u in uppers)
+
+
+def test_every_band_of_growth_is_found_and_the_onset_is_the_edge_of_the_one_asked_for():
+    # Short modes grow at the bottom of the sweep (a band reaching its lowest Gamma), decay
+    # over 2.2 to 3.0, the stripes grow over 3.2 to 3.8, decay at 4.2, grow again at 4.6.
+    gamma = np.array([1.8, 2.0, 2.2, 2.6, 2.8, 3.0, 3.2, 3.4, 3.8, 4.2, 4.6])
+    rate = np.array([0.04, 0.01, -0.18, -0.06, -0.03, -0.01, 0.03, 0.06, 0.09, -0.08, 0.2])
+    error = np.full(gamma.size, 0.005)
+    bands = growth_bands(gamma, rate, error)
+    assert [(b.first_gamma, b.last_gamma) for b in bands] == [(1.8, 2.0), (3.2, 3.8),
+                                                              (4.6, 4.6)]
+    assert bands[0].lower is None and bands[2].upper is None
+    # the upper edge of the lowest band: the line from (2.0, 0.01) to (2.2, -0.18)
+    assert bands[0].upper.gamma_c == pytest.approx(2.0 + 0.2 * 0.01 / 0.19, rel=1e-9)
+    # the stripes' lower edge: the line through 2.8, 3.0, 3.2, 3.4
+    slope, intercept = np.polyfit(gamma[4:8], rate[4:8], 1)
+    assert bands[1].lower.gamma_c == pytest.approx(-intercept / slope, rel=1e-9)
+    assert bands[1].lower.points == 4
+    # the top band's lower edge takes its neighbours below from the gap since the stripes'
+    # band only: (4.2, -0.08) and (4.6, 0.2)
+    assert bands[2].lower.points == 2
+    assert bands[2].lower.gamma_c == pytest.approx(4.2 + 0.4 * 0.08 / 0.28, rel=1e-9)
+    stripes = fit_zero_crossing(gamma, rate, error, holding=3.4)
+    assert stripes == bands[1].lower
+    assert fit_zero_crossing(gamma, rate, error) == bands[1].lower  # the lowest with an edge
+    assert fit_zero_crossing(gamma, rate, error, holding=4.6).gamma_c == bands[2].lower.gamma_c
+    with pytest.raises(NoGrowthFit, match="reaches the sweep's lowest Gamma 1.8"):
+        fit_zero_crossing(gamma, rate, error, holding=1.8)
+    with pytest.raises(NoGrowthFit, match="no band of growth holds Gamma 4.2"):
+        fit_zero_crossing(gamma, rate, error, holding=4.2)
 
 
 def test_a_rate_within_its_errors_of_zero_does_not_place_the_onset():

@@ -70,6 +70,17 @@ class ZeroCrossing:
     points: int
 
 
+@dataclass
+class GrowthBand:
+    """A range of Gamma over which the pattern grows: consecutive points with a positive rate,
+    at least one of them significantly. Its edges are where the rate crosses zero, None where
+    the band reaches the end of the sweep."""
+    first_gamma: float   # the band's lowest and highest points
+    last_gamma: float
+    lower: ZeroCrossing | None
+    upper: ZeroCrossing | None
+
+
 def fit_growth_rate(cycles, order, first_cycle=5.0, saturation_fraction=0.2, min_points=5,
                     floor=0.0):
     """The growth rate of ln(order) per cycle over the linear stage (module docstring), which
@@ -115,13 +126,7 @@ def _end_of_linear_stage(order, fraction):
     return int(np.argmax(beyond)) if spans else order.size
 
 
-def fit_zero_crossing(gamma, rate, rate_error, neighbours=2, significance=SIGNIFICANT_GROWTH):
-    """Gamma_c where the growth rate first changes sign from negative to positive: a weighted
-    straight line through the `neighbours` points below the change and up to `neighbours`
-    growing points from it. The change is at the first rate above zero by `significance` of
-    its standard errors, with a negative rate below it: a rate within its errors of zero does
-    not place the onset by its sign alone (it still enters the line as a neighbour). Raises
-    NoGrowthFit when the rates do not change sign so."""
+def _sorted_rates(gamma, rate, rate_error):
     gamma, rate, error = (np.asarray(a, float) for a in (gamma, rate, rate_error))
     if not (gamma.shape == rate.shape == error.shape) or gamma.ndim != 1:
         raise ValueError("one growth rate and one error per acceleration")
@@ -130,34 +135,78 @@ def fit_zero_crossing(gamma, rate, rate_error, neighbours=2, significance=SIGNIF
     if gamma.size == 0:
         raise NoGrowthFit("no growth rate measured (no finished run)")
     order = np.argsort(gamma)
-    gamma, rate, error = gamma[order], rate[order], error[order]
-    growing = np.flatnonzero(rate > significance * error)
-    if growing.size == 0 or not np.any(rate[:growing[0]] < 0):
-        raise NoGrowthFit("the growth rates do not change sign from negative to positive "
-                          f"(by {significance:g} standard errors) over Gamma {gamma[0]:.4g} to "
-                          f"{gamma[-1]:.4g}")
-    change = growing[0]
-    # Only the rising side of the first change of sign: a rate that falls below zero again
-    # further up (a band of instability) does not belong to this onset's line.
-    rising = change
-    while rising + 1 < min(change + neighbours, gamma.size) and rate[rising + 1] > 0:
-        rising += 1
-    chosen = slice(max(change - neighbours, 0), rising + 1)
-    g = gamma[chosen]
-    coefficients, covariance, chi2 = linear_fit([np.ones_like(g), g], rate[chosen],
-                                                error[chosen])
-    dof = g.size - 2
+    return gamma[order], rate[order], error[order]
+
+
+def _crossing(gamma, rate, error, rising):
+    """Where a weighted straight line through the points crosses zero; its slope must have the
+    edge's sign (rising: a lower edge)."""
+    coefficients, covariance, chi2 = linear_fit([np.ones_like(gamma), gamma], rate, error)
+    dof = gamma.size - 2
     chi2_per_dof = chi2 / dof if dof > 0 else float("nan")
     covariance = covariance * (max(1.0, chi2_per_dof) if dof > 0 else 1.0)
     intercept, slope = coefficients
-    if not slope > 0:
-        raise NoGrowthFit(f"the growth rate does not rise with Gamma near the change of sign "
-                          f"(slope {slope:.3g})")
-    gamma_c = -intercept / slope
+    if not (slope > 0 if rising else slope < 0):
+        raise NoGrowthFit(f"the growth rate does not {'rise' if rising else 'fall'} with Gamma "
+                          f"near the change of sign (slope {slope:.3g})")
     gradient = np.array([-1.0 / slope, intercept / slope ** 2])
-    gamma_c_error = float(np.sqrt(gradient @ covariance @ gradient))
-    return ZeroCrossing(float(gamma_c), gamma_c_error, float(slope),
-                        float(np.sqrt(covariance[1, 1])), chi2_per_dof, int(g.size))
+    return ZeroCrossing(float(-intercept / slope), float(np.sqrt(gradient @ covariance @ gradient)),
+                        float(slope), float(np.sqrt(covariance[1, 1])), chi2_per_dof,
+                        int(gamma.size))
+
+
+def growth_bands(gamma, rate, rate_error, neighbours=2, significance=SIGNIFICANT_GROWTH):
+    """Every band of growth over the sweep (GrowthBand), lowest first. The lower edge is fitted
+    by a straight line through up to `neighbours` points on each side of the change of sign,
+    those below it from the gap since the previous band only (a rate within its errors of zero
+    enters the line as a neighbour, but does not make a band by itself). The upper edge is the
+    line through the two points around it: the rate peaks inside the band, so that a line
+    through more of its points bends away from the change of sign."""
+    gamma, rate, error = _sorted_rates(gamma, rate, rate_error)
+    runs, start = [], None
+    for i, positive in enumerate(np.append(rate > 0, False)):
+        if positive and start is None:
+            start = i
+        elif not positive and start is not None:
+            if np.any(rate[start:i] > significance * error[start:i]):
+                runs.append((start, i - 1))
+            start = None
+    bands = []
+    for k, (first, last) in enumerate(runs):
+        gap_below = runs[k - 1][1] + 1 if k else 0
+        lower = upper = None
+        if first > 0:
+            lower = slice(max(first - neighbours, gap_below), min(first + neighbours, last + 1))
+            lower = _crossing(gamma[lower], rate[lower], error[lower], rising=True)
+        if last < gamma.size - 1:
+            upper = slice(last, last + 2)
+            upper = _crossing(gamma[upper], rate[upper], error[upper], rising=False)
+        bands.append(GrowthBand(float(gamma[first]), float(gamma[last]), lower, upper))
+    return bands
+
+
+def fit_zero_crossing(gamma, rate, rate_error, neighbours=2, significance=SIGNIFICANT_GROWTH,
+                      holding=None):
+    """Gamma_c: the lower edge of the band of growth holding the acceleration `holding` (the
+    saturated pattern's), or without it of the lowest band that has one (growth_bands). The
+    change of sign needs a rate above zero by `significance` of its standard errors. Raises
+    NoGrowthFit when the rates do not change sign so."""
+    gamma, rate, error = _sorted_rates(gamma, rate, rate_error)
+    bands = growth_bands(gamma, rate, error, neighbours, significance)
+    if holding is not None:
+        band = next((b for b in bands if b.first_gamma <= holding <= b.last_gamma), None)
+        if band is None:
+            raise NoGrowthFit(f"no band of growth holds Gamma {holding:g}")
+        if band.lower is None:
+            raise NoGrowthFit(f"the band of growth holding Gamma {holding:g} reaches the "
+                              f"sweep's lowest Gamma {gamma[0]:.4g}")
+        return band.lower
+    edges = [b.lower for b in bands if b.lower is not None]
+    if not edges:
+        raise NoGrowthFit("the growth rates do not change sign from negative to positive "
+                          f"(by {significance:g} standard errors) over Gamma {gamma[0]:.4g} to "
+                          f"{gamma[-1]:.4g}")
+    return edges[0]
 
 
 def column_mass_modes(fields_path, modes=12):

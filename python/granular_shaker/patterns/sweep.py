@@ -44,7 +44,7 @@ import time
 import numpy as np
 
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
-                                             fit_zero_crossing)
+                                             fit_zero_crossing, growth_bands)
 from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg, rising_branch
 from granular_shaker.patterns.views import run_view
 from granular_shaker.reports.report_common import read_shaker_csv
@@ -265,14 +265,22 @@ def growth_summary(run_path):
                 mode_rates={str(m): rate for m, rate in rates.items()})
 
 
-def growth_fits(points):
-    """The continuum's onset: where its growth rate changes sign."""
+def growth_fits(points, holding=None):
+    """The continuum's bands of growth and its onset: the lower edge of the band holding the
+    acceleration `holding` (the saturated stripes'), else of the lowest band that has one."""
+    rates = ([p["gamma"] for p in points], [p["rate"] for p in points],
+             [p["rate_error"] for p in points])
     try:
-        crossing = fit_zero_crossing([p["gamma"] for p in points], [p["rate"] for p in points],
-                                     [p["rate_error"] for p in points])
-        return dict(onset=vars(crossing))
+        bands = growth_bands(*rates)
     except (NoGrowthFit, ValueError) as reason:
-        return dict(onset=dict(reason=str(reason)))
+        return dict(onset=dict(reason=str(reason)), bands=[])
+    try:
+        onset = vars(fit_zero_crossing(*rates, holding=holding))
+    except NoGrowthFit as reason:
+        onset = dict(reason=str(reason))
+    return dict(onset=onset, bands=[dict(first_gamma=b.first_gamma, last_gamma=b.last_gamma,
+                                         lower=b.lower and vars(b.lower),
+                                         upper=b.upper and vars(b.upper)) for b in bands])
 
 
 def case_points(plan, case, kind="sweep"):
@@ -332,9 +340,10 @@ def collect(shaker, plan):
     for case in dict.fromkeys(r["case"] for r in plan):
         solver = next(r["solver"] for r in plan if r["case"] == case)
         points = case_points(plan, case)
-        found = growth_fits(points) if solver == "continuum" else fits(points)
-        cases[case] = dict(solver=solver, points=points, **found)
         saturated = case_points(plan, case, "saturation")
+        holding = min((p["gamma"] for p in saturated), default=None)
+        found = growth_fits(points, holding) if solver == "continuum" else fits(points)
+        cases[case] = dict(solver=solver, points=points, **found)
         if saturated:
             cases[case]["saturation"] = saturated
         grid = grid_points(plan, case)

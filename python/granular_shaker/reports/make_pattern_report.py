@@ -70,23 +70,32 @@ def figure_order_parameter(cases):
 
 
 def figure_growth_rate(cases):
-    """The continuum's growth rate of its fastest pattern mode against Gamma, with the onset
-    where it changes sign."""
+    """The continuum's growth rate of its fastest pattern mode against Gamma, one panel per
+    case (their rates differ by a decade), with its bands of growth (from their edges, or
+    their outermost points where a band reaches the sweep's end) and the onset."""
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for name, case in cases.items():
+    fig, axes = plt.subplots(len(cases), 1, sharex=True, squeeze=False,
+                             figsize=(6.4, 1.2 + 2.2 * len(cases)))
+    for ax, (name, case) in zip(axes[:, 0], cases.items()):
         points = case["points"]
         drawn = ax.errorbar([p["gamma"] for p in points], [p["rate"] for p in points],
                             yerr=[p["rate_error"] for p in points],
-                            label=f"continuum {name}: fastest pattern mode (± standard error)",
+                            label="continuum: fastest pattern mode (± standard error)",
                             **{**rc.CONTINUUM_STYLE, "marker": "s", "ms": 3})
+        colour = drawn[0].get_color()
         onset = case.get("onset", {})
+        ax.set_title(name + (f": Gamma_c = {onset['gamma_c']:.3f}" if "gamma_c" in onset
+                             else ": no onset"), fontsize=9)
         if "gamma_c" in onset:
-            ax.axvline(onset["gamma_c"], color=drawn[0].get_color(), lw=1, ls="--",
-                       label=f"{name}: Gamma_c = {onset['gamma_c']:.3f}")
-    ax.axhline(0.0, color="0.5", lw=0.8, label="no growth")
-    ax.set_xlabel("plate acceleration Gamma [g]")
-    ax.set_ylabel("growth rate [1/cycle]")
+            ax.axvline(onset["gamma_c"], color=colour, lw=1, ls="--", label="onset Gamma_c")
+        for band in case.get("bands", []):
+            edges = [band[side]["gamma_c"] if band[side] else point
+                     for side, point in (("lower", band["first_gamma"]),
+                                         ("upper", band["last_gamma"]))]
+            ax.axvspan(*edges, color=colour, alpha=0.1, lw=0, label="bands of growth")
+        ax.axhline(0.0, color="0.5", lw=0.8, label="no growth")
+        ax.set_ylabel("growth rate [1/cycle]")
+    axes[-1, 0].set_xlabel("plate acceleration Gamma [g]")
     rc.legend_above(fig, columns=1)
     return fig
 
@@ -227,6 +236,14 @@ def ratio_with_error(a, b):
     return x / y, x / y * np.hypot(dx / x, dy / y)
 
 
+def band_top(case):
+    """The upper edge of the continuum's band of growth that starts at its onset (infinity when
+    the band reaches the sweep's end)."""
+    onset = onset_of(case)[0]
+    band = next(b for b in case["bands"] if b["lower"] and b["lower"]["gamma_c"] == onset)
+    return band["upper"]["gamma_c"] if band["upper"] else np.inf
+
+
 def first_growing_point(case):
     """The continuum's first point above its onset (its fastest mode is the pattern's)."""
     onset = onset_of(case)
@@ -241,17 +258,18 @@ def continuum_part(claim, continuum, parameters, dispersion):
         return None
     if claim["id"] == "P1":
         # In a box a few cells deep every mode along x is a stripe: the planform follows from
-        # the geometry, so the part judged is growth above the onset and decay below it; a
-        # point goes against it when its rate has the wrong sign beyond its errors (the test
-        # of significance that places the onset).
+        # the geometry, so the part judged is growth from the onset to the top of its band
+        # and decay below the onset; a point goes against it when its rate has the wrong sign
+        # beyond its errors (the test of significance that places the onset).
         contrary = {n: [p["gamma"] for p in c["points"]
                         if abs(p["rate"]) > SIGNIFICANT_GROWTH * p["rate_error"]
-                        and (p["rate"] > 0) != (p["gamma"] > onset_of(c)[0])]
+                        and (p["rate"] > 0) != (onset_of(c)[0] < p["gamma"] < band_top(c))]
                     for n, c in measured.items()}
-        return ("; ".join(f"{n}: growth from Gamma_c {rc.fmt(onset_of(c)[0])}" + (
-            "; against it at Gamma " + ", ".join(f"{g:g}" for g in contrary[n])
-            if contrary[n] else "") for n, c in measured.items()),
-                "fail" if any(contrary.values()) else "pass")
+        described = [f"{n}: growth from Gamma_c {rc.fmt(onset_of(c)[0])}"
+                     + (f" to {rc.fmt(band_top(c))}" if np.isfinite(band_top(c)) else "")
+                     + ("; against it at Gamma " + ", ".join(f"{g:g}" for g in contrary[n])
+                        if contrary[n] else "") for n, c in measured.items()]
+        return "; ".join(described), "fail" if any(contrary.values()) else "pass"
     first = {n: first_growing_point(c) for n, c in measured.items()}
     if claim["id"] == "P3" and len(first) == 2 and None not in first.values():
         low, high = sorted(first, key=lambda n: parameters[n][0])
@@ -351,11 +369,14 @@ def md_against_continuum(claim, md, continuum):
                                         onset_continuum)
     elif claim["id"] == "P6":
         # Each solver below its own onset: the MD's noise at its highest Gamma below its onset,
-        # the continuum's last frame at its Gamma nearest to that below its own onset.
+        # the continuum's last frame at its Gamma nearest to that below its own onset and
+        # outside its bands of growth (where it decays, or stays within its errors of flat).
         onset_md = md_onset(case_md)
         below_md = [p for p in (case_md or {}).get("points", [])
                     if onset_md is not None and p["gamma"] < onset_md[0]]
-        below = [p for p in case_continuum["points"] if p["gamma"] < onset_continuum[0]]
+        below = [p for p in case_continuum["points"] if p["gamma"] < onset_continuum[0]
+                 and not any(b["first_gamma"] <= p["gamma"] <= b["last_gamma"]
+                             for b in case_continuum.get("bands", []))]
         if not below_md or not below:
             return None, "no point below its onset in one of the solvers' sweeps"
         mine = max(below_md, key=lambda p: p["gamma"])
@@ -587,6 +608,15 @@ def figure_wavelength(cases, parameters, dispersion):
     return fig
 
 
+def band_text(band):
+    """One band of growth in words: its points and its edges (where the rate crosses zero)."""
+    def edge(crossing, beyond):
+        return (f"{crossing['gamma_c']:.4g} ± {crossing['gamma_c_error']:.2g}" if crossing
+                else f"{beyond} the sweep")
+    return (f"band of growth, points Gamma {band['first_gamma']:g} to {band['last_gamma']:g}: "
+            f"from {edge(band['lower'], 'below')} to {edge(band['upper'], 'beyond')}")
+
+
 def continuum_case_lines(name, case):
     lines = [f"### {name} (continuum)", "", "| Gamma [g] | growth rate [1/cycle] | fastest pattern "
              "mode m | its wavelength [sigma] | cycles fitted | order parameter, last frame "
@@ -595,14 +625,18 @@ def continuum_case_lines(name, case):
         lines.append(f"| {p['gamma']:g} | {rc.fmt(p['rate'])} ± {rc.fmt(p['rate_error'], 2)} | "
                      f"{p['mode']} | {rc.fmt(p['mode_wavelength'])} | {p['fit_cycles'][0]:g} to "
                      f"{p['fit_cycles'][1]:g} | {rc.fmt(p['final_order'])} |")
+    lines += [""] + [f"- {band_text(b)}" for b in case.get("bands", [])]
     onset = case.get("onset", {})
+    saturated = [p["gamma"] for p in case.get("saturation", [])]
+    which = (f"the lower edge of the band holding Gamma {min(saturated):g}, where the stripes "
+             "saturate" if saturated else "the lower edge of the lowest band that has one")
     if "gamma_c" in onset:
-        lines += ["", f"- onset (growth rate zero): Gamma_c = {onset['gamma_c']:.4f} ± "
+        lines += [f"- onset ({which}): Gamma_c = {onset['gamma_c']:.4f} ± "
                   f"{onset['gamma_c_error']:.2g} (straight line through {onset['points']} points "
                   f"nearest the change of sign, chi^2 per degree of freedom "
                   f"{onset['chi2_per_dof']:.3g})"]
     else:
-        lines += ["", f"- onset: none: {onset.get('reason', 'not fitted')}"]
+        lines += [f"- onset: none: {onset.get('reason', 'not fitted')}"]
     grid = sorted(case.get("grid", []), key=lambda p: (p["gamma"], -p["cell"]))
     if grid:
         lines += ["", "Grid check (the same run at each cell, the box 4 cells deep):", "",

@@ -229,9 +229,12 @@ def synthetic_continuum(onset, mode_wavelength=21.3333, slope=0.5):
                            final_order=1e-6 if gamma < onset else 0.1, order=0.1,
                            order_error=0.01, seeds=1, wavelength=21.3, a2=1.0, a4=1.0, a6=1.0,
                            correlation_previous_cycle=-1.0))
-    return dict(solver="continuum", points=points,
-                onset=dict(gamma_c=onset, gamma_c_error=0.02, slope=slope, slope_error=0.01,
-                           chi2_per_dof=1.0, points=4))
+    edge = dict(gamma_c=onset, gamma_c_error=0.02, slope=slope, slope_error=0.01,
+                chi2_per_dof=1.0, points=4)
+    growing = [p["gamma"] for p in points if p["gamma"] > onset]
+    return dict(solver="continuum", points=points, onset=edge,
+                bands=[dict(first_gamma=growing[0], last_gamma=growing[-1], lower=edge,
+                            upper=None)] if growing else [])
 
 
 def test_the_continuum_parts_and_the_comparisons_are_judged():
@@ -304,6 +307,28 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
         claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
                         "pattern_md_f0p18": (0.18, 5.0)}, relation)}
     assert rows["P1"]["verdict"] == "pass" and "against it" not in rows["P1"]["value"]
+    # growth below the onset, in a band of its own, goes against P1 (Gamma 2.0 grows) ...
+    banded = synthetic_continuum(2.3)
+    banded["points"][0]["rate"] = 0.05
+    banded["bands"].insert(0, dict(first_gamma=2.0, last_gamma=2.0, lower=None,
+                                   upper=dict(gamma_c=2.1)))
+    # ... where a decay above the top of the onset's band does not (Gamma 3.0 decays)
+    banded["points"][-1]["rate"] = -0.05
+    banded["bands"][1].update(last_gamma=2.8, upper=dict(gamma_c=2.9))
+    cases["pattern_continuum_f0p18"] = banded
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P1"]["verdict"] == "fail"
+    assert "growth from Gamma_c 2.3 to 2.9; against it at Gamma 2 " in rows["P1"]["value"] + " "
+    # P6 compares the MD's noise with the continuum where it does not grow: at 2.2, not 2.0
+    assert "continuum's last frame 1e-06 at Gamma 2.2" in rows["P6"]["value"]
+    banded["points"][1]["rate"] = 0.05  # the low band now holds every point below the onset
+    banded["bands"][0].update(last_gamma=2.2, upper=dict(gamma_c=2.25))
+    rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
+        claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
+                        "pattern_md_f0p18": (0.18, 5.0)}, relation)}
+    assert rows["P6"]["verdict"] == "not measured"
 
 
 def test_a_report_with_the_continuum_shows_its_growth_rates(work_dir):
@@ -320,7 +345,9 @@ def test_a_report_with_the_continuum_shows_its_growth_rates(work_dir):
     assert text.startswith("# Onset of patterns: MD and continuum sweeps")
     assert "### pattern_continuum_f0p18 (continuum)" in text
     assert "| 2.4 | 0.05 ± 0.01 | 6 | 21.33 | 5 to 39 | 0.1 |" in text
-    assert "- onset (growth rate zero): Gamma_c = 2.3000 ± 0.02" in text
+    assert "- band of growth, points Gamma 2.4 to 3: from 2.3 ± 0.02 to beyond the sweep" in text
+    assert ("- onset (the lower edge of the lowest band that has one): Gamma_c = 2.3000 ± 0.02"
+            in text)
     assert os.path.exists(os.path.join(work_dir, make_pattern_report.FIGURES,
                                        "growth_rate.png"))
 
