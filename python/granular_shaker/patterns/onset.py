@@ -30,6 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 
 PROFILE_POINTS = 4001
+# A point shows an ordered standing wave when its spectrum's angular moments name stripes (A2,
+# docs/analysis.md "Patterns": the symmetry threshold) and its pattern inverts from one cycle to
+# the next (the subharmonic response).
+STRIPES_A2 = 0.5
+SUBHARMONIC_CORRELATION = -0.5
 
 
 class NoOnset(ValueError):
@@ -179,3 +184,25 @@ def rising_branch(points):
         return points
     top = int(np.argmax([p["order"] for p in points]))
     return points[:top + 1]
+
+
+def ordered(point):
+    """A point without a symmetry measurement (a figure's bare points) is not ordered."""
+    return (point.get("a2", 0.0) >= STRIPES_A2
+            and point.get("correlation_previous_cycle", 0.0) <= SUBHARMONIC_CORRELATION)
+
+
+def order_bracket(case):
+    """The onset of ordered standing waves bracketed by the sweep: (midpoint, its standard
+    error as a uniform distribution over the bracket, last disordered Gamma, first ordered
+    Gamma), when on the rising branch of the order parameter (the points the onset fit uses)
+    every point above some Gamma is ordered and none below it; else None."""
+    points = rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))
+    flags = [ordered(p) for p in points]
+    if True not in flags or False not in flags:
+        return None
+    first = flags.index(True)
+    if first == 0 or not all(flags[first:]):
+        return None
+    low, high = points[first - 1]["gamma"], points[first]["gamma"]
+    return 0.5 * (low + high), (high - low) / np.sqrt(12.0), low, high

@@ -45,7 +45,8 @@ import numpy as np
 
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                              fit_zero_crossing, growth_bands)
-from granular_shaker.patterns.onset import NoOnset, fit_onset, fit_swift_hohenberg, rising_branch
+from granular_shaker.patterns.onset import (NoOnset, fit_onset, fit_swift_hohenberg, order_bracket,
+                                            rising_branch)
 from granular_shaker.patterns.views import run_view
 from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
@@ -230,7 +231,9 @@ def point_summary(runs):
 
 def fits(points):
     """The onset and Swift-Hohenberg fits of one case's points (the onset on the rising
-    branch), or the reason there are none."""
+    branch), or the reason there are none. The Swift-Hohenberg fit takes the points below the
+    fitted onset (less its error), or where the onset fit cannot place it, those below the
+    sweep's bracket of ordered points (order_bracket)."""
     rising = rising_branch(points)
     usable = [p for p in rising if np.isfinite(p["order_error"]) and p["order_error"] > 0]
     if 0 < len(rising) < 5 <= len(points):
@@ -244,11 +247,14 @@ def fits(points):
     try:
         onset = fit_onset(gamma, order, error)
         out["onset"] = vars(onset)
+        below = onset.gamma_c - onset.gamma_c_error
     except (NoOnset, ValueError) as reason:
         out["onset"] = dict(reason=str(reason))
-        return out
+        bracket = order_bracket(dict(points=points))
+        if bracket is None:
+            return out
+        below = bracket[3]
     try:
-        below = onset.gamma_c - onset.gamma_c_error
         out["swift_hohenberg"] = vars(fit_swift_hohenberg(gamma, order, error, below))
     except (NoOnset, ValueError) as reason:
         out["swift_hohenberg"] = dict(reason=str(reason))

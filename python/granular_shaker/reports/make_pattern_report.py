@@ -15,24 +15,12 @@ import tomllib
 import numpy as np
 
 from granular_shaker.patterns.growth import SIGNIFICANT_GROWTH
-from granular_shaker.patterns.onset import rising_branch
+from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, order_bracket,
+                                            ordered, rising_branch)
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
 CLAIMS = os.path.join("reference-data", "pattern-claims.toml")
-# A point shows an ordered standing wave when its spectrum's angular moments name stripes (A2,
-# docs/analysis.md "Patterns": the symmetry threshold) and its pattern inverts from one cycle to
-# the next (the subharmonic response).
-STRIPES_A2 = 0.5
-SUBHARMONIC_CORRELATION = -0.5
-
-
-def ordered(point):
-    """A point without a symmetry measurement (a figure's bare points) is not ordered."""
-    return (point.get("a2", 0.0) >= STRIPES_A2
-            and point.get("correlation_previous_cycle", 0.0) <= SUBHARMONIC_CORRELATION)
-
-
 FIGURES = "patterns"  # beside the report
 
 
@@ -143,22 +131,6 @@ def stripe_wavelength(case):
 def onset_of(case, key="onset", parameter="gamma_c"):
     fit = (case or {}).get(key, {})
     return (fit[parameter], fit[parameter + "_error"]) if parameter in fit else None
-
-
-def order_bracket(case):
-    """The onset of ordered standing waves bracketed by the sweep: (midpoint, its standard
-    error as a uniform distribution over the bracket, last disordered Gamma, first ordered
-    Gamma), when on the rising branch of the order parameter (the points the onset fit uses)
-    every point above some Gamma is ordered and none below it; else None."""
-    points = rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))
-    flags = [ordered(p) for p in points]
-    if True not in flags or False not in flags:
-        return None
-    first = flags.index(True)
-    if first == 0 or not all(flags[first:]):
-        return None
-    low, high = points[first - 1]["gamma"], points[first]["gamma"]
-    return 0.5 * (low + high), (high - low) / np.sqrt(12.0), low, high
 
 
 def md_onset(case):
@@ -689,9 +661,12 @@ def case_lines(name, case):
         if fit is None:
             continue
         if parameter in fit:
+            strength = (f", noise power strength = {fit['strength']:.3g} ± "
+                        f"{fit['strength_error']:.2g} [1/sigma^4]" if key == "swift_hohenberg"
+                        else "")
             lines.append(f"- {model}: {parameter} = {fit[parameter]:.4f} ± "
-                         f"{fit[parameter + '_error']:.2g} (chi^2 per degree of freedom "
-                         f"{fit['chi2_per_dof']:.3g}, {fit['points']} points)")
+                         f"{fit[parameter + '_error']:.2g}{strength} (chi^2 per degree of "
+                         f"freedom {fit['chi2_per_dof']:.3g}, {fit['points']} points)")
         else:
             lines.append(f"- {model}: none: {fit['reason']}")
     bracket = order_bracket(case)

@@ -9,6 +9,7 @@ import tomllib
 import numpy as np
 import pytest
 
+from granular_shaker.patterns import onset as pattern_onset
 from granular_shaker.patterns import sweep
 from granular_shaker.reports import make_pattern_report
 
@@ -404,23 +405,23 @@ def test_a_continuum_at_a_coarser_cell_says_so_beside_its_verdicts():
 def test_without_an_onset_fit_the_md_onset_is_the_bracket_of_ordered_points():
     case = synthetic_case(21.3, 2.5)  # ordered at 2.6, 2.8, 3.0; disordered at 2.4 and below
     case["onset"] = dict(reason="the best onset is at the end of the sweep")
-    middle, error, low, high = make_pattern_report.order_bracket(case)
+    middle, error, low, high = pattern_onset.order_bracket(case)
     assert (low, high) == (2.4, 2.6)
     assert middle == pytest.approx(2.5) and error == pytest.approx(0.2 / np.sqrt(12.0))
     assert make_pattern_report.md_onset(case) == (middle, error)
     assert make_pattern_report.stripes_above_onset_only(case) is True
     mixed = synthetic_case(21.3, 2.5, ordered_below=True)  # ordered at 2.0 too: no bracket
     mixed["onset"] = {}
-    assert make_pattern_report.order_bracket(mixed) is None
+    assert pattern_onset.order_bracket(mixed) is None
     # Past the order parameter's peak (2.8) the stripes may lose their order (3.0, the
     # measured sweep at f = 0.18 and Gamma 3.4): the bracket and P1 use the rising branch.
     for point in case["points"]:
         point["order"] = {2.6: 1.5, 2.8: 2.0, 3.0: 1.2}.get(point["gamma"], point["order"])
     case["points"][-1]["correlation_previous_cycle"] = -0.3
-    assert make_pattern_report.order_bracket(case)[2:] == (2.4, 2.6)
+    assert pattern_onset.order_bracket(case)[2:] == (2.4, 2.6)
     assert make_pattern_report.stripes_above_onset_only(case) is True
     case["points"][-1]["order"] = 2.5   # a disordered point on the rising branch: no bracket
-    assert make_pattern_report.order_bracket(case) is None
+    assert pattern_onset.order_bracket(case) is None
 
 
 def test_a_saturation_table_is_checked_and_planned():
@@ -519,3 +520,34 @@ def test_a_grid_or_saturation_table_may_name_some_of_the_continuums_cases(work_d
             "cells = [2.0, 1.0, 0.8]", 'cases = ["pattern_md_f0p18"]\ncells = [2.0, 1.0, 0.8]'))
     with pytest.raises(ValueError, match=r"continuum.grid\]: cases \['pattern_md_f0p18'\]"):
         sweep.load_sweep(repository, "wrong")
+
+
+def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the_bracket(
+        monkeypatch):
+    # Noise below the onset of order in the Swift-Hohenberg form towards Gamma_mf = 2.3, then
+    # ordered stripes from 2.2 whose amplitude the supercritical form cannot place.
+    gamma_mf, floor, strength = 2.3, 0.01, 0.05
+    noise = [np.sqrt(floor + strength / np.sqrt((gamma_mf - g) / gamma_mf))
+             for g in (1.8, 1.9, 2.0, 2.1)]
+    points = [dict(gamma=g, order=float(m), a2=1.0, correlation_previous_cycle=0.0)
+              for g, m in zip((1.8, 1.9, 2.0, 2.1), noise)]
+    points += [dict(gamma=g, order=1.5 + 0.1 * (g - 2.2), a2=1.0,
+                    correlation_previous_cycle=-0.8) for g in (2.2, 2.4, 2.6, 2.8)]
+    for point in points:
+        point.update(order_error=1e-3 * point["order"], seeds=1, wavelength=21.3)
+
+    def no_onset(*args):
+        raise sweep.NoOnset("the best onset is at the end of the sweep")
+    monkeypatch.setattr(sweep, "fit_onset", no_onset)
+    found = sweep.fits(points)
+    assert "reason" in found["onset"]
+    fit = found["swift_hohenberg"]
+    assert fit["points"] == 4  # 1.8 to 2.1: below the bracket's first ordered point, 2.2
+    assert fit["gamma_mf"] == pytest.approx(gamma_mf, abs=2e-3)
+    assert fit["strength"] == pytest.approx(strength, rel=0.02)
+    lines = make_pattern_report.case_lines("pattern_md_f0p18", dict(points=points, **found))
+    assert any(line.startswith("- Swift-Hohenberg fit below onset: gamma_mf = 2.30")
+               and "noise power strength = 0.05" in line for line in lines)
+    for point in points[:4]:  # one of them ordered: no bracket, no Swift-Hohenberg fit
+        point["correlation_previous_cycle"] = -0.8 if point["gamma"] == 1.9 else 0.0
+    assert "swift_hohenberg" not in sweep.fits(points)
