@@ -8,6 +8,7 @@ import synthetic_files as synthetic
 from estimator_coverage import coverage
 
 from granular_shaker.patterns import growth
+from granular_shaker.patterns.views import column_mass_frames
 from granular_shaker.patterns import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                       fit_growth_rate, fit_zero_crossing, growth_bands)
 
@@ -175,7 +176,7 @@ def test_the_modes_of_a_fields_file_and_the_fastest_pattern_mode(tmp_path):
     frames = [(c, p) for c in range(30) for p in (0.0, 0.5)]
     frames = [(c, 0.9999999999 if p == 0.0 and c % 3 else p) for c, p in frames]
     synthetic.write_pattern_fields(tmp_path / "run.fields.h5", frames)
-    cycles, phases, amplitudes, length = column_mass_modes(tmp_path / "run.fields.h5")
+    cycles, phases, amplitudes, length = column_mass_modes(column_mass_frames(tmp_path / "run.h5"))
     assert length == 128.0
     assert sorted(set(phases)) == [0.0, 0.5]
     assert amplitudes[0, 5] == pytest.approx(0.5e-4, rel=1e-9)  # |c_6| / c_0 of a cosine

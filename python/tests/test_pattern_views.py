@@ -66,7 +66,7 @@ def test_the_view_is_the_last_complete_cycle_and_the_spectrum_of_the_stronger_ph
     cycle, phase, fields, _ = column_mass_frames(tmp_path / "run.h5")
     last, views = last_cycle_views(cycle, phase, fields)
     assert last == 12.0 and sorted(views) == [0.0, 0.5]
-    view = run_view(tmp_path / "run.h5")
+    view = run_view(column_mass_frames(tmp_path / "run.h5"))
     assert view["cycle"] == 12.0 and view["spectrum_phase"] == 0.0 and view["frames"] == 4
     assert view["box"] == [LX, LY]
     relative = np.array(view["fields"]["0"])
@@ -82,7 +82,7 @@ def test_a_continuum_view_is_its_last_frame(tmp_path):
     synthetic.write_pattern_fields(tmp_path / "run.fields.h5", frames)
     cycle, phase, fields, box = column_mass_frames(tmp_path / "run.h5")
     assert box == (128.0, 8.0) and fields.shape == (20, 64, 4)
-    view = run_view(tmp_path / "run.h5", frames="last")
+    view = run_view((cycle, phase, fields, box), which="last")
     assert view["cycle"] == 9.0 and view["frames"] == 1
     growing = (0.5e-4 * np.exp(0.9)) ** 2
     assert view["power"][MODE - 1] == pytest.approx(growing, rel=1e-3)

@@ -16,7 +16,7 @@ cycle, crosses zero as Gamma rises.
   scatter about the line (the cycle-to-cycle modulation of a mode that is not purely
   subharmonic).
 - column_mass_modes and fastest_pattern_mode: the amplitude of each Fourier mode of the column
-  mass along the box's long side, from a continuum run's fields file, and the growth rate of
+  mass along the box's long side, from a continuum run's column mass, and the growth rate of
   the fastest-growing one. The pattern modes are m >= 2: mode 1, the box's own length, carries
   a slow sloshing of the whole layer (a period of several cycles, not a standing wave).
 - fit_zero_crossing: Gamma_c from a weighted straight line through the growth rates of the
@@ -30,9 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fields import read_fields
 from .onset import linear_fit
-from .views import mode_amplitudes, phase_of
+from .views import mode_amplitudes
 
 FIRST_PATTERN_MODE = 2
 # The modes of a run sit on a floor of the solver's when their typical amplitude over the last
@@ -209,19 +208,15 @@ def fit_zero_crossing(gamma, rate, rate_error, neighbours=2, significance=SIGNIF
     return edges[0]
 
 
-def column_mass_modes(fields_path, modes=12):
-    """From a continuum fields file (granular_shaker.read_fields): per snapshot its cycle and
-    phase, the amplitudes |c_m| / c_0 of the Fourier modes m = 1..modes of the column mass along
-    x (n summed over z, averaged over y), and the box's length along x [sigma]."""
-    fields = read_fields(fields_path, names=("n",))
-    snapshots, nx = fields.snapshots, fields.shape[0]
-    if "cycle" not in snapshots:
-        raise NoGrowthFit(f"{fields_path}: its snapshots carry no cycle")
-    if nx <= 2 * modes:
-        raise NoGrowthFit(f"{fields_path}: {nx} cells along x cannot hold {modes} modes")
-    columns = snapshots["n"].sum(axis=1).transpose(0, 2, 1)   # frame, x, y
-    return (snapshots["cycle"], phase_of(snapshots["phase"]), mode_amplitudes(columns, modes),
-            nx * fields.cell_size)
+def column_mass_modes(frames, modes=12):
+    """From a continuum run's column mass (views.column_mass_frames: cycle, phase, fields
+    [frame, x, y], box): per frame its cycle and phase, the amplitudes |c_m| / c_0 of the
+    Fourier modes m = 1..modes along x (averaged over y), and the box's length along x
+    [sigma]."""
+    cycle, phase, fields, (length, _) = frames
+    if fields.shape[1] <= 2 * modes:
+        raise NoGrowthFit(f"{fields.shape[1]} cells along x cannot hold {modes} modes")
+    return cycle, phase, mode_amplitudes(fields, modes), length
 
 
 def solver_floor(amplitudes):

@@ -47,7 +47,7 @@ from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fas
                                              fit_zero_crossing, growth_bands)
 from granular_shaker.patterns.onset import (NoOnset, fit_onset, fit_swift_hohenberg, order_bracket,
                                             rising_branch)
-from granular_shaker.patterns.views import run_view
+from granular_shaker.patterns.views import column_mass_frames, run_view
 from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
                                         repository_argument)
@@ -261,10 +261,10 @@ def fits(points):
     return out
 
 
-def growth_summary(run_path):
-    """The growth of a continuum run's fastest pattern mode, from its fields file."""
-    cycles, phases, amplitudes, length = column_mass_modes(
-        os.path.splitext(run_path)[0] + ".fields.h5")
+def growth_summary(frames):
+    """The growth of a continuum run's fastest pattern mode, from its column mass
+    (views.column_mass_frames)."""
+    cycles, phases, amplitudes, length = column_mass_modes(frames)
     mode, fit, rates = fastest_pattern_mode(cycles, phases, amplitudes)
     return dict(mode=mode, mode_wavelength=length / mode, rate=fit.rate,
                 rate_error=fit.rate_error, fit_cycles=[fit.first_cycle, fit.last_cycle],
@@ -329,20 +329,20 @@ def collect(shaker, plan):
             continue
         columns = read_shaker_csv(table)[0]
         run["summary"] = frame_summary(columns)
-        if run["solver"] == "continuum" and run.get("kind") != "saturation":
-            run["summary"]["final_order"] = float(columns[f"{FIELD}_order_parameter"][-1])
-            try:
-                run["growth"] = growth_summary(run["record"]["path"])
-            except (NoGrowthFit, OSError, KeyError) as error:
-                failures.append(f"{where}: no growth rate: {error}")
-                del run["summary"]
-                continue
+        # The continuum's growth runs grow or decay to their end: their last frame is the view.
+        growing = run["solver"] == "continuum" and run.get("kind") != "saturation"
         try:
-            # The continuum's runs grow or decay to their end: their last frame is the view.
-            growing = run["solver"] == "continuum" and run.get("kind") != "saturation"
-            run["view"] = run_view(run["record"]["path"], "last" if growing else "all")
-        except (OSError, KeyError, ValueError) as error:
-            failures.append(f"{where}: no top view or spectrum: {error}")
+            frames = column_mass_frames(run["record"]["path"])
+            if growing:
+                run["summary"]["final_order"] = float(columns[f"{FIELD}_order_parameter"][-1])
+                run["growth"] = growth_summary(frames)
+            run["view"] = run_view(frames, "last" if growing else "all")
+        except (NoGrowthFit, OSError, KeyError, ValueError) as error:
+            what = "no top view or spectrum" if "growth" in run or not growing else \
+                "no growth rate"
+            failures.append(f"{where}: {what}: {error}")
+            if what == "no growth rate":
+                del run["summary"]
     for case in dict.fromkeys(r["case"] for r in plan):
         solver = next(r["solver"] for r in plan if r["case"] == case)
         points = case_points(plan, case)

@@ -82,15 +82,15 @@ def spectrum_at(phase, power, which):
     return at.mean(axis=0), at.std(axis=0, ddof=1) / np.sqrt(len(at))
 
 
-def run_view(run_path, frames="all", cell=2.0):
-    """The view of one run for the results file: the last complete cycle's fields at its
-    phases (relative to their mean) and the spectrum at the phase of larger power, over the
-    frames `frames` ("all", or "last" for a run still growing, whose last frame is its
-    largest)."""
-    cycle, phase, fields, (lx, ly) = column_mass_frames(run_path, cell)
+def run_view(frames, which="all"):
+    """The view of one run for the results file, from its column mass (column_mass_frames):
+    the last complete cycle's fields at its phases (relative to their mean) and the spectrum
+    at the phase of larger power, over the frames `which` ("all", or "last" for a run still
+    growing, whose last frame is its largest)."""
+    cycle, phase, fields, (lx, ly) = frames
     last, views = last_cycle_views(cycle, phase, fields)
     power = mode_power(fields)
-    if frames == "last":
+    if which == "last":
         keep = cycle == last
         cycle, phase, power = cycle[keep], phase[keep], power[keep]
     best = max(np.unique(phase), key=lambda p: power[phase == p].sum(axis=1).mean())
