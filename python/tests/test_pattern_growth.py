@@ -213,3 +213,24 @@ def test_a_band_of_growth_gives_the_onset_of_its_rising_side():
     # the line through (3.0, -0.2), (3.4, -0.1), (3.8, 0.05) crosses zero near 3.69
     slope, intercept = np.polyfit(gamma[2:5], rate[2:5], 1)
     assert crossing.gamma_c == pytest.approx(-intercept / slope, rel=1e-9)
+
+
+def test_the_grid_scale_gain_is_the_growth_over_the_run_of_the_shortest_modes():
+    # 128 cells: modes 32 to 63 have 4 cells per wavelength or fewer, all seeded by a fixed
+    # background of 1e-6. Mode 6 grows six times faster than mode 40, which gains
+    # exp(0.05 * 29) over 30 cycles at phase 0.5 (at phase 0 it is smaller and decays).
+    cycles = np.repeat(np.arange(30.0), 2)
+    phases = np.tile([0.0, 0.5], 30)
+    x = (np.arange(128) + 0.5) / 128.0
+    background = 1e-6 * np.random.default_rng(3).standard_normal(128)
+    fields = []
+    for c, p in zip(cycles, phases):
+        short = 1e-3 * np.exp(0.05 * c) if p == 0.5 else 1e-4 * np.exp(-0.05 * c)
+        column = 1.0 + background + 1e-4 * np.exp(0.3 * c) * np.cos(2 * np.pi * 6 * x) \
+            + short * np.cos(2 * np.pi * 40 * x)
+        fields.append(np.repeat(column[:, None], 4, axis=1))
+    frames = (cycles, phases, np.array(fields), (128.0, 8.0))
+    # the background's share of mode 40 (about 1e-7 against 1e-3) sets the tolerance
+    assert growth.grid_scale_gain(frames) == pytest.approx(np.exp(0.05 * 29), rel=1e-3)
+    with pytest.raises(NoGrowthFit, match="no grid-scale mode"):
+        growth.grid_scale_gain((cycles, phases, np.array(fields)[:, :3, :], (3.0, 8.0)))

@@ -19,6 +19,9 @@ cycle, crosses zero as Gamma rises.
   mass along the box's long side, from a continuum run's column mass, and the growth rate of
   the fastest-growing one. The pattern modes are m >= 2: mode 1, the box's own length, carries
   a slow sloshing of the whole layer (a period of several cycles, not a standing wave).
+- grid_scale_gain: whether the growth reaches the grid scale, from the gain over the run of
+  the modes of a few cells per wavelength (a broadband growth that does is not a pattern the
+  cell resolves).
 - fit_zero_crossing: Gamma_c from a weighted straight line through the growth rates of the
   points nearest to the first change of sign from decay to growth (on its rising side only),
   its error from the line's covariance (delta method).
@@ -44,6 +47,9 @@ FLOOR_FRAMES = 10
 
 # A growth rate places the onset by its sign when it lies this many standard errors above 0.
 SIGNIFICANT_GROWTH = 2.0
+# Modes of this many cells per wavelength or fewer are at the grid scale, where the
+# discretisation rather than the equations sets their dynamics.
+GRID_SCALE_CELLS = 4
 
 
 class NoGrowthFit(ValueError):
@@ -217,6 +223,26 @@ def column_mass_modes(frames, modes=12):
     if fields.shape[1] <= 2 * modes:
         raise NoGrowthFit(f"{fields.shape[1]} cells along x cannot hold {modes} modes")
     return cycle, phase, mode_amplitudes(fields, modes), length
+
+
+def grid_scale_gain(frames):
+    """The largest factor by which a grid-scale mode of the column mass (GRID_SCALE_CELLS or
+    fewer cells per wavelength along x, below the Nyquist mode, present in the first frame)
+    grows from the first to the last frame, at the stored phase where those modes are larger.
+    Above 1 the growth reaches the grid scale: the pattern it feeds is not resolved by the
+    cell."""
+    cycle, phase, fields, _ = frames
+    nx = fields.shape[1]
+    first = -(-nx // GRID_SCALE_CELLS)
+    amplitudes = mode_amplitudes(fields, nx // 2 - 1)[:, first - 1:]
+    if amplitudes.shape[1] == 0:
+        raise NoGrowthFit(f"{nx} cells along x hold no grid-scale mode below the Nyquist mode")
+    best = max(np.unique(phase), key=lambda p: amplitudes[phase == p].mean())
+    at = amplitudes[phase == best]
+    seeded = at[0] > 0.0    # a mode absent at the start has no gain to measure
+    if not np.any(seeded):
+        raise NoGrowthFit("no grid-scale mode is present in the first frame")
+    return float(np.max(at[-1, seeded] / at[0, seeded]))
 
 
 def solver_floor(amplitudes):

@@ -44,7 +44,7 @@ import time
 import numpy as np
 
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
-                                             fit_zero_crossing, growth_bands)
+                                             fit_zero_crossing, grid_scale_gain, growth_bands)
 from granular_shaker.patterns.onset import (NoOnset, fit_onset, fit_swift_hohenberg, order_bracket,
                                             rising_branch)
 from granular_shaker.patterns.views import column_mass_frames, run_view
@@ -268,7 +268,8 @@ def growth_summary(frames):
     mode, fit, rates = fastest_pattern_mode(cycles, phases, amplitudes)
     return dict(mode=mode, mode_wavelength=length / mode, rate=fit.rate,
                 rate_error=fit.rate_error, fit_cycles=[fit.first_cycle, fit.last_cycle],
-                mode_rates={str(m): rate for m, rate in rates.items()})
+                mode_rates={str(m): rate for m, rate in rates.items()},
+                grid_scale_gain=grid_scale_gain(frames))
 
 
 def growth_fits(points, holding=None):

@@ -14,7 +14,7 @@ import tomllib
 
 import numpy as np
 
-from granular_shaker.patterns.growth import SIGNIFICANT_GROWTH
+from granular_shaker.patterns.growth import GRID_SCALE_CELLS, SIGNIFICANT_GROWTH
 from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, order_bracket,
                                             ordered, rising_branch)
 from granular_shaker.reports import report_common as rc
@@ -592,12 +592,19 @@ def band_text(band):
 def continuum_case_lines(name, case):
     lines = [f"### {name} (continuum)", "", "| Gamma [g] | growth rate [1/cycle] | fastest pattern "
              "mode m | its wavelength [sigma] | cycles fitted | order parameter, last frame "
-             "[1/sigma^2] |", "| --- | --- | --- | --- | --- | --- |"]
+             "[1/sigma^2] | grid-scale gain |", "| --- | --- | --- | --- | --- | --- | --- |"]
     for p in case["points"]:
         lines.append(f"| {p['gamma']:g} | {rc.fmt(p['rate'])} ± {rc.fmt(p['rate_error'], 2)} | "
                      f"{p['mode']} | {rc.fmt(p['mode_wavelength'])} | {p['fit_cycles'][0]:g} to "
-                     f"{p['fit_cycles'][1]:g} | {rc.fmt(p['final_order'])} |")
+                     f"{p['fit_cycles'][1]:g} | {rc.fmt(p['final_order'])} | "
+                     f"{rc.fmt(p['grid_scale_gain'], 3) if 'grid_scale_gain' in p else 'n/a'} |")
     lines += [""] + [f"- {band_text(b)}" for b in case.get("bands", [])]
+    unresolved = [p["gamma"] for p in case["points"] if p.get("grid_scale_gain", 0.0) > 1.0]
+    if unresolved:
+        lines.append(f"- growth reaches the grid scale (a mode of {GRID_SCALE_CELLS} cells or "
+                     "fewer per wavelength grows over the run: grid-scale gain above 1) at Gamma "
+                     + ", ".join(f"{g:g}" for g in unresolved) + ": the pattern there is not "
+                     "resolved by the cell")
     onset = case.get("onset", {})
     saturated = [p["gamma"] for p in case.get("saturation", [])]
     which = (f"the lower edge of the band holding Gamma {min(saturated):g}, where the stripes "
@@ -613,10 +620,12 @@ def continuum_case_lines(name, case):
     if grid:
         lines += ["", "Grid check (the same run at each cell, the box 4 cells deep):", "",
                   "| Gamma [g] | cell [sigma] | growth rate [1/cycle] | fastest pattern mode m "
-                  "| cycles fitted |", "| --- | --- | --- | --- | --- |"]
+                  "| cycles fitted | grid-scale gain |", "| --- | --- | --- | --- | --- | --- |"]
         lines += [f"| {p['gamma']:g} | {p['cell']:g} | {rc.fmt(p['rate'])} ± "
                   f"{rc.fmt(p['rate_error'], 2)} | {p['mode']} | {p['fit_cycles'][0]:g} to "
-                  f"{p['fit_cycles'][1]:g} |" for p in grid]
+                  f"{p['fit_cycles'][1]:g} | "
+                  f"{rc.fmt(p['grid_scale_gain'], 3) if 'grid_scale_gain' in p else 'n/a'} |"
+                  for p in grid]
         refined = len({p["cell"] for p in grid}) > 1
         verdicts = [f"- refinement reverses the growth at Gamma {g:g}: {rc.fmt(r, 3)} per cycle "
                     f"at the sweep's cell, {rc.fmt(fine, 3)} at cell {cell:g}"

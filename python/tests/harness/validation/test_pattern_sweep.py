@@ -228,6 +228,7 @@ def synthetic_continuum(onset, mode_wavelength=21.3333, slope=0.5):
         points.append(dict(gamma=gamma, rate=slope * (gamma - onset), rate_error=0.01, mode=6,
                            mode_wavelength=mode_wavelength, fit_cycles=[5, 39],
                            final_order=1e-6 if gamma < onset else 0.1, order=0.1,
+                           grid_scale_gain=30.0 if gamma == 3.0 else 0.01,
                            order_error=0.01, seeds=1, wavelength=21.3, a2=1.0, a4=1.0, a6=1.0,
                            correlation_previous_cycle=-1.0))
     edge = dict(gamma_c=onset, gamma_c_error=0.02, slope=slope, slope_error=0.01,
@@ -345,7 +346,9 @@ def test_a_report_with_the_continuum_shows_its_growth_rates(work_dir):
     text = open(output).read()
     assert text.startswith("# Onset of patterns: MD and continuum sweeps")
     assert "### pattern_continuum_f0p18 (continuum)" in text
-    assert "| 2.4 | 0.05 ± 0.01 | 6 | 21.33 | 5 to 39 | 0.1 |" in text
+    assert "| 2.4 | 0.05 ± 0.01 | 6 | 21.33 | 5 to 39 | 0.1 | 0.01 |" in text
+    assert "| 3 | 0.35 ± 0.01 | 6 | 21.33 | 5 to 39 | 0.1 | 30 |" in text
+    assert "grid-scale gain above 1) at Gamma 3: the pattern there is not resolved" in text
     assert "- band of growth, points Gamma 2.4 to 3: from 2.3 ± 0.02 to beyond the sweep" in text
     assert ("- onset (the lower edge of the lowest band that has one): Gamma_c = 2.3000 ± 0.02"
             in text)
