@@ -22,9 +22,10 @@ cycle, crosses zero as Gamma rises.
 - grid_scale_gain: whether the growth reaches the grid scale, from the gain over the run of
   the modes of a few cells per wavelength (a broadband growth that does is not a pattern the
   cell resolves).
-- fit_zero_crossing: Gamma_c from a weighted straight line through the growth rates of the
-  points nearest to the first change of sign from decay to growth (on its rising side only),
-  its error from the line's covariance (delta method).
+- growth_bands and fit_zero_crossing: the bands of Gamma over which the pattern grows, each
+  edge where a weighted straight line through the growth rates of the points around a change
+  of sign crosses zero, its error from the line's covariance (delta method); Gamma_c is the
+  lower edge of the band holding the saturated pattern.
 
 python/tests/test_pattern_growth.py measures the bias and the coverage of both errors on
 synthetic series and sweeps of known rate and onset.
