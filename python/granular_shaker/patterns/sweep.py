@@ -97,6 +97,21 @@ def check_grid(part, where):
         raise ValueError(f"{where}: gamma must be increasing, at least 1")
 
 
+def check_below(part, sweep, where):
+    """ValueError naming what is wrong with a sweep's `below` table: points of some MD cases
+    below the sweep's lowest Gamma."""
+    for key in ("cases", "gamma", "timeout"):
+        if key not in part:
+            raise ValueError(f"{where} has no '{key}'")
+    gamma = part["gamma"]
+    if not gamma or sorted(set(gamma)) != list(gamma) or gamma[-1] >= sweep["gamma"][0]:
+        raise ValueError(f"{where}: gamma {gamma!r}: allowed: increasing, at least 1, each below "
+                         f"the sweep's lowest Gamma {sweep['gamma'][0]:g}")
+    unknown = set(part["cases"]) - set(sweep["cases"])
+    if unknown:
+        raise ValueError(f"{where}: cases {sorted(unknown)} are not the sweep's")
+
+
 def grid_overrides(cell):
     """The --set values of a grid-check run: the cell, and a box GRID_DEPTH_CELLS cells deep
     (the stripes lie across y, so its depth only needs to hold a few cells)."""
@@ -120,6 +135,8 @@ def load_sweep(repository, name):
                          f"({SWEEP_FILE})")
     sweep = studies[name]
     check_part(repository, sweep, f"{SWEEP_FILE} [study.{name}]")
+    if "below" in sweep:
+        check_below(sweep["below"], sweep, f"{SWEEP_FILE} [study.{name}.below]")
     if "continuum" in sweep:
         check_part(repository, sweep["continuum"], f"{SWEEP_FILE} [study.{name}.continuum]")
         if "saturation" in sweep["continuum"]:
@@ -145,17 +162,21 @@ def solver_parts(sweep):
 
 
 def within(part, table):
-    """The gamma, timeout and cases of a continuum part's saturation or grid table (its cases:
+    """The gamma, timeout and cases of a part's below, saturation or grid table (its cases:
     the part's unless the table names some of them)."""
     return dict(gamma=table["gamma"], timeout=table["timeout"],
                 cases=table.get("cases", part["cases"]))
 
 
 def plan_points(repository, sweep):
-    """One run per solver, case, Gamma and seed, in the run dicts of the validation study; the
-    continuum's saturation runs (kind "saturation") and grid-check runs (kind "grid", one per
-    cell, key "cell") after its growth runs."""
+    """One run per solver, case, Gamma and seed, in the run dicts of the validation study (the
+    MD's points of the `below` table first); the continuum's saturation runs (kind
+    "saturation") and grid-check runs (kind "grid", one per cell, key "cell") after its growth
+    runs."""
     parts = [(solver, part, [], "sweep", None) for solver, part in solver_parts(sweep)]
+    if "below" in sweep:
+        # The dense, cold layer below onset makes these the longest runs: they go first.
+        parts.insert(0, ("md", dict(sweep, **within(sweep, sweep["below"])), [], "sweep", None))
     continuum = sweep.get("continuum") or {}
     if "saturation" in continuum:
         saturation = continuum["saturation"]
@@ -292,10 +313,10 @@ def growth_fits(points, holding=None):
 
 def case_points(plan, case, kind="sweep"):
     """A case's points of one kind of run (the sweep's, or the continuum's saturation runs),
-    one per Gamma, from its runs' summaries."""
+    one per Gamma in increasing order, from its runs' summaries."""
     points = []
     mine = [r for r in plan if r["case"] == case and r.get("kind", "sweep") == kind]
-    for gamma in dict.fromkeys(r["gamma"] for r in mine):
+    for gamma in sorted({r["gamma"] for r in mine}):
         runs = [r for r in mine if r["gamma"] == gamma and "summary" in r]
         if not runs:
             continue

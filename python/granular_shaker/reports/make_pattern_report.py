@@ -697,7 +697,10 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
              f"{results['commit'][:12]} (granular_shaker.patterns.sweep; design and definitions: "
              "docs/patterns.md). Cases "
              + ", ".join(sweep["cases"]) + f"; Gamma {sweep['gamma'][0]:g} to "
-             f"{sweep['gamma'][-1]:g} ({len(sweep['gamma'])} points); seeds "
+             f"{sweep['gamma'][-1]:g} ({len(sweep['gamma'])} points)" + (
+                 f", and below it {', '.join(sweep['below']['cases'])} at Gamma "
+                 + ", ".join(f"{g:g}" for g in sweep["below"]["gamma"])
+                 if "below" in sweep else "") + "; seeds "
              + ", ".join(map(str, sweep["seeds"])) + "; overrides "
              + (", ".join(f"`{o}`" for o in sweep["overrides"]) or "none")
              + f". {len(runs)} runs of {sum(r['seconds'] for r in runs):.0f} s in all when they "
