@@ -276,7 +276,8 @@ def fits(points):
             return out
         below = bracket[3]
     try:
-        out["swift_hohenberg"] = vars(fit_swift_hohenberg(gamma, order, error, below))
+        out["swift_hohenberg"] = dict(vars(fit_swift_hohenberg(gamma, order, error, below)),
+                                      below=float(below))
     except (NoOnset, ValueError) as reason:
         out["swift_hohenberg"] = dict(reason=str(reason))
     return out

@@ -33,6 +33,11 @@ def onset_curve(fit, gamma):
     return np.sqrt(fit["floor"] + fit["slope"] * np.maximum(gamma - fit["gamma_c"], 0.0))
 
 
+def swift_hohenberg_curve(fit, gamma):
+    return np.sqrt(fit["floor"] + fit["strength"]
+                   / np.sqrt((fit["gamma_mf"] - gamma) / fit["gamma_mf"]))
+
+
 def figure_order_parameter(cases):
     """The saturated order parameter against Gamma, each MD case with its onset fit."""
     import matplotlib.pyplot as plt
@@ -51,6 +56,13 @@ def figure_order_parameter(cases):
             low, high = bracket[2:]
             ax.axvspan(low, high, color=drawn[0].get_color(), alpha=0.15,
                        label=f"{name}: onset of order between Gamma {low:g} and {high:g}")
+        if "gamma_mf" in case.get("swift_hohenberg", {}):
+            fit = case["swift_hohenberg"]
+            below = gamma[gamma < fit.get("below", fit["gamma_mf"])]   # the points fitted
+            fine = np.linspace(below.min(), below.max(), 200)
+            ax.plot(fine, swift_hohenberg_curve(fit, fine), color=drawn[0].get_color(), lw=1,
+                    ls="--", label=f"{name}: Swift-Hohenberg fit below onset, Gamma_mf = "
+                    f"{fit['gamma_mf']:.3f}")
     ax.set_xlabel("plate acceleration Gamma [g]")
     ax.set_ylabel("order parameter of the column mass [1/sigma^2]")
     rc.legend_above(fig, columns=1)

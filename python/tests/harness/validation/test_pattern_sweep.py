@@ -11,7 +11,7 @@ import pytest
 
 from granular_shaker.patterns import onset as pattern_onset
 from granular_shaker.patterns import sweep
-from granular_shaker.reports import make_pattern_report
+from granular_shaker.reports import figure_rules, make_pattern_report
 
 from .. import REPOSITORY
 
@@ -551,6 +551,13 @@ def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the
     lines = make_pattern_report.case_lines("pattern_md_f0p18", dict(points=points, **found))
     assert any(line.startswith("- Swift-Hohenberg fit below onset: gamma_mf = 2.30")
                and "noise power strength = 0.05" in line for line in lines)
+    figure = make_pattern_report.figure_order_parameter(
+        {"pattern_md_f0p18": dict(solver="md", points=points, **found)})
+    curve = next(line for line in figure.axes[0].lines
+                 if "Swift-Hohenberg fit below onset, Gamma_mf = 2.300" in line.get_label())
+    assert curve.get_xdata().max() == pytest.approx(2.1)  # the highest point fitted
+    assert curve.get_ydata()[0] == pytest.approx(points[0]["order"], rel=1e-3)
+    assert figure_rules.figure_problems(figure) == []
     for point in points[:4]:  # one of them ordered: no bracket, no Swift-Hohenberg fit
         point["correlation_previous_cycle"] = -0.8 if point["gamma"] == 1.9 else 0.0
     assert "swift_hohenberg" not in sweep.fits(points)
