@@ -27,7 +27,9 @@ part's): its growth runs repeated at each cell (the box GRID_DEPTH_CELLS cells d
 rates tell whether the onset found at the case files' cell survives refinement; and a
 `saturation` table (gamma, cycles, frames, timeout, optionally cases): runs of `cycles` cycles
 whose last `frames` hold the fields, summarised as the MD's are (the saturated order parameter
-over those frames), the amplitude the claims compare with MD's.
+over those frames), the amplitude the claims compare with MD's; and a `scheme` table (gamma,
+limiters, timeout, optionally cases): its growth runs repeated with each slope limiter at the
+sweep's cell, whose rates tell whether the growth is the equations' or the scheme's.
 Each point also keeps its first seed's view (granular_shaker.patterns.views): the layer seen
 from above at the stored phases of one cycle and the spectrum of its column mass along x, which
 the report draws.
@@ -58,6 +60,9 @@ from granular_shaker.validation.summary import git, write_json_atomically
 SWEEP_FILE = os.path.join("validation", "patterns.toml")
 FIELD = "mass"  # the column mass: its noise is the counts' (docs/analysis.md "Patterns")
 GRID_DEPTH_CELLS = 4  # the fewest cells across y that the continuum accepts
+# The continuum's slope limiters a scheme check may try (docs/configuration.md; `none` is for
+# smooth solutions only).
+LIMITERS = ("minmod", "van_leer", "mc", "first_order")
 
 
 def check_part(repository, part, where):
@@ -112,6 +117,19 @@ def check_below(part, sweep, where):
         raise ValueError(f"{where}: cases {sorted(unknown)} are not the sweep's")
 
 
+def check_scheme(part, where):
+    """ValueError naming what is wrong with a continuum part's scheme table."""
+    for key in ("gamma", "limiters", "timeout"):
+        if key not in part:
+            raise ValueError(f"{where} has no '{key}'")
+    limiters = part["limiters"]
+    if not limiters or len(set(limiters)) != len(limiters) or not set(limiters) <= set(LIMITERS):
+        raise ValueError(f"{where}: limiters {limiters!r}: allowed: one or more, distinct, of "
+                         + ", ".join(LIMITERS))
+    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
+        raise ValueError(f"{where}: gamma must be increasing, at least 1")
+
+
 def grid_overrides(cell):
     """The --set values of a grid-check run: the cell, and a box GRID_DEPTH_CELLS cells deep
     (the stripes lie across y, so its depth only needs to hold a few cells)."""
@@ -144,7 +162,10 @@ def load_sweep(repository, name):
                              f"{SWEEP_FILE} [study.{name}.continuum.saturation]")
         if "grid" in sweep["continuum"]:
             check_grid(sweep["continuum"]["grid"], f"{SWEEP_FILE} [study.{name}.continuum.grid]")
-        for table in ("saturation", "grid"):
+        if "scheme" in sweep["continuum"]:
+            check_scheme(sweep["continuum"]["scheme"],
+                         f"{SWEEP_FILE} [study.{name}.continuum.scheme]")
+        for table in ("saturation", "grid", "scheme"):
             unknown = set(sweep["continuum"].get(table, {}).get("cases", [])) \
                 - set(sweep["continuum"]["cases"])
             if unknown:
@@ -171,28 +192,33 @@ def within(part, table):
 def plan_points(repository, sweep):
     """One run per solver, case, Gamma and seed, in the run dicts of the validation study (the
     MD's points of the `below` table first); the continuum's saturation runs (kind
-    "saturation") and grid-check runs (kind "grid", one per cell, key "cell") after its growth
-    runs."""
-    parts = [(solver, part, [], "sweep", None) for solver, part in solver_parts(sweep)]
+    "saturation"), grid-check runs (kind "grid", one per cell, key "cell") and scheme-check
+    runs (kind "scheme", one per limiter, key "limiter") after its growth runs."""
+    parts = [(solver, part, [], "sweep", {}) for solver, part in solver_parts(sweep)]
     if "below" in sweep:
         # The dense, cold layer below onset makes these the longest runs: they go first.
-        parts.insert(0, ("md", dict(sweep, **within(sweep, sweep["below"])), [], "sweep", None))
+        parts.insert(0, ("md", dict(sweep, **within(sweep, sweep["below"])), [], "sweep", {}))
     continuum = sweep.get("continuum") or {}
     if "saturation" in continuum:
         saturation = continuum["saturation"]
         parts.append(("continuum", dict(continuum, **within(continuum, saturation)),
-                      saturation_overrides(saturation), "saturation", None))
+                      saturation_overrides(saturation), "saturation", {}))
     if "grid" in continuum:
         grid = continuum["grid"]
         parts += [("continuum", dict(continuum, **within(continuum, grid)), grid_overrides(cell),
-                   "grid", cell) for cell in grid["cells"]]
+                   "grid", dict(cell=cell)) for cell in grid["cells"]]
+    if "scheme" in continuum:
+        scheme = continuum["scheme"]
+        parts += [("continuum", dict(continuum, **within(continuum, scheme)),
+                   [f"continuum.limiter={limiter}"], "scheme", dict(limiter=limiter))
+                  for limiter in scheme["limiters"]]
     plan = []
-    for solver, part, extra, kind, cell in parts:
+    for solver, part, extra, kind, variant in parts:
         for case in part["cases"]:
             for gamma in part["gamma"]:
                 for seed in part["seeds"]:
                     plan.append(dict(case=case, case_file=case_file(repository, case),
-                                     solver=solver, kind=kind, cell=cell, replicas=1,
+                                     solver=solver, kind=kind, **variant, replicas=1,
                                      gamma=gamma, seed=seed,
                                      overrides=[f"shaker.gamma={gamma}", f"run.seed={seed}",
                                                 *part["overrides"], *extra],
@@ -330,14 +356,14 @@ def case_points(plan, case, kind="sweep"):
     return points
 
 
-def grid_points(plan, case):
-    """A case's grid check: per cell and Gamma, its first seed's growth of the fastest
-    pattern mode."""
+def check_points(plan, case, kind, key):
+    """A case's grid or scheme check (kind "grid", key "cell"; kind "scheme", key "limiter"):
+    per value of the key and Gamma, its first seed's growth of the fastest pattern mode."""
     points = {}
     for run in plan:
-        if run["case"] == case and run.get("kind") == "grid" and "growth" in run:
-            points.setdefault((run["cell"], run["gamma"]),
-                              dict(cell=run["cell"], gamma=run["gamma"], **run["growth"]))
+        if run["case"] == case and run.get("kind") == kind and "growth" in run:
+            points.setdefault((run[key], run["gamma"]),
+                              {key: run[key], "gamma": run["gamma"], **run["growth"]})
     return list(points.values())
 
 
@@ -375,9 +401,10 @@ def collect(shaker, plan):
         cases[case] = dict(solver=solver, points=points, **found)
         if saturated:
             cases[case]["saturation"] = saturated
-        grid = grid_points(plan, case)
-        if grid:
-            cases[case]["grid"] = grid
+        for kind, key in (("grid", "cell"), ("scheme", "limiter")):
+            checked = check_points(plan, case, kind, key)
+            if checked:
+                cases[case][kind] = checked
     return cases, failures
 
 

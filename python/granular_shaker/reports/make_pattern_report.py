@@ -387,31 +387,74 @@ def coarse_continuum_note(sweep):
             "continuum's onset', compares them with the case files' cell)")
 
 
-def refinement_changes(case):
-    """The grid check's (Gamma, the sweep's rate, the finest cell, its rate) where refinement
-    reverses a growth rate significant at both cells (the test that places the onset)."""
+# The continuum's checks: the growth runs repeated at finer cells (grid) or with other slope
+# limiters at the sweep's cell (scheme); the key that tells a check's runs apart, and how the
+# report names a run of it.
+CHECKS = {"grid": ("cell", "cell [sigma]", "refinement reverses the growth",
+                   "at the sweep's cell", "at cell {}", "so its onset there is not the converged "
+                   "continuum's"),
+          "scheme": ("limiter", "limiter", "another slope limiter reverses the growth",
+                     "with the sweep's limiter", "with {}", "so the growth there is the scheme's, "
+                     "not the equations'")}
+
+
+def reversals(case, kind):
+    """A check's (Gamma, the sweep's rate, the run's key, its rate) where the check reverses a
+    growth rate significant in both runs (the test that places the onset): for the grid, the
+    finest cell at each Gamma; for the scheme, every limiter."""
+    key = CHECKS[kind][0]
+    checked = case.get(kind, [])
+    if kind == "grid":
+        checked = [min((p for p in checked if p["gamma"] == g), key=lambda p: p["cell"])
+                   for g in sorted({p["gamma"] for p in checked})]
     sweep_rate = {p["gamma"]: p for p in case["points"]}
     changes = []
-    for gamma in sorted({p["gamma"] for p in case.get("grid", [])}):
-        finest = min((p for p in case["grid"] if p["gamma"] == gamma), key=lambda p: p["cell"])
-        mine = sweep_rate.get(gamma)
+    for point in checked:
+        mine = sweep_rate.get(point["gamma"])
         if mine is None:
             continue
         significant = [abs(p["rate"]) > SIGNIFICANT_GROWTH * p["rate_error"]
-                       for p in (mine, finest)]
-        if all(significant) and (mine["rate"] > 0) != (finest["rate"] > 0):
-            changes.append((gamma, mine["rate"], finest["cell"], finest["rate"]))
+                       for p in (mine, point)]
+        if all(significant) and (mine["rate"] > 0) != (point["rate"] > 0):
+            changes.append((point["gamma"], mine["rate"], point[key], point["rate"]))
     return changes
 
 
-def grid_note(cases):
-    """The caveat of continuum cases whose growth the grid check reverses, or ""."""
-    notes = [f"{name}: refinement reverses its growth at Gamma {g:g} ({rc.fmt(r, 3)} per cycle "
-             f"at the sweep's cell, {rc.fmt(fine, 3)} at cell {cell:g}), so its onset there is "
-             "not the converged continuum's"
+def reversal_text(kind, gamma, rate, which, other):
+    _, _, reverses, mine, theirs, _ = CHECKS[kind]
+    return (f"{reverses} at Gamma {gamma:g} ({rc.fmt(rate, 3)} per cycle {mine}, "
+            f"{rc.fmt(other, 3)} {theirs.format(f'{which:g}' if kind == 'grid' else which)})")
+
+
+def check_note(cases):
+    """The caveat of continuum cases whose growth a grid or scheme check reverses, or ""."""
+    notes = [f"{name}: {reversal_text(kind, *change)}, {CHECKS[kind][5]}"
              for name, case in solver_cases(cases, "continuum").items()
-             for g, r, cell, fine in refinement_changes(case)]
+             for kind in CHECKS for change in reversals(case, kind)]
     return "; ".join(notes)
+
+
+def check_lines(case, kind):
+    """A continuum case's grid or scheme check: its table and what it finds."""
+    key, heading = CHECKS[kind][:2]
+    checked = sorted(case.get(kind, []), key=lambda p: (
+        p["gamma"], -p[key] if kind == "grid" else p[key]))
+    if not checked:
+        return []
+    title = ("Grid check (the same run at each cell, the box 4 cells deep):" if kind == "grid"
+             else "Scheme check (the same run with other slope limiters at the sweep's cell):")
+    lines = ["", title, "", f"| Gamma [g] | {heading} | growth rate [1/cycle] | fastest pattern "
+             "mode m | cycles fitted | grid-scale gain |", "| --- | --- | --- | --- | --- | --- |"]
+    lines += [f"| {p['gamma']:g} | {p[key]:{'g' if kind == 'grid' else ''}} | "
+              f"{rc.fmt(p['rate'])} ± {rc.fmt(p['rate_error'], 2)} | {p['mode']} | "
+              f"{p['fit_cycles'][0]:g} to {p['fit_cycles'][1]:g} | "
+              f"{rc.fmt(p['grid_scale_gain'], 3) if 'grid_scale_gain' in p else 'n/a'} |"
+              for p in checked]
+    found = [f"- {reversal_text(kind, *change)}" for change in reversals(case, kind)]
+    if not found and kind == "grid" and len({p["cell"] for p in checked}) < 2:
+        found = ["- no run at a finer cell has finished: the grid check is incomplete"]
+    return lines + [""] + (found or [f"- the {kind} check keeps the sign of every growth rate "
+                                     "checked"]) + [""]
 
 
 def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_note=""):
@@ -628,23 +671,7 @@ def continuum_case_lines(name, case):
                   f"{onset['chi2_per_dof']:.3g})"]
     else:
         lines += [f"- onset: none: {onset.get('reason', 'not fitted')}"]
-    grid = sorted(case.get("grid", []), key=lambda p: (p["gamma"], -p["cell"]))
-    if grid:
-        lines += ["", "Grid check (the same run at each cell, the box 4 cells deep):", "",
-                  "| Gamma [g] | cell [sigma] | growth rate [1/cycle] | fastest pattern mode m "
-                  "| cycles fitted | grid-scale gain |", "| --- | --- | --- | --- | --- | --- |"]
-        lines += [f"| {p['gamma']:g} | {p['cell']:g} | {rc.fmt(p['rate'])} ± "
-                  f"{rc.fmt(p['rate_error'], 2)} | {p['mode']} | {p['fit_cycles'][0]:g} to "
-                  f"{p['fit_cycles'][1]:g} | "
-                  f"{rc.fmt(p['grid_scale_gain'], 3) if 'grid_scale_gain' in p else 'n/a'} |"
-                  for p in grid]
-        refined = len({p["cell"] for p in grid}) > 1
-        verdicts = [f"- refinement reverses the growth at Gamma {g:g}: {rc.fmt(r, 3)} per cycle "
-                    f"at the sweep's cell, {rc.fmt(fine, 3)} at cell {cell:g}"
-                    for g, r, cell, fine in refinement_changes(case)] or [
-            "- refinement keeps the sign of every growth rate checked" if refined else
-            "- no run at a finer cell has finished: the grid check is incomplete"]
-        lines += [""] + verdicts + [""]
+    lines += check_lines(case, "grid") + check_lines(case, "scheme")
     for p in case.get("saturation", []):
         lines.append(f"- saturated at Gamma {p['gamma']:g} (over the last frames of a long "
                      f"run): order parameter {rc.fmt(p['order'])} ± "
@@ -752,7 +779,7 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
         lines += case_lines(name, case)
     lines += ["## Claims (reference-data/pattern-claims.toml)", "",
               "| claim | statement | value | verdict | why |", "| --- | --- | --- | --- | --- |"]
-    note = "; ".join(n for n in (coarse_continuum_note(sweep), grid_note(results["cases"])) if n)
+    note = "; ".join(n for n in (coarse_continuum_note(sweep), check_note(results["cases"])) if n)
     for row in claim_verdicts(claims, results["cases"], parameters, dispersion, note):
         lines.append(f"| {row['id']} ({row['status']}) | {row['statement']} | {row['value']} | "
                      f"{row['verdict']} | {row['reason']} |")

@@ -495,21 +495,60 @@ def test_a_grid_table_is_checked_and_a_reversed_growth_is_noted():
     case = synthetic_continuum(2.3)   # grows at 2.6 at +0.15 +- 0.01
     case["grid"] = [dict(cell=c, gamma=2.6, rate=r, rate_error=0.01, mode=6, fit_cycles=[5, 39])
                     for c, r in ((2.0, 0.05), (1.0, 0.03), (0.5, -0.04))]
-    assert make_pattern_report.refinement_changes(case) == [(2.6, pytest.approx(0.15), 0.5,
-                                                             -0.04)]
-    note = make_pattern_report.grid_note({"pattern_continuum_f0p18": case})
-    assert "refinement reverses its growth at Gamma 2.6" in note and "cell 0.5" in note
+    assert make_pattern_report.reversals(case, "grid") == [(2.6, pytest.approx(0.15), 0.5,
+                                                            -0.04)]
+    note = make_pattern_report.check_note({"pattern_continuum_f0p18": case})
+    assert note == ("pattern_continuum_f0p18: refinement reverses the growth at Gamma 2.6 (0.15 "
+                    "per cycle at the sweep's cell, -0.04 at cell 0.5), so its onset there is "
+                    "not the converged continuum's")
     lines = make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
-    assert "- refinement reverses the growth at Gamma 2.6: 0.15 per cycle at the sweep's " \
-        "cell, -0.04 at cell 0.5" in lines
+    assert "- refinement reverses the growth at Gamma 2.6 (0.15 per cycle at the sweep's " \
+        "cell, -0.04 at cell 0.5)" in lines
     case["grid"][-1]["rate"] = -0.015   # within two errors of zero: no reversal
-    assert make_pattern_report.refinement_changes(case) == []
-    assert make_pattern_report.grid_note({"pattern_continuum_f0p18": case}) == ""
-    assert "- refinement keeps the sign of every growth rate checked" in \
+    assert make_pattern_report.reversals(case, "grid") == []
+    assert make_pattern_report.check_note({"pattern_continuum_f0p18": case}) == ""
+    assert "- the grid check keeps the sign of every growth rate checked" in \
         make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
     case["grid"] = case["grid"][:1]   # the sweep's own cell only
     assert "- no run at a finer cell has finished: the grid check is incomplete" in \
         make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
+
+
+def test_a_scheme_table_is_checked_planned_and_a_reversed_growth_is_noted():
+    where = "[study.x.continuum.scheme]"
+    good = dict(gamma=[3.4], limiters=["minmod", "van_leer"], timeout=60)
+    sweep.check_scheme(good, where)
+    for bad, message in ((dict(good, limiters=[]), "one or more"),
+                         (dict(good, limiters=["minmod", "minmod"]), "distinct"),
+                         (dict(good, limiters=["none"]), "minmod, van_leer, mc, first_order"),
+                         (dict(good, gamma=[]), "at least 1")):
+        with pytest.raises(ValueError, match=message):
+            sweep.check_scheme(bad, where)
+    with pytest.raises(ValueError, match="no 'limiters'"):
+        sweep.check_scheme(dict(gamma=[3.4], timeout=60), where)
+    continuum = dict(cases=["pattern_continuum_f0p18"], gamma=[2.2, 2.6, 3.0, 3.4, 3.8],
+                     seeds=[1], overrides=[], timeout=60, scheme=good)
+    study = dict(cases=["pattern_md_f0p18"], gamma=[2.0, 2.4, 2.8, 3.2, 3.6], seeds=[1],
+                 overrides=[], timeout=60, continuum=continuum)
+    scheme = [r for r in sweep.plan_points(REPOSITORY, study) if r["kind"] == "scheme"]
+    assert [(r["limiter"], r["gamma"]) for r in scheme] == [("minmod", 3.4), ("van_leer", 3.4)]
+    assert all("continuum.limiter=" + r["limiter"] in r["overrides"] for r in scheme)
+    # Collected as the grid check is: one point per limiter and Gamma, from its first seed.
+    for run in scheme:
+        run["growth"] = dict(rate=-0.06 if run["limiter"] == "van_leer" else 0.01,
+                             rate_error=0.01, mode=7, fit_cycles=[5, 39], grid_scale_gain=0.1)
+    points = sweep.check_points(scheme, "pattern_continuum_f0p18", "scheme", "limiter")
+    case = synthetic_continuum(2.3)   # grows at 3.0 at +0.35 +- 0.01
+    case["scheme"] = [dict(p, gamma=3.0) for p in points]
+    assert make_pattern_report.reversals(case, "scheme") == [
+        (3.0, pytest.approx(0.35), "van_leer", -0.06)]   # minmod's +0.01 is within its errors
+    note = make_pattern_report.check_note({"pattern_continuum_f0p18": case})
+    assert note == ("pattern_continuum_f0p18: another slope limiter reverses the growth at "
+                    "Gamma 3 (0.35 per cycle with the sweep's limiter, -0.06 with van_leer), so "
+                    "the growth there is the scheme's, not the equations'")
+    lines = make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
+    assert "| 3 | minmod | 0.01 ± 0.01 | 7 | 5 to 39 | 0.1 |" in lines
+    assert "Scheme check (the same run with other slope limiters at the sweep's cell):" in lines
 
 
 def test_a_grid_or_saturation_table_may_name_some_of_the_continuums_cases(work_dir):
