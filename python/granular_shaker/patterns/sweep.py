@@ -60,6 +60,9 @@ from granular_shaker.validation.summary import git, write_json_atomically
 SWEEP_FILE = os.path.join("validation", "patterns.toml")
 FIELD = "mass"  # the column mass: its noise is the counts' (docs/analysis.md "Patterns")
 GRID_DEPTH_CELLS = 4  # the fewest cells across y that the continuum accepts
+# Every run writes a checkpoint this often (cycles), so that a sweep stopped mid-run continues
+# it (granular_shaker.validation.run.solver_command): the runs below onset take hours.
+CHECKPOINT_EVERY = 10
 # The continuum's slope limiters a scheme check may try (docs/configuration.md; `none` is for
 # smooth solutions only).
 LIMITERS = ("minmod", "van_leer", "mc", "first_order")
@@ -223,6 +226,7 @@ def plan_points(repository, sweep):
                                      overrides=[f"shaker.gamma={gamma}", f"run.seed={seed}",
                                                 *part["overrides"], *extra],
                                      timeout=part["timeout"], fallback=[],
+                                     checkpoint_every=CHECKPOINT_EVERY,
                                      expect_failure=False))
     return plan
 

@@ -5,6 +5,9 @@ import json
 import os
 import subprocess
 import time
+import tomllib
+
+import h5py
 
 from granular_shaker.validation.plan import run_key
 
@@ -27,6 +30,55 @@ def solver_environment(jobs):
     return env
 
 
+def first_kept_cycle(run, config):
+    """The first cycle whose output a continued run would lose: the run's first sampled cycle
+    and its first stored frame (md.snapshot_cycles, continuum.field_cycles), whichever is
+    earlier; a continued run's files hold only the frames and rows it reached itself."""
+    values = tomllib.loads(config)
+    cycles = values["run"]["transient_cycles"] + values["run"]["sampled_cycles"]
+    frames = (values["md"].get("snapshot_cycles", []) if run["solver"] == "md"
+              else values.get("continuum", {}).get("field_cycles", []))
+    return min([values["run"]["transient_cycles"]]
+               + [c if c >= 0 else cycles + c for c in frames])
+
+
+def usable_checkpoint(path, run, config):
+    """Whether a run may continue from the checkpoint at `path`: it exists, reads, and was
+    taken before any output the run keeps (first_kept_cycle)."""
+    try:
+        with h5py.File(path, "r") as f:
+            reached = (int(f.attrs["schedule_cycle"]), int(f.attrs["schedule_phase"]))
+    except (OSError, KeyError):
+        return False
+    return reached <= (first_kept_cycle(run, config), 0)
+
+
+def remove_checkpoints(checkpoint):
+    for path in (checkpoint, os.path.splitext(checkpoint)[0] + ".previous.h5"):
+        if os.path.exists(path):
+            os.remove(path)
+
+
+def solver_command(shaker, run, output, config, checkpoint, launcher=()):
+    """The command of one run. A resumable run (its `checkpoint_every`, in cycles) writes
+    periodic checkpoints to `checkpoint` and continues from one an earlier, stopped attempt
+    left when that one precedes the output the run keeps (usable_checkpoint; otherwise it is
+    removed and the run starts afresh). Neither changes the run's key: a continued run ends
+    in the uninterrupted one's state (programs.Checkpoints.RestartIsExact)."""
+    cmd = list(launcher) if run["replicas"] > 1 else []
+    cmd += [shaker, run["solver"], run["case_file"]]
+    cmd += [a for o in run["overrides"] for a in ("--set", o)]
+    cmd += ["--set", f"run.output={output}"]
+    if run.get("checkpoint_every"):
+        if usable_checkpoint(checkpoint, run, config):
+            cmd += ["--set", f"run.restart_from={checkpoint}"]
+        else:
+            remove_checkpoints(checkpoint)
+        cmd += ["--set", f"run.checkpoint={checkpoint}",
+                "--set", f"run.checkpoint_every={run['checkpoint_every']}"]
+    return cmd
+
+
 def execute(shaker, workdir, run, rerun, reuse_only, env=None, launcher=()):
     """Runs (or reuses) one solver run; returns its record (status, path, seconds, ...). An
     ensemble (replicas > 1) is started through `launcher` (e.g. mpirun -np 8) if one is given."""
@@ -46,10 +98,10 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None, launcher=()):
         return dict(status=status, path=output if status == "ok" else None, seconds=0.0,
                     key=key, config=text, reused=status == "ok", returncode=None,
                     stderr="--reuse-only: no finished run", command="")
-    cmd = list(launcher) if run["replicas"] > 1 else []
-    cmd += [shaker, run["solver"], run["case_file"]]
-    cmd += [a for o in run["overrides"] for a in ("--set", o)]
-    cmd += ["--set", f"run.output={output}"]
+    checkpoint = stem + ".checkpoint.h5"
+    if rerun:
+        remove_checkpoints(checkpoint)
+    cmd = solver_command(shaker, run, output, text, checkpoint, launcher)
     log(f"run {run['solver']} {run['case']}" + (f" [{run['replicas']} replicas]"
                                                 if run["replicas"] > 1 else "")
         + f" -> {os.path.basename(output)}")
@@ -72,6 +124,8 @@ def execute(shaker, workdir, run, rerun, reuse_only, env=None, launcher=()):
     record = dict(status=status, path=output if status == "ok" else None, seconds=seconds,
                   key=key, config=text, returncode=rc, command=" ".join(cmd),
                   stdout=stdout[-3000:], stderr=stderr[-3000:], reused=False)
+    if status == "ok":
+        remove_checkpoints(checkpoint)
     if status in ("ok", "collapse"):
         tmp = record_path + ".partial"
         with open(tmp, "w") as f:

@@ -12,6 +12,7 @@ import pytest
 from granular_shaker.patterns import onset as pattern_onset
 from granular_shaker.patterns import sweep
 from granular_shaker.reports import figure_rules, make_pattern_report
+from granular_shaker.validation import run as run_module
 
 from .. import REPOSITORY
 
@@ -642,3 +643,58 @@ def test_every_study_of_the_repository_loads_and_plans(name):
         * len(study["seeds"])
     assert len(md) == expected
     assert min(r["gamma"] for r in md) == min(study.get("below", study)["gamma"])
+
+
+MD_CONFIG = """[run]
+transient_cycles = 120
+sampled_cycles = 10
+[md]
+snapshot_cycles = [125, -1]
+[continuum]
+field_cycles = [0.0, 1.0]
+"""
+
+
+def write_checkpoint(path, cycle, phase):
+    import h5py
+    with h5py.File(path, "w") as f:
+        f.attrs["schedule_cycle"], f.attrs["schedule_phase"] = cycle, phase
+
+
+def test_a_stopped_run_continues_from_its_checkpoint_only_before_the_output_it_keeps(work_dir):
+    md, continuum = dict(solver="md"), dict(solver="continuum")
+    # MD: the sampled cycles from 120 and snapshots at 125 and 129; the continuum: fields from 0
+    assert run_module.first_kept_cycle(md, MD_CONFIG) == 120
+    assert run_module.first_kept_cycle(continuum, MD_CONFIG) == 0
+    checkpoint = os.path.join(work_dir, "md-key.checkpoint.h5")
+    assert not run_module.usable_checkpoint(checkpoint, md, MD_CONFIG)   # none yet
+    for (cycle, phase), usable in (((60, 3), True), ((120, 0), True), ((120, 1), False),
+                                   ((125, 0), False)):
+        write_checkpoint(checkpoint, cycle, phase)
+        assert run_module.usable_checkpoint(checkpoint, md, MD_CONFIG) is usable
+    write_checkpoint(checkpoint, 0, 0)
+    assert run_module.usable_checkpoint(checkpoint, continuum, MD_CONFIG)
+    write_checkpoint(checkpoint, 1, 0)   # a growth run's fields from cycle 0: start afresh
+    assert not run_module.usable_checkpoint(checkpoint, continuum, MD_CONFIG)
+
+    run = dict(solver="md", case_file="case.toml", overrides=["shaker.gamma=1.8"], replicas=1,
+               checkpoint_every=10)
+    output = os.path.join(work_dir, "md-key.h5")
+    write_checkpoint(checkpoint, 60, 3)
+    cmd = run_module.solver_command("shaker", run, output, MD_CONFIG, checkpoint)
+    assert cmd == ["shaker", "md", "case.toml", "--set", "shaker.gamma=1.8",
+                   "--set", f"run.output={output}", "--set", f"run.restart_from={checkpoint}",
+                   "--set", f"run.checkpoint={checkpoint}", "--set", "run.checkpoint_every=10"]
+    write_checkpoint(checkpoint, 126, 0)   # past the first snapshot: removed, a fresh start
+    open(os.path.splitext(checkpoint)[0] + ".previous.h5", "w").close()
+    cmd = run_module.solver_command("shaker", run, output, MD_CONFIG, checkpoint)
+    assert not any(a.startswith("run.restart_from") for a in cmd)
+    assert not os.path.exists(checkpoint)
+    assert not os.path.exists(os.path.splitext(checkpoint)[0] + ".previous.h5")
+    plain = run_module.solver_command("shaker", dict(run, checkpoint_every=0), output,
+                                      MD_CONFIG, checkpoint)
+    assert plain == cmd[:7]   # a run that is not resumable writes no checkpoints
+    # The sweep's runs are resumable.
+    study = sweep.load_sweep(REPOSITORY, "bracket")
+    assert {r["checkpoint_every"] for r in sweep.plan_points(REPOSITORY, study)} == {
+        sweep.CHECKPOINT_EVERY}
