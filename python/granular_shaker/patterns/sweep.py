@@ -257,24 +257,31 @@ def frame_summary(columns):
         order = columns[f"{FIELD}_order_parameter"][at]
         if best is None or order.mean() > best["order"]:
             best = dict(phase=float(phase), frames=int(at.sum()), order=float(order.mean()),
-                        order_error=float(order.std(ddof=1) / np.sqrt(order.size))
-                        if order.size > 1 else float("nan"))
+                        order_error=standard_error(order))
             for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
                 values = columns[f"{FIELD}_{name}"][at]
                 values = values[np.isfinite(values)]
                 best[name] = float(values.mean()) if values.size else float("nan")
+                if name == "correlation_previous_cycle":
+                    best["correlation_error"] = standard_error(values)
     return best
+
+
+def standard_error(values):
+    """The standard error of the mean of independent values (nan for fewer than two)."""
+    values = np.asarray(values, float)
+    return float(values.std(ddof=1) / np.sqrt(values.size)) if values.size > 1 else float("nan")
 
 
 def point_summary(runs):
     """A point (case, Gamma) from its runs' summaries: the mean over seeds, their standard
     error (one seed: its frames' standard error)."""
     order = np.array([r["order"] for r in runs])
-    if order.size > 1:
-        error = float(order.std(ddof=1) / np.sqrt(order.size))
-    else:
-        error = runs[0]["order_error"]
-    point = dict(order=float(order.mean()), order_error=error, seeds=len(runs))
+    correlation = [r["correlation_previous_cycle"] for r in runs]
+    point = dict(order=float(order.mean()), seeds=len(runs),
+                 order_error=standard_error(order) if order.size > 1 else runs[0]["order_error"],
+                 correlation_error=standard_error(correlation) if len(runs) > 1
+                 else runs[0].get("correlation_error", float("nan")))
     for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
         point[name] = float(np.mean([r[name] for r in runs]))
     return point

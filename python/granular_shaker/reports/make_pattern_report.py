@@ -685,12 +685,14 @@ def case_lines(name, case):
     if case.get("solver") == "continuum":
         return continuum_case_lines(name, case)
     lines = [f"### {name}", "", "| Gamma [g] | order parameter [1/sigma^2] | seeds | "
-             "wavelength [sigma] | A2 | cycle-to-cycle correlation |", "| --- | --- | --- | --- "
-             "| --- | --- |"]
+             "wavelength [sigma] | A2 | cycle-to-cycle correlation (± standard error) |",
+             "| --- | --- | --- | --- | --- | --- |"]
     for p in case["points"]:
         lines.append(f"| {p['gamma']:g} | {rc.fmt(p['order'])} ± {rc.fmt(p['order_error'], 2)} "
                      f"| {p['seeds']} | {rc.fmt(p['wavelength'])} | {rc.fmt(p['a2'], 3)} | "
-                     f"{rc.fmt(p['correlation_previous_cycle'], 3)} |")
+                     f"{rc.fmt(p['correlation_previous_cycle'], 3)}"
+                     + (f" ± {rc.fmt(p['correlation_error'], 1)}"
+                        if np.isfinite(p.get("correlation_error", np.nan)) else "") + " |")
     lines.append("")
     shown = [p["gamma"] for p in case["points"] if ordered(p)]
     if shown:

@@ -77,16 +77,20 @@ def test_a_run_is_summarised_at_the_phase_of_the_larger_pattern():
     assert summary["order"] == pytest.approx(0.4)
     assert summary["order_error"] == pytest.approx(0.1 / np.sqrt(3))  # sd 0.1 over 3 frames
     assert summary["correlation_previous_cycle"] == pytest.approx(-0.75)  # NaN left out
+    # -0.8 and -0.7: sd 0.0707 over the 2 frames that have a previous cycle
+    assert summary["correlation_error"] == pytest.approx(0.05)
     assert summary["frames"] == 3
 
 
 def test_a_point_of_several_seeds_takes_their_spread_as_its_error():
     runs = [dict(order=x, order_error=1e-6, wavelength=16.0, a2=1.0, a4=1.0, a6=1.0,
-                 correlation_previous_cycle=-1.0) for x in (0.2, 0.4)]
+                 correlation_previous_cycle=-x, correlation_error=1e-3) for x in (0.2, 0.4)]
     point = sweep.point_summary(runs)
     assert point["order"] == pytest.approx(0.3)
     assert point["order_error"] == pytest.approx(0.1)  # sd 0.1414 / sqrt 2
+    assert point["correlation_error"] == pytest.approx(0.1)   # the seeds' spread, likewise
     assert sweep.point_summary(runs[:1])["order_error"] == 1e-6
+    assert sweep.point_summary(runs[:1])["correlation_error"] == 1e-3   # one seed: its frames'
 
 
 def test_an_unknown_study_is_refused(work_dir, shaker):
