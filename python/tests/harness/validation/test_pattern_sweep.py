@@ -4,6 +4,8 @@ of known values, and a whole sweep of a small box through `shaker`, resumed from
 import json
 import os
 import shutil
+import signal
+import subprocess
 import tomllib
 
 import numpy as np
@@ -702,3 +704,51 @@ def test_a_stopped_run_continues_from_its_checkpoint_only_before_the_output_it_k
     study = sweep.load_sweep(REPOSITORY, "bracket")
     assert {r["checkpoint_every"] for r in sweep.plan_points(REPOSITORY, study)} == {
         sweep.CHECKPOINT_EVERY}
+
+
+def test_a_stopped_sweep_run_continues_from_its_checkpoint_to_the_straight_runs_result(
+        work_dir, shaker):
+    # The tiny MD case of the sweep's tests, 44 cycles, run straight in one workdir; in the
+    # other an attempt is stopped by SIGTERM once it has checkpointed cycle 1 (as a session's
+    # end stops a sweep), well before cycle 40, the first the run keeps, and the sweep
+    # continues it.
+    import h5py
+    overrides = ["shaker.gamma=2.4", "run.seed=1", "layer.particles=300", "md.box_width=16.0",
+                 "md.box_depth=8.0", "run.transient_cycles=40", "run.sampled_cycles=4",
+                 "md.snapshot_cycles=[40, 41, 42, 43]"]
+    run = dict(case="pattern_md_f0p18", solver="md", replicas=1, overrides=overrides,
+               case_file=sweep.case_file(REPOSITORY, "pattern_md_f0p18"), timeout=300,
+               checkpoint_every=1)
+    straight_dir, continued_dir = (os.path.join(work_dir, d) for d in ("straight", "continued"))
+    for d in (straight_dir, continued_dir):
+        os.makedirs(os.path.join(d, "runs"))
+    straight = run_module.execute(shaker, straight_dir, run, rerun=False, reuse_only=False)
+    assert straight["status"] == "ok" and "restart_from" not in straight["command"]
+    text, key = run_module.run_key(shaker, run)
+    stem = os.path.join(continued_dir, "runs", f"md-{key[:20]}")
+    checkpoint = stem + ".checkpoint.h5"
+    attempt = subprocess.Popen(run_module.solver_command(shaker, run, stem + ".h5", text,
+                                                         checkpoint),
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    reached = (0, 0)
+    while reached < (2, 0) and attempt.poll() is None:
+        try:
+            with h5py.File(checkpoint, "r") as f:
+                reached = (int(f.attrs["schedule_cycle"]), int(f.attrs["schedule_phase"]))
+        except (OSError, KeyError):
+            pass
+    attempt.send_signal(signal.SIGTERM)
+    assert attempt.wait() == 128 + signal.SIGTERM
+    assert run_module.usable_checkpoint(checkpoint, run, text)   # stopped before cycle 40
+    continued = run_module.execute(shaker, continued_dir, run, rerun=False, reuse_only=False)
+    assert continued["status"] == "ok", continued["stderr"]
+    assert f"run.restart_from={checkpoint}" in continued["command"]
+    assert not os.path.exists(checkpoint)   # a finished run's checkpoints are removed
+    with h5py.File(straight["path"]) as a, h5py.File(continued["path"]) as b:
+        for name in ("n", "T", "uz"):
+            assert np.array_equal(a["profiles"][name][:], b["profiles"][name][:],
+                                  equal_nan=True), name   # nan: a bin the layer never reached
+    particles = [os.path.splitext(r["path"])[0] + ".particles.h5" for r in (straight, continued)]
+    with h5py.File(particles[0]) as a, h5py.File(particles[1]) as b:
+        position = "particles/all/position/value"
+        assert np.array_equal(a[position][:], b[position][:])
