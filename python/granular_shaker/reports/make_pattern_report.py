@@ -11,6 +11,7 @@ import json
 import os
 import sys
 import tomllib
+from typing import NamedTuple
 
 import numpy as np
 
@@ -387,22 +388,36 @@ def coarse_continuum_note(sweep):
             "continuum's onset', compares them with the case files' cell)")
 
 
-# The continuum's checks: the growth runs repeated at finer cells (grid) or with other slope
-# limiters at the sweep's cell (scheme); the key that tells a check's runs apart, and how the
-# report names a run of it.
-CHECKS = {"grid": ("cell", "cell [sigma]", "refinement reverses the growth",
-                   "at the sweep's cell", "at cell {}", "so its onset there is not the converged "
-                   "continuum's"),
-          "scheme": ("limiter", "limiter", "another slope limiter reverses the growth",
-                     "with the sweep's limiter", "with {}", "so the growth there is the scheme's, "
-                     "not the equations'")}
+class Check(NamedTuple):
+    """How the report names one of the continuum's checks and what it finds."""
+    key: str           # what tells the check's runs apart (in the results' points)
+    heading: str       # its column in the check's table
+    title: str         # the line above the table
+    reverses: str      # a reversal, and the two runs compared: the sweep's and the check's
+    mine: str
+    theirs: str        # with {} for the key's value
+    consequence: str   # what a reversal means for the verdicts
+
+
+# The growth runs repeated at finer cells (grid) or with other slope limiters at the sweep's
+# cell (scheme).
+CHECKS = {
+    "grid": Check("cell", "cell [sigma]",
+                  "Grid check (the same run at each cell, the box 4 cells deep):",
+                  "refinement reverses the growth", "at the sweep's cell", "at cell {}",
+                  "so its onset there is not the converged continuum's"),
+    "scheme": Check("limiter", "limiter",
+                    "Scheme check (the same run with other slope limiters at the sweep's cell):",
+                    "another slope limiter reverses the growth", "with the sweep's limiter",
+                    "with {}", "so the growth there is the scheme's, not the equations'"),
+}
 
 
 def reversals(case, kind):
     """A check's (Gamma, the sweep's rate, the run's key, its rate) where the check reverses a
     growth rate significant in both runs (the test that places the onset): for the grid, the
     finest cell at each Gamma; for the scheme, every limiter."""
-    key = CHECKS[kind][0]
+    key = CHECKS[kind].key
     checked = case.get(kind, [])
     if kind == "grid":
         checked = [min((p for p in checked if p["gamma"] == g), key=lambda p: p["cell"])
@@ -421,14 +436,15 @@ def reversals(case, kind):
 
 
 def reversal_text(kind, gamma, rate, which, other):
-    _, _, reverses, mine, theirs, _ = CHECKS[kind]
-    return (f"{reverses} at Gamma {gamma:g} ({rc.fmt(rate, 3)} per cycle {mine}, "
-            f"{rc.fmt(other, 3)} {theirs.format(f'{which:g}' if kind == 'grid' else which)})")
+    check = CHECKS[kind]
+    value = f"{which:g}" if kind == "grid" else which
+    return (f"{check.reverses} at Gamma {gamma:g} ({rc.fmt(rate, 3)} per cycle {check.mine}, "
+            f"{rc.fmt(other, 3)} {check.theirs.format(value)})")
 
 
 def check_note(cases):
     """The caveat of continuum cases whose growth a grid or scheme check reverses, or ""."""
-    notes = [f"{name}: {reversal_text(kind, *change)}, {CHECKS[kind][5]}"
+    notes = [f"{name}: {reversal_text(kind, *change)}, {CHECKS[kind].consequence}"
              for name, case in solver_cases(cases, "continuum").items()
              for kind in CHECKS for change in reversals(case, kind)]
     return "; ".join(notes)
@@ -436,13 +452,11 @@ def check_note(cases):
 
 def check_lines(case, kind):
     """A continuum case's grid or scheme check: its table and what it finds."""
-    key, heading = CHECKS[kind][:2]
+    key, heading, title = CHECKS[kind][:3]
     checked = sorted(case.get(kind, []), key=lambda p: (
         p["gamma"], -p[key] if kind == "grid" else p[key]))
     if not checked:
         return []
-    title = ("Grid check (the same run at each cell, the box 4 cells deep):" if kind == "grid"
-             else "Scheme check (the same run with other slope limiters at the sweep's cell):")
     lines = ["", title, "", f"| Gamma [g] | {heading} | growth rate [1/cycle] | fastest pattern "
              "mode m | cycles fitted | grid-scale gain |", "| --- | --- | --- | --- | --- | --- |"]
     lines += [f"| {p['gamma']:g} | {p[key]:{'g' if kind == 'grid' else ''}} | "
