@@ -194,24 +194,31 @@ def growth_bands(gamma, rate, rate_error, neighbours=2, significance=SIGNIFICANT
 def fit_zero_crossing(gamma, rate, rate_error, neighbours=2, significance=SIGNIFICANT_GROWTH,
                       holding=None):
     """Gamma_c: the lower edge of the band of growth holding the acceleration `holding` (the
-    saturated pattern's), or without it of the lowest band that has one (growth_bands). The
-    change of sign needs a rate above zero by `significance` of its standard errors. Raises
-    NoGrowthFit when the rates do not change sign so."""
+    saturated pattern's), or without it of the lowest band that has one (growth_bands,
+    lower_edge). The change of sign needs a rate above zero by `significance` of its standard
+    errors. Raises NoGrowthFit when the rates do not change sign so."""
     gamma, rate, error = _sorted_rates(gamma, rate, rate_error)
-    bands = growth_bands(gamma, rate, error, neighbours, significance)
+    return lower_edge(growth_bands(gamma, rate, error, neighbours, significance),
+                      (gamma[0], gamma[-1]), holding, significance)
+
+
+def lower_edge(bands, gamma_range, holding=None, significance=SIGNIFICANT_GROWTH):
+    """The onset from a sweep's bands of growth (growth_bands over Gamma `gamma_range`, its
+    lowest and highest): the lower edge of the band holding `holding`, or without it of the
+    lowest band that has one. Raises NoGrowthFit naming why there is none."""
     if holding is not None:
         band = next((b for b in bands if b.first_gamma <= holding <= b.last_gamma), None)
         if band is None:
             raise NoGrowthFit(f"no band of growth holds Gamma {holding:g}")
         if band.lower is None:
             raise NoGrowthFit(f"the band of growth holding Gamma {holding:g} reaches the "
-                              f"sweep's lowest Gamma {gamma[0]:.4g}")
+                              f"sweep's lowest Gamma {gamma_range[0]:.4g}")
         return band.lower
     edges = [b.lower for b in bands if b.lower is not None]
     if not edges:
         raise NoGrowthFit("the growth rates do not change sign from negative to positive "
-                          f"(by {significance:g} standard errors) over Gamma {gamma[0]:.4g} to "
-                          f"{gamma[-1]:.4g}")
+                          f"(by {significance:g} standard errors) over Gamma "
+                          f"{gamma_range[0]:.4g} to {gamma_range[1]:.4g}")
     return edges[0]
 
 

@@ -46,7 +46,7 @@ import time
 import numpy as np
 
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
-                                             fit_zero_crossing, grid_scale_gain, growth_bands)
+                                             grid_scale_gain, growth_bands, lower_edge)
 from granular_shaker.patterns.onset import (NoOnset, fit_onset, fit_swift_hohenberg, order_bracket,
                                             rising_branch)
 from granular_shaker.patterns.views import column_mass_frames, run_view
@@ -66,13 +66,27 @@ CHECKPOINT_EVERY = 10
 # The continuum's slope limiters a scheme check may try (docs/configuration.md; `none` is for
 # smooth solutions only).
 LIMITERS = ("minmod", "van_leer", "mc", "first_order")
+# The continuum's checks, each run again with one setting changed (the grid: the cell; the
+# scheme: the slope limiter), and the key that names that setting in its runs and points.
+CHECK_KEYS = {"grid": "cell", "scheme": "limiter"}
+
+
+def require_keys(part, keys, where):
+    """ValueError naming the first of `keys` a table of the sweep lacks."""
+    for key in keys:
+        if key not in part:
+            raise ValueError(f"{where} has no '{key}'")
+
+
+def check_some_gamma(part, where):
+    """ValueError unless a table's gamma is increasing and holds at least one value."""
+    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
+        raise ValueError(f"{where}: gamma must be increasing, at least 1")
 
 
 def check_part(repository, part, where):
     """ValueError naming what is wrong with one solver's part of a sweep."""
-    for key in ("cases", "gamma", "seeds", "overrides", "timeout"):
-        if key not in part:
-            raise ValueError(f"{where} has no '{key}'")
+    require_keys(part, ("cases", "gamma", "seeds", "overrides", "timeout"), where)
     for case in part["cases"]:
         if not os.path.isfile(case_file(repository, case)):
             raise ValueError(f"{where}: no case file for '{case}'")
@@ -82,11 +96,8 @@ def check_part(repository, part, where):
 
 def check_saturation(part, where):
     """ValueError naming what is wrong with a continuum part's saturation table."""
-    for key in ("gamma", "cycles", "frames", "timeout"):
-        if key not in part:
-            raise ValueError(f"{where} has no '{key}'")
-    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
-        raise ValueError(f"{where}: gamma must be increasing, at least 1")
+    require_keys(part, ("gamma", "cycles", "frames", "timeout"), where)
+    check_some_gamma(part, where)
     if not (isinstance(part["frames"], int) and isinstance(part["cycles"], int)
             and 2 <= part["frames"] < part["cycles"]):
         raise ValueError(f"{where}: frames {part['frames']!r} and cycles {part['cycles']!r}: "
@@ -95,22 +106,17 @@ def check_saturation(part, where):
 
 def check_grid(part, where):
     """ValueError naming what is wrong with a continuum part's grid table."""
-    for key in ("gamma", "cells", "timeout"):
-        if key not in part:
-            raise ValueError(f"{where} has no '{key}'")
+    require_keys(part, ("gamma", "cells", "timeout"), where)
     cells = part["cells"]
     if len(cells) < 3 or sorted(set(cells), reverse=True) != list(cells) or cells[-1] <= 0:
         raise ValueError(f"{where}: cells {cells!r}: allowed: at least 3, decreasing, > 0")
-    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
-        raise ValueError(f"{where}: gamma must be increasing, at least 1")
+    check_some_gamma(part, where)
 
 
 def check_below(part, sweep, where):
     """ValueError naming what is wrong with a sweep's `below` table: points of some MD cases
     below the sweep's lowest Gamma."""
-    for key in ("cases", "gamma", "timeout"):
-        if key not in part:
-            raise ValueError(f"{where} has no '{key}'")
+    require_keys(part, ("cases", "gamma", "timeout"), where)
     gamma = part["gamma"]
     if not gamma or sorted(set(gamma)) != list(gamma) or gamma[-1] >= sweep["gamma"][0]:
         raise ValueError(f"{where}: gamma {gamma!r}: allowed: increasing, at least 1, each below "
@@ -122,15 +128,12 @@ def check_below(part, sweep, where):
 
 def check_scheme(part, where):
     """ValueError naming what is wrong with a continuum part's scheme table."""
-    for key in ("gamma", "limiters", "timeout"):
-        if key not in part:
-            raise ValueError(f"{where} has no '{key}'")
+    require_keys(part, ("gamma", "limiters", "timeout"), where)
     limiters = part["limiters"]
     if not limiters or len(set(limiters)) != len(limiters) or not set(limiters) <= set(LIMITERS):
         raise ValueError(f"{where}: limiters {limiters!r}: allowed: one or more, distinct, of "
                          + ", ".join(LIMITERS))
-    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
-        raise ValueError(f"{where}: gamma must be increasing, at least 1")
+    check_some_gamma(part, where)
 
 
 def grid_overrides(cell):
@@ -209,11 +212,11 @@ def plan_points(repository, sweep):
     if "grid" in continuum:
         grid = continuum["grid"]
         parts += [("continuum", dict(continuum, **within(continuum, grid)), grid_overrides(cell),
-                   "grid", dict(cell=cell)) for cell in grid["cells"]]
+                   "grid", {CHECK_KEYS["grid"]: cell}) for cell in grid["cells"]]
     if "scheme" in continuum:
         scheme = continuum["scheme"]
         parts += [("continuum", dict(continuum, **within(continuum, scheme)),
-                   [f"continuum.limiter={limiter}"], "scheme", dict(limiter=limiter))
+                   [f"continuum.limiter={limiter}"], "scheme", {CHECK_KEYS["scheme"]: limiter})
                   for limiter in scheme["limiters"]]
     plan = []
     for solver, part, extra, kind, variant in parts:
@@ -341,7 +344,7 @@ def growth_fits(points, holding=None):
     except (NoGrowthFit, ValueError) as reason:
         return dict(onset=dict(reason=str(reason)), bands=[])
     try:
-        onset = vars(fit_zero_crossing(*rates, holding=holding))
+        onset = vars(lower_edge(bands, (min(rates[0]), max(rates[0])), holding))
     except NoGrowthFit as reason:
         onset = dict(reason=str(reason))
     return dict(onset=onset, bands=[dict(first_gamma=b.first_gamma, last_gamma=b.last_gamma,
@@ -412,7 +415,7 @@ def collect(shaker, plan):
         cases[case] = dict(solver=solver, points=points, **found)
         if saturated:
             cases[case]["saturation"] = saturated
-        for kind, key in (("grid", "cell"), ("scheme", "limiter")):
+        for kind, key in CHECK_KEYS.items():
             checked = check_points(plan, case, kind, key)
             if checked:
                 cases[case][kind] = checked

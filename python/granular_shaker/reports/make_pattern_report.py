@@ -18,6 +18,7 @@ import numpy as np
 from granular_shaker.patterns.growth import GRID_SCALE_CELLS, SIGNIFICANT_GROWTH
 from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, order_bracket,
                                             ordered, rising_branch)
+from granular_shaker.patterns.sweep import CHECK_KEYS
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
@@ -389,8 +390,8 @@ def coarse_continuum_note(sweep):
 
 
 class Check(NamedTuple):
-    """How the report names one of the continuum's checks and what it finds."""
-    key: str           # what tells the check's runs apart (in the results' points)
+    """How the report names one of the continuum's checks (sweep.CHECK_KEYS) and what it
+    finds."""
     heading: str       # its column in the check's table
     title: str         # the line above the table
     reverses: str      # a reversal, and the two runs compared: the sweep's and the check's
@@ -402,11 +403,11 @@ class Check(NamedTuple):
 # The growth runs repeated at finer cells (grid) or with other slope limiters at the sweep's
 # cell (scheme).
 CHECKS = {
-    "grid": Check("cell", "cell [sigma]",
+    "grid": Check("cell [sigma]",
                   "Grid check (the same run at each cell, the box 4 cells deep):",
                   "refinement reverses the growth", "at the sweep's cell", "at cell {}",
                   "so its onset there is not the converged continuum's"),
-    "scheme": Check("limiter", "limiter",
+    "scheme": Check("limiter",
                     "Scheme check (the same run with other slope limiters at the sweep's cell):",
                     "another slope limiter reverses the growth", "with the sweep's limiter",
                     "with {}", "so the growth there is the scheme's, not the equations'"),
@@ -417,7 +418,7 @@ def reversals(case, kind):
     """A check's (Gamma, the sweep's rate, the run's key, its rate) where the check reverses a
     growth rate significant in both runs (the test that places the onset): for the grid, the
     finest cell at each Gamma; for the scheme, every limiter."""
-    key = CHECKS[kind].key
+    key = CHECK_KEYS[kind]
     checked = case.get(kind, [])
     if kind == "grid":
         checked = [min((p for p in checked if p["gamma"] == g), key=lambda p: p["cell"])
@@ -452,17 +453,18 @@ def check_note(cases):
 
 def check_lines(case, kind):
     """A continuum case's grid or scheme check: its table and what it finds."""
-    key, heading, title = CHECKS[kind][:3]
+    key, check = CHECK_KEYS[kind], CHECKS[kind]
     checked = sorted(case.get(kind, []), key=lambda p: (
         p["gamma"], -p[key] if kind == "grid" else p[key]))
     if not checked:
         return []
-    lines = ["", title, "", f"| Gamma [g] | {heading} | growth rate [1/cycle] | fastest pattern "
-             "mode m | cycles fitted | grid-scale gain |", "| --- | --- | --- | --- | --- | --- |"]
+    lines = ["", check.title, "", f"| Gamma [g] | {check.heading} | growth rate [1/cycle] | "
+             "fastest pattern mode m | cycles fitted | grid-scale gain |",
+             "| --- | --- | --- | --- | --- | --- |"]
     lines += [f"| {p['gamma']:g} | {p[key]:{'g' if kind == 'grid' else ''}} | "
               f"{rc.fmt(p['rate'])} ± {rc.fmt(p['rate_error'], 2)} | {p['mode']} | "
               f"{p['fit_cycles'][0]:g} to {p['fit_cycles'][1]:g} | "
-              f"{rc.fmt(p['grid_scale_gain'], 3) if 'grid_scale_gain' in p else 'n/a'} |"
+              f"{gain_text(p)} |"
               for p in checked]
     found = [f"- {reversal_text(kind, *change)}" for change in reversals(case, kind)]
     if not found and kind == "grid" and len({p["cell"] for p in checked}) < 2:
@@ -649,6 +651,11 @@ def figure_wavelength(cases, parameters, dispersion):
     return fig
 
 
+def gain_text(point):
+    """A continuum run's grid-scale gain (results made before it was recorded have none)."""
+    return rc.fmt(point["grid_scale_gain"], 3) if "grid_scale_gain" in point else "n/a"
+
+
 def band_text(band):
     """One band of growth in words: its points and its edges (where the rate crosses zero)."""
     def edge(crossing, beyond):
@@ -666,7 +673,7 @@ def continuum_case_lines(name, case):
         lines.append(f"| {p['gamma']:g} | {rc.fmt(p['rate'])} ± {rc.fmt(p['rate_error'], 2)} | "
                      f"{p['mode']} | {rc.fmt(p['mode_wavelength'])} | {p['fit_cycles'][0]:g} to "
                      f"{p['fit_cycles'][1]:g} | {rc.fmt(p['final_order'])} | "
-                     f"{rc.fmt(p['grid_scale_gain'], 3) if 'grid_scale_gain' in p else 'n/a'} |")
+                     f"{gain_text(p)} |")
     lines += [""] + [f"- {band_text(b)}" for b in case.get("bands", [])]
     unresolved = [p["gamma"] for p in case["points"] if p.get("grid_scale_gain", 0.0) > 1.0]
     if unresolved:
