@@ -186,10 +186,26 @@ def rising_branch(points):
     return points[:top + 1]
 
 
+def ordered_run(summary):
+    """One run's (or a bare point's) saturated pattern is an ordered standing wave; without a
+    symmetry measurement (a figure's bare points) it is not."""
+    return (summary.get("a2", 0.0) >= STRIPES_A2
+            and summary.get("correlation_previous_cycle", 0.0) <= SUBHARMONIC_CORRELATION)
+
+
 def ordered(point):
-    """A point without a symmetry measurement (a figure's bare points) is not ordered."""
-    return (point.get("a2", 0.0) >= STRIPES_A2
-            and point.get("correlation_previous_cycle", 0.0) <= SUBHARMONIC_CORRELATION)
+    """Ordered standing waves at the point: in some of its seeds (a point of several seeds
+    counts them in `ordered_seeds`), else by its own values. Near a hysteretic onset the flat
+    layer of one seed orders where another's stays disordered; the onset of order from a flat
+    start is the lowest Gamma where any does."""
+    if "ordered_seeds" in point:
+        return point["ordered_seeds"] > 0
+    return ordered_run(point)
+
+
+def coexisting(point):
+    """Some of the point's seeds ordered and some not: ordered and disordered states coexist."""
+    return 0 < point.get("ordered_seeds", 0) < point.get("seeds", 1)
 
 
 def order_bracket(case):

@@ -48,7 +48,7 @@ import numpy as np
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                              grid_scale_gain, growth_bands, lower_edge)
 from granular_shaker.patterns.onset import (NoOnset, fit_onset, fit_swift_hohenberg, order_bracket,
-                                            rising_branch)
+                                            ordered_run, rising_branch)
 from granular_shaker.patterns.views import column_mass_frames, run_view
 from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
@@ -278,15 +278,19 @@ def standard_error(values):
 
 def point_summary(runs):
     """A point (case, Gamma) from its runs' summaries: the mean over seeds, their standard
-    error (one seed: its frames' standard error)."""
+    error (one seed: its frames' standard error), and how many seeds show ordered waves (the
+    wavelength is then theirs)."""
     order = np.array([r["order"] for r in runs])
     correlation = [r["correlation_previous_cycle"] for r in runs]
     point = dict(order=float(order.mean()), seeds=len(runs),
+                 ordered_seeds=sum(ordered_run(r) for r in runs),
                  order_error=standard_error(order) if order.size > 1 else runs[0]["order_error"],
                  correlation_error=standard_error(correlation) if len(runs) > 1
                  else runs[0].get("correlation_error", float("nan")))
     for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
         point[name] = float(np.mean([r[name] for r in runs]))
+    if 0 < point["ordered_seeds"] < len(runs):   # the stripes' wavelength, not the noise's
+        point["wavelength"] = float(np.mean([r["wavelength"] for r in runs if ordered_run(r)]))
     return point
 
 
@@ -381,31 +385,50 @@ def check_points(plan, case, kind, key):
     return list(points.values())
 
 
+READ_ERRORS = (NoGrowthFit, OSError, KeyError, ValueError)
+
+
+def read_growth(run, columns):
+    """A growth run's final order parameter and growth rate into `run`; its column-mass frames."""
+    frames = column_mass_frames(run["record"]["path"])
+    run["summary"]["final_order"] = float(columns[f"{FIELD}_order_parameter"][-1])
+    run["growth"] = growth_summary(frames)
+    return frames
+
+
+def read_run(shaker, run):
+    """The finished run's summary, growth rate (continuum growth runs) and top view into `run`;
+    the reason it has none of them, or None. A run without a growth rate keeps no summary."""
+    table, reason = analyze(shaker, run["record"])
+    if table is None:
+        return reason
+    columns = read_shaker_csv(table)[0]
+    run["summary"] = frame_summary(columns)
+    # The continuum's growth runs grow or decay to their end: their last frame is the view.
+    growing = run["solver"] == "continuum" and run.get("kind") != "saturation"
+    frames = None
+    if growing:
+        try:
+            frames = read_growth(run, columns)
+        except READ_ERRORS as error:
+            del run["summary"]
+            return f"no growth rate: {error}"
+    try:
+        if frames is None:
+            frames = column_mass_frames(run["record"]["path"])
+        run["view"] = run_view(frames, "last" if growing else "all")
+    except READ_ERRORS as error:
+        return f"no top view or spectrum: {error}"
+    return None
+
+
 def collect(shaker, plan):
     """Every case's points and fits from the finished runs; the failures met."""
     failures, cases = [], {}
     for run in plan:
-        where = f"{run['case']} Gamma {run['gamma']} seed {run['seed']}"
-        table, reason = analyze(shaker, run["record"])
-        if table is None:
-            failures.append(f"{where}: {reason}")
-            continue
-        columns = read_shaker_csv(table)[0]
-        run["summary"] = frame_summary(columns)
-        # The continuum's growth runs grow or decay to their end: their last frame is the view.
-        growing = run["solver"] == "continuum" and run.get("kind") != "saturation"
-        try:
-            frames = column_mass_frames(run["record"]["path"])
-            if growing:
-                run["summary"]["final_order"] = float(columns[f"{FIELD}_order_parameter"][-1])
-                run["growth"] = growth_summary(frames)
-            run["view"] = run_view(frames, "last" if growing else "all")
-        except (NoGrowthFit, OSError, KeyError, ValueError) as error:
-            what = "no top view or spectrum" if "growth" in run or not growing else \
-                "no growth rate"
-            failures.append(f"{where}: {what}: {error}")
-            if what == "no growth rate":
-                del run["summary"]
+        failure = read_run(shaker, run)
+        if failure is not None:
+            failures.append(f"{run['case']} Gamma {run['gamma']} seed {run['seed']}: {failure}")
     for case in dict.fromkeys(r["case"] for r in plan):
         solver = next(r["solver"] for r in plan if r["case"] == case)
         points = case_points(plan, case)

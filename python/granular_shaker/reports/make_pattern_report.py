@@ -16,8 +16,8 @@ from typing import NamedTuple
 import numpy as np
 
 from granular_shaker.patterns.growth import GRID_SCALE_CELLS, SIGNIFICANT_GROWTH
-from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, order_bracket,
-                                            ordered, rising_branch)
+from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, coexisting,
+                                            order_bracket, ordered, rising_branch)
 from granular_shaker.patterns.sweep import CHECK_KEYS
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
@@ -705,21 +705,29 @@ def continuum_case_lines(name, case):
 def case_lines(name, case):
     if case.get("solver") == "continuum":
         return continuum_case_lines(name, case)
-    lines = [f"### {name}", "", "| Gamma [g] | order parameter [1/sigma^2] | seeds | "
+    lines = [f"### {name}", "", "| Gamma [g] | order parameter [1/sigma^2] | seeds (ordered) | "
              "wavelength [sigma] | A2 | cycle-to-cycle correlation (± standard error) |",
              "| --- | --- | --- | --- | --- | --- |"]
     for p in case["points"]:
+        seeds = f"{p['seeds']} ({p['ordered_seeds']})" if "ordered_seeds" in p else p["seeds"]
         lines.append(f"| {p['gamma']:g} | {rc.fmt(p['order'])} ± {rc.fmt(p['order_error'], 2)} "
-                     f"| {p['seeds']} | {rc.fmt(p['wavelength'])} | {rc.fmt(p['a2'], 3)} | "
+                     f"| {seeds} | {rc.fmt(p['wavelength'])} | {rc.fmt(p['a2'], 3)} | "
                      f"{rc.fmt(p['correlation_previous_cycle'], 3)}"
                      + (f" ± {rc.fmt(p['correlation_error'], 1)}"
                         if np.isfinite(p.get("correlation_error", np.nan)) else "") + " |")
     lines.append("")
-    shown = [p["gamma"] for p in case["points"] if ordered(p)]
+    shown = ordered_gammas(case)
     if shown:
         lines.append(f"- ordered standing waves (A2 >= {STRIPES_A2}, cycle-to-cycle correlation "
-                     f"<= {SUBHARMONIC_CORRELATION}) at Gamma "
+                     f"<= {SUBHARMONIC_CORRELATION}, in some seed) at Gamma "
                      + ", ".join(f"{g:g}" for g in shown))
+        mixed = [p for p in case["points"] if coexisting(p)]
+        if mixed:
+            lines.append("- ordered and disordered states coexist (the seeds disagree) at Gamma "
+                         + ", ".join(f"{p['gamma']:g} ({p['ordered_seeds']} of {p['seeds']} "
+                                     "ordered)" for p in mixed)
+                         + ": the onset is hysteretic, and the onset of order from a flat start "
+                         "is the lowest Gamma where any seed orders")
     else:
         lines.append(f"- no ordered standing wave at any Gamma of the sweep (A2 >= {STRIPES_A2} "
                      f"with cycle-to-cycle correlation <= {SUBHARMONIC_CORRELATION} nowhere): the "

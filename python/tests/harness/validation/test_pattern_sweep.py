@@ -95,6 +95,68 @@ def test_a_point_of_several_seeds_takes_their_spread_as_its_error():
     assert sweep.point_summary(runs[:1])["correlation_error"] == 1e-3   # one seed: its frames'
 
 
+def test_seeds_that_disagree_make_a_coexisting_point_and_the_onset_is_the_first_ordered_seed():
+    def run(correlation, wavelength):
+        return dict(order=1.0, order_error=0.1, wavelength=wavelength, a2=0.9, a4=0.5, a6=0.5,
+                    correlation_previous_cycle=correlation, correlation_error=0.01)
+    disordered, ordered = run(-0.1, 60.0), run(-0.7, 20.0)
+    both = sweep.point_summary([disordered, ordered])
+    # The mean correlation (-0.4) fails the test; one seed of two passes it.
+    assert both["correlation_previous_cycle"] == pytest.approx(-0.4)
+    assert both["ordered_seeds"] == 1 and both["wavelength"] == 20.0   # the ordered seed's
+    assert pattern_onset.ordered(both) and pattern_onset.coexisting(both)
+    none = sweep.point_summary([disordered, disordered])
+    every = sweep.point_summary([ordered, ordered])
+    assert not pattern_onset.ordered(none) and not pattern_onset.coexisting(none)
+    assert pattern_onset.ordered(every) and not pattern_onset.coexisting(every)
+    assert none["wavelength"] == 60.0 and every["wavelength"] == 20.0
+    points = [dict(gamma=g, **p) for g, p in
+              zip([1.8, 1.9, 2.0, 2.1, 2.2], [none, none, both, both, every])]
+    for i, p in enumerate(points):
+        p["order"] = 1.0 + i   # one rising branch
+    assert pattern_onset.order_bracket(dict(points=points))[2:] == (1.9, 2.0)
+    text = "\n".join(make_pattern_report.case_lines("pattern_md_f0p14", dict(points=points)))
+    assert "| 2 | 3 ± 0 | 2 (1) |" in text and "| 2.2 | 5 ± 0 | 2 (2) |" in text
+    assert "coexist (the seeds disagree) at Gamma 2 (1 of 2 ordered), 2.1 (1 of 2 ordered)" \
+        in text
+    assert "- onset of order bracketed by the sweep: Gamma_c = 1.95" in text
+
+
+def test_a_run_that_cannot_be_read_names_the_step_that_failed(monkeypatch):
+    columns = table([0.0, 0.0], [0.1, 0.2], [np.nan, -0.9])
+    monkeypatch.setattr(sweep, "analyze", lambda shaker, record: ("run.csv", None))
+    monkeypatch.setattr(sweep, "read_shaker_csv", lambda path: (columns,))
+    monkeypatch.setattr(sweep, "column_mass_frames", lambda path: "frames")
+
+    def fails(error):
+        def raise_it(*args):
+            raise error
+        return raise_it
+
+    def read(solver, kind=None):
+        run = dict(solver=solver, record=dict(path="run.h5", status="ok"))
+        if kind:
+            run["kind"] = kind
+        return sweep.read_run("shaker", run), run
+
+    monkeypatch.setattr(sweep, "growth_summary", fails(sweep.NoGrowthFit("too short")))
+    failure, run = read("continuum")
+    assert failure == "no growth rate: too short" and "summary" not in run
+    # A saturation run measures no growth: only its view fails.
+    monkeypatch.setattr(sweep, "run_view", fails(ValueError("no frame")))
+    failure, run = read("continuum", "saturation")
+    assert failure == "no top view or spectrum: no frame" and run["summary"]["order"] > 0.0
+    monkeypatch.setattr(sweep, "growth_summary", lambda frames: dict(rate=0.1))
+    failure, run = read("continuum")
+    assert failure == "no top view or spectrum: no frame" and run["growth"] == dict(rate=0.1)
+    assert run["summary"]["final_order"] == pytest.approx(0.2)
+    monkeypatch.setattr(sweep, "column_mass_frames", fails(OSError("unreadable")))
+    failure, run = read("md")
+    assert failure == "no top view or spectrum: unreadable" and "summary" in run
+    monkeypatch.setattr(sweep, "analyze", lambda shaker, record: (None, "run timeout"))
+    assert read("md")[0] == "run timeout"
+
+
 def test_an_unknown_study_is_refused(work_dir, shaker):
     with pytest.raises(SystemExit) as exit_info:
         sweep.main(["--shaker", shaker, "--study", "huge", "--repository",
