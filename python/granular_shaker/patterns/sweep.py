@@ -294,11 +294,26 @@ def point_summary(runs):
     return point
 
 
+def check_against_bracket(onset, bracket):
+    """Raises NoOnset when the fitted onset lies, by more than its error, outside the sweep's
+    bracket of ordered points (low, high): it then places the rise of the disordered
+    fluctuations (or a jump the supercritical form cannot follow), not the onset of order."""
+    if bracket is None:
+        return
+    low, high = bracket[2:]
+    if onset.gamma_c + onset.gamma_c_error < low or onset.gamma_c - onset.gamma_c_error > high:
+        raise NoOnset(f"the supercritical fit's onset {onset.gamma_c:.4g} ± "
+                      f"{onset.gamma_c_error:.2g} (chi^2 per degree of freedom "
+                      f"{onset.chi2_per_dof:.3g}) lies outside the sweep's bracket of ordered "
+                      f"points, {low:g} to {high:g}: it is not the onset of order")
+
+
 def fits(points):
     """The onset and Swift-Hohenberg fits of one case's points (the onset on the rising
-    branch), or the reason there are none. The Swift-Hohenberg fit takes the points below the
-    fitted onset (less its error), or where the onset fit cannot place it, those below the
-    sweep's bracket of ordered points (order_bracket)."""
+    branch), or the reason there are none. The fitted onset stands only within the sweep's
+    bracket of ordered points (order_bracket), where there is one. The Swift-Hohenberg fit takes
+    the points below the fitted onset (less its error), or where the onset fit cannot place it,
+    those below the bracket's first ordered point."""
     rising = rising_branch(points)
     usable = [p for p in rising if np.isfinite(p["order_error"]) and p["order_error"] > 0]
     if 0 < len(rising) < 5 <= len(points):
@@ -309,13 +324,14 @@ def fits(points):
     order = np.array([p["order"] for p in usable])
     error = np.array([p["order_error"] for p in usable])
     out = {}
+    bracket = order_bracket(dict(points=points))
     try:
         onset = fit_onset(gamma, order, error)
+        check_against_bracket(onset, bracket)
         out["onset"] = vars(onset)
         below = onset.gamma_c - onset.gamma_c_error
     except (NoOnset, ValueError) as reason:
         out["onset"] = dict(reason=str(reason))
-        bracket = order_bracket(dict(points=points))
         if bracket is None:
             return out
         below = bracket[3]
@@ -323,7 +339,7 @@ def fits(points):
         out["swift_hohenberg"] = dict(vars(fit_swift_hohenberg(gamma, order, error, below)),
                                       below=float(below))
     except (NoOnset, ValueError) as reason:
-        out["swift_hohenberg"] = dict(reason=str(reason))
+        out["swift_hohenberg"] = dict(reason=str(reason), below=float(below))
     return out
 
 

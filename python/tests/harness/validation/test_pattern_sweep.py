@@ -181,7 +181,7 @@ def test_a_small_sweep_runs_resumes_and_reports(work_dir, shaker):
         assert 0.0 < p["order"] < 10.0 and 0.0 < p["order_error"] < p["order"]
     onset = first["cases"]["pattern_md_f0p18"]["onset"]
     assert "gamma_c" in onset or "does not" in onset["reason"] \
-        or "rising branch holds" in onset["reason"]
+        or "rising branch holds" in onset["reason"] or "not the onset of order" in onset["reason"]
     assert all(not r["reused"] for r in first["runs"])
     # Resumed: every run reused, the same numbers.
     assert sweep.main(arguments + ["--reuse-only"]) == 0
@@ -438,6 +438,33 @@ def test_the_onset_is_fitted_on_the_rising_branch_only():
     assert sweep.rising_branch([]) == []
     early = [dict(p, order=2.0 - 0.1 * i) for i, p in enumerate(points)]  # falls from the 1st
     assert "rising branch holds 1 points" in sweep.fits(early)["onset"]["reason"]
+
+
+def test_a_fitted_onset_outside_the_bracket_of_ordered_points_is_not_the_onset_of_order():
+    # The measured f = 0.18 sweep: the disordered layer's order parameter rises slowly to 2.1,
+    # jumps into stripes at 2.2; the supercritical form puts its onset near 2.0, below the
+    # disordered points at 2.05 and 2.1, with chi^2 per degree of freedom in the hundreds.
+    measured = [(1.9, 0.5956, 0.017, 0.09), (2.0, 0.6749, 0.016, -0.02),
+                (2.05, 0.7559, 0.014, -0.06), (2.1, 0.7367, 0.013, -0.18),
+                (2.2, 1.201, 0.013, -0.70), (2.3, 1.693, 0.0044, -0.78),
+                (2.4, 1.839, 0.0099, -0.79), (2.6, 1.975, 0.018, -0.75),
+                (2.8, 2.029, 0.011, -0.72)]
+    points = [dict(gamma=g, order=m, order_error=e, a2=1.0, correlation_previous_cycle=c)
+              for g, m, e, c in measured]
+    gamma, order, error = (np.array(column) for column in list(zip(*measured))[:3])
+    fitted = pattern_onset.fit_onset(gamma, order, error)
+    assert fitted.gamma_c + fitted.gamma_c_error < 2.1 and fitted.chi2_per_dof > 100
+    found = sweep.fits(points)
+    assert "gamma_c" not in found["onset"]
+    assert "outside the sweep's bracket of ordered points, 2.1 to 2.2" in found["onset"]["reason"]
+    # The points below the bracket (1.9 to 2.1) do not diverge towards an onset: 2.1 lies below
+    # 2.05.
+    assert found["swift_hohenberg"]["below"] == 2.2
+    assert "do not grow towards a mean-field onset" in found["swift_hohenberg"]["reason"]
+    # An onset inside the bracket stands: the supercritical form exact, onset 2.15.
+    inside = [dict(p, order=float(np.sqrt(0.36 + 10.0 * max(p["gamma"] - 2.15, 0.0))))
+              for p in points]
+    assert sweep.fits(inside)["onset"]["gamma_c"] == pytest.approx(2.15, abs=1e-3)
 
 
 def test_a_continuum_without_an_onset_is_named_as_the_reason():
