@@ -15,10 +15,6 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-bool same_grid(const HorizontalGrid& a, const HorizontalGrid& b) {
-  return a.nx == b.nx && a.ny == b.ny && a.lx == b.lx && a.ly == b.ly;
-}
-
 void check_field(const HorizontalField& f) {
   check_grid(f.grid);
   if (f.values.size() != f.grid.cells())
@@ -33,6 +29,10 @@ double mean_of(const std::vector<double>& v) {
 }
 
 }  // namespace
+
+bool same_grid(const HorizontalGrid& a, const HorizontalGrid& b) {
+  return a.nx == b.nx && a.ny == b.ny && a.lx == b.lx && a.ly == b.ly;
+}
 
 double field_correlation(const HorizontalField& a, const HorizontalField& b) {
   check_field(a);

@@ -25,6 +25,8 @@ struct HorizontalGrid {
 
 /// Throws InputError unless nx, ny >= 1 and Lx, Ly are finite and positive.
 void check_grid(const HorizontalGrid& grid);
+/// The same cells over the same box.
+bool same_grid(const HorizontalGrid& a, const HorizontalGrid& b);
 
 /// One value per cell, row-major: values[j * nx + i] (x varies fastest).
 struct HorizontalField {
@@ -134,6 +136,15 @@ PatternSymmetry classify_symmetry(double a2, double a4, double a6, double thresh
 /// Pearson correlation of two fields on the same grid over the cells (NaN if either is
 /// uniform).
 double field_correlation(const HorizontalField& a, const HorizontalField& b);
+
+/// Pearson correlation of `now` with `before` translated by half a wavelength along the
+/// wavevector k0 of `now`'s strongest Fourier mode (of k0 and -k0 the one with kx > 0, or kx = 0
+/// and ky > 0; by d = pi k0 / |k0|^2, in Fourier space:
+/// F_before(k) exp(-i k.d)). A subharmonic standing wave repeats one drive cycle later shifted
+/// by half its wavelength, whatever its waveform: +1 for it, where field_correlation gives -1
+/// only for a sinusoid (the even harmonics of a steep wave do not invert). NaN if either field
+/// is uniform; InputError for differing grids or a value that is not finite.
+double half_wavelength_correlation(const HorizontalField& before, const HorizontalField& now);
 
 /// The correlation of the fields at one phase of consecutive cycles, averaged over the pairs
 /// (0-1, 1-2, ...): -1 for a pattern that inverts every cycle (subharmonic, period two drive

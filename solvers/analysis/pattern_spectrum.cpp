@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -57,7 +58,11 @@ double PowerSpectrum::total() const {
   return sum;
 }
 
-PowerSpectrum power_spectrum(const HorizontalField& field) {
+namespace {
+
+/// F(k) of the mean-removed field (pattern.hpp, PowerSpectrum), packed re, im per mode
+/// [j * nx + i].
+std::vector<double> fourier_coefficients(const HorizontalField& field) {
   check_grid(field.grid);
   const std::size_t nx = field.grid.nx, ny = field.grid.ny, cells = field.grid.cells();
   if (field.values.size() != cells)
@@ -72,11 +77,52 @@ PowerSpectrum power_spectrum(const HorizontalField& field) {
   for (std::size_t c = 0; c < cells; ++c) data[2 * c] = field.values[c] - mean;
   fft_lines(data, nx, 1, ny, nx);  // rows: along x
   fft_lines(data, ny, nx, nx, 1);  // columns: along y
+  return data;
+}
+
+}  // namespace
+
+PowerSpectrum power_spectrum(const HorizontalField& field) {
+  const std::vector<double> data = fourier_coefficients(field);
+  const std::size_t cells = field.grid.cells();
   PowerSpectrum spectrum{field.grid, std::vector<double>(cells)};
   const double norm = 1.0 / (static_cast<double>(cells) * static_cast<double>(cells));
   for (std::size_t c = 0; c < cells; ++c)
     spectrum.power[c] = (data[2 * c] * data[2 * c] + data[2 * c + 1] * data[2 * c + 1]) * norm;
   return spectrum;
+}
+
+double half_wavelength_correlation(const HorizontalField& before, const HorizontalField& now) {
+  if (!same_grid(before.grid, now.grid))
+    throw InputError(fmt::format("half-wavelength correlation: grids {} x {} over {} x {} and {} x {} "
+                                 "over {} x {}; allowed: the same grid", before.grid.nx, before.grid.ny,
+                                 before.grid.lx, before.grid.ly, now.grid.nx, now.grid.ny, now.grid.lx,
+                                 now.grid.ly));
+  const std::vector<double> a = fourier_coefficients(before), b = fourier_coefficients(now);
+  const PowerSpectrum modes{now.grid, {}};  // for kx, ky
+  const std::size_t nx = now.grid.nx, cells = now.grid.cells();
+  std::size_t strongest = 0;
+  double aa = 0.0, bb = 0.0, top = 0.0;
+  for (std::size_t c = 0; c < cells; ++c) {
+    const double power = b[2 * c] * b[2 * c] + b[2 * c + 1] * b[2 * c + 1];
+    if (power > top) top = power, strongest = c;
+    aa += a[2 * c] * a[2 * c] + a[2 * c + 1] * a[2 * c + 1], bb += power;
+  }
+  if (!(aa > 0.0) || !(bb > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  double k0x = modes.kx(strongest % nx), k0y = modes.ky(strongest / nx);
+  // k0 and -k0 carry the same power: take the one with kx > 0 (or kx = 0, ky > 0), so that the
+  // shift does not hang on the last bits of the two.
+  if (k0x < 0.0 || (k0x == 0.0 && k0y < 0.0)) k0x = -k0x, k0y = -k0y;
+  const double scale = M_PI / (k0x * k0x + k0y * k0y);
+  const double dx = scale * k0x, dy = scale * k0y;
+  double ab = 0.0;  // Re sum F_shifted(k) conj F_now(k)
+  for (std::size_t c = 0; c < cells; ++c) {
+    const std::complex<double> shifted =
+        std::complex<double>(a[2 * c], a[2 * c + 1]) *
+        std::polar(1.0, -(modes.kx(c % nx) * dx + modes.ky(c / nx) * dy));
+    ab += std::real(shifted * std::complex<double>(b[2 * c], -b[2 * c + 1]));
+  }
+  return ab / std::sqrt(aa * bb);
 }
 
 double shell_width(const HorizontalGrid& grid) { return two_pi / std::max(grid.lx, grid.ly); }

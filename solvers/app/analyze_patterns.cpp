@@ -136,28 +136,42 @@ std::optional<std::size_t> previous_cycle(const std::vector<FramePatterns>& fram
   return std::nullopt;
 }
 
-std::string measure_columns(const analysis::PatternMeasure& m, double correlation) {
-  return fmt::format("{},{},{},{},{},{},{},{}", m.dominant.k, m.dominant.wavelength, m.symmetry.a2,
+/// A frame's correlations with the same phase one cycle earlier (NaN without that frame).
+struct Correlations {
+  double plain = NAN, half_wavelength = NAN;
+};
+
+Correlations correlations(const std::optional<std::size_t>& before, const std::vector<FramePatterns>& frames,
+                          analysis::HorizontalField FramePatterns::*field, std::size_t f) {
+  if (!before) return {};
+  const analysis::HorizontalField &a = frames[*before].*field, &b = frames[f].*field;
+  return {analysis::field_correlation(a, b), analysis::half_wavelength_correlation(a, b)};
+}
+
+std::string measure_columns(const analysis::PatternMeasure& m, const Correlations& c) {
+  return fmt::format("{},{},{},{},{},{},{},{},{}", m.dominant.k, m.dominant.wavelength, m.symmetry.a2,
                      m.symmetry.a4, m.symmetry.a6, analysis::to_string(m.symmetry.symmetry),
-                     m.order_parameter, correlation);
+                     m.order_parameter, c.plain, c.half_wavelength);
 }
 
 /// "# patterns at phase P, FIELD over N cycles: ..." for one stored phase and field.
 std::string summary_line(double phase, const char* field, const char* unit,
                          const std::vector<analysis::PatternMeasure>& measures,
-                         const std::vector<double>& correlations) {
+                         const std::vector<Correlations>& pairs) {
   const analysis::PatternSummary s = analysis::summarize_patterns(measures);
-  const analysis::MeanAndError c = analysis::mean_and_error(correlations);
+  std::vector<double> plain, shifted;
+  for (const Correlations& pair : pairs) plain.push_back(pair.plain), shifted.push_back(pair.half_wavelength);
+  const analysis::MeanAndError c = analysis::mean_and_error(plain), h = analysis::mean_and_error(shifted);
   const auto e = [](const analysis::MeanAndError& m) {
     return fmt::format("{:.4g} ({:.2g})", m.mean, m.standard_error);
   };
   return fmt::format("# patterns at phase {}, {} over {} frame(s): k* {} 1/sigma, wavelength {} sigma, "
-                     "A2 {}, A4 {}, A6 {} ({}), order parameter {} {}, cycle-to-cycle correlation {} over "
-                     "{} pair(s)\n", phase, field, measures.size(), e(s.k), e(s.wavelength), e(s.a2),
-                     e(s.a4), e(s.a6),
+                     "A2 {}, A4 {}, A6 {} ({}), order parameter {} {}, cycle-to-cycle correlation {} "
+                     "(half-wavelength shifted {}) over {} pair(s)\n", phase, field, measures.size(), e(s.k),
+                     e(s.wavelength), e(s.a2), e(s.a4), e(s.a6),
                      analysis::to_string(analysis::classify_symmetry(s.a2.mean, s.a4.mean, s.a6.mean,
                                                                      analysis::SymmetryOptions{}.threshold)),
-                     e(s.order_parameter), unit, e(c), c.samples);
+                     e(s.order_parameter), unit, e(c), e(h), c.samples);
 }
 
 }  // namespace
@@ -189,19 +203,20 @@ PatternTables pattern_tables(const std::filesystem::path& snapshots, double cell
   std::string csv = "cycle [1],phase [1],time [sqrt(sigma/g)]";
   for (const char* field : {"mass", "height"})
     csv += fmt::format(",{0}_k [1/sigma],{0}_wavelength [sigma],{0}_a2 [1],{0}_a4 [1],{0}_a6 [1],{0}_symmetry,"
-                       "{0}_order_parameter [{1}],{0}_correlation_previous_cycle [1]", field,
+                       "{0}_order_parameter [{1}],{0}_correlation_previous_cycle [1],"
+                       "{0}_half_wavelength_correlation [1]", field,
                        field == std::string("mass") ? "1/sigma^2" : "sigma");
   csv += "\n";
   struct PerPhase {
     std::vector<analysis::PatternMeasure> mass, height;
-    std::vector<double> mass_correlation, height_correlation;
+    std::vector<Correlations> mass_correlation, height_correlation;
   };
   std::vector<std::pair<double, PerPhase>> per_phase;
   for (std::size_t f = 0; f < frames.size(); ++f) {
     const auto& fr = frames[f];
     const auto before = previous_cycle(frames, f);
-    const double mass_c = before ? analysis::field_correlation(frames[*before].mass, fr.mass) : NAN;
-    const double height_c = before ? analysis::field_correlation(frames[*before].height, fr.height) : NAN;
+    const Correlations mass_c = correlations(before, frames, &FramePatterns::mass, f);
+    const Correlations height_c = correlations(before, frames, &FramePatterns::height, f);
     csv += fmt::format("{},{},{},{},{}\n", fr.cycle, fr.phase, fr.time, measure_columns(fr.mass_measure, mass_c),
                        measure_columns(fr.height_measure, height_c));
     auto at = std::find_if(per_phase.begin(), per_phase.end(),

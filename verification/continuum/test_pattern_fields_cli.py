@@ -17,7 +17,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from pattern_reference import correlation, measure
+from pattern_reference import correlation, half_wavelength_correlation, measure
 
 NX, NY, H = 6, 4, 1.0
 
@@ -93,5 +93,8 @@ def test_values_equal_the_definitions(analysed):
     for f in (2, 3):  # the second cycle's snapshots follow the first's at the same phase
         for index, name in ((0, "mass"), (1, "height")):
             got = float(rows[f][f"{name}_correlation_previous_cycle [1]"])
-            expected = correlation(computed[f - 2][index], computed[f][index])
-            assert got == pytest.approx(expected, rel=1e-9, abs=1e-12)
+            a, b = computed[f - 2][index], computed[f][index]
+            assert got == pytest.approx(correlation(a, b), rel=1e-9, abs=1e-12)
+            shifted = float(rows[f][f"{name}_half_wavelength_correlation [1]"])
+            assert shifted == pytest.approx(half_wavelength_correlation(a, b, edges), rel=1e-9,
+                                            abs=1e-12)

@@ -16,7 +16,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from pattern_reference import correlation, measure
+from pattern_reference import correlation, half_wavelength_correlation, measure
 
 WIDTH, PARTICLES, CELL = 16.0, 300, 2.0
 
@@ -97,11 +97,14 @@ def test_values_equal_the_definitions(shaker, work_dir):
                   and frames["phase"][g] == frames["phase"][f]]
         for index, name in ((0, "mass"), (1, "height")):
             got = float(rows[f][f"{name}_correlation_previous_cycle [1]"])
+            shifted = float(rows[f][f"{name}_half_wavelength_correlation [1]"])
             if not before:
-                assert np.isnan(got)
+                assert np.isnan(got) and np.isnan(shifted)
             else:
-                expected = correlation(computed[before[0]][index], computed[f][index])
-                assert got == pytest.approx(expected, rel=1e-9, abs=1e-12)
+                a, b = computed[before[0]][index], computed[f][index]
+                assert got == pytest.approx(correlation(a, b), rel=1e-9, abs=1e-12)
+                assert shifted == pytest.approx(
+                    half_wavelength_correlation(a, b, frames["edges"]), rel=1e-9, abs=1e-12)
 
 
 def test_a_cell_wider_than_half_the_box_is_refused(shaker, work_dir):

@@ -292,6 +292,43 @@ TEST(PatternSubharmonic, CorrelationFromCycleToCycle) {
   EXPECT_NEAR(mean_error / expected, 1.0, 0.1);
 }
 
+// A subharmonic standing wave repeats one cycle later shifted by half its wavelength, whatever
+// its waveform. A steep one carries even harmonics, which that shift leaves in place: the plain
+// correlation then misses -1, the half-wavelength correlation still gives +1.
+TEST(PatternSubharmonic, HalfWavelengthCorrelationSeesSteepStripesInvert) {
+  const HorizontalGrid g{64, 4, 128.0, 8.0};
+  const double k = two_pi * 5 / 128.0;
+  const auto steep = [k](double sign) {
+    return [k, sign](double x, double) { return sign * std::cos(k * x) + 0.6 * std::cos(2.0 * k * x); };
+  };
+  const HorizontalField up = sampled(g, steep(1.0)), down = sampled(g, steep(-1.0));
+  // Power 1/2 inverts, 0.18 stays: (0.18 - 0.5) / 0.68.
+  EXPECT_NEAR(an::field_correlation(up, down), (0.18 - 0.5) / 0.68, 1e-9);
+  EXPECT_NEAR(an::half_wavelength_correlation(up, down), 1.0, 1e-9);
+  EXPECT_NEAR(an::half_wavelength_correlation(down, up), 1.0, 1e-9);
+  // A sinusoid: the shift is the inversion, so the two correlations are opposite; a pattern
+  // that repeats unshifted (harmonic) gives -1.
+  const HorizontalField wave = sampled(g, stripes(k, 0.0, 0.3)), inverted = sampled(g, stripes(k, 0.0, 0.3 + M_PI));
+  EXPECT_NEAR(an::half_wavelength_correlation(wave, inverted), 1.0, 1e-9);
+  EXPECT_NEAR(an::half_wavelength_correlation(wave, wave), -1.0, 1e-9);
+  // Oblique stripes on a square box: the shift runs along their wavevector.
+  const HorizontalGrid square{32, 32, 32.0, 32.0};
+  const double kx = two_pi * 3 / 32.0, ky = two_pi * 2 / 32.0;
+  const auto oblique = [kx, ky](double sign) {
+    return [=](double x, double y) {
+      const double phase = kx * x + ky * y;
+      return sign * std::cos(phase) + 0.5 * std::cos(2.0 * phase);
+    };
+  };
+  EXPECT_NEAR(an::half_wavelength_correlation(sampled(square, oblique(1.0)), sampled(square, oblique(-1.0))),
+              1.0, 1e-9);
+  // Independent noise: near 0 (one pair of 1024 cells scatters by about 1 / sqrt(1024)).
+  EXPECT_LT(std::abs(an::half_wavelength_correlation(white_noise(square, 7), white_noise(square, 8))), 0.1);
+  EXPECT_TRUE(std::isnan(an::half_wavelength_correlation(sampled(g, [](double, double) { return 2.0; }), up)));
+  shaker::testing::expect_input_error([&] { an::half_wavelength_correlation(up, white_noise(square, 1)); },
+                     {"half-wavelength correlation", "the same grid"});
+}
+
 // ---- Order parameter and saturation --------------------------------------------------------
 
 struct Growth {

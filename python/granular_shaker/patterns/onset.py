@@ -31,10 +31,10 @@ import numpy as np
 
 PROFILE_POINTS = 4001
 # A point shows an ordered standing wave when its spectrum's angular moments name stripes (A2,
-# docs/analysis.md "Patterns": the symmetry threshold) and its pattern inverts from one cycle to
-# the next (the subharmonic response).
+# docs/analysis.md "Patterns": the symmetry threshold) and its pattern repeats from one cycle to
+# the next shifted by half a wavelength (the subharmonic response, whatever the waveform).
 STRIPES_A2 = 0.5
-SUBHARMONIC_CORRELATION = -0.5
+SUBHARMONIC_CORRELATION = 0.5
 
 
 class NoOnset(ValueError):
@@ -190,7 +190,7 @@ def ordered_run(summary):
     """One run's (or a bare point's) saturated pattern is an ordered standing wave; without a
     symmetry measurement (a figure's bare points) it is not."""
     return (summary.get("a2", 0.0) >= STRIPES_A2
-            and summary.get("correlation_previous_cycle", 0.0) <= SUBHARMONIC_CORRELATION)
+            and summary.get("half_wavelength_correlation", 0.0) >= SUBHARMONIC_CORRELATION)
 
 
 def ordered(point):

@@ -234,13 +234,21 @@ def plan_points(repository, sweep):
     return plan
 
 
+def has_every_column(table):
+    """Whether a kept pattern table has the columns this sweep reads (one made by an older
+    `shaker analyze` is made again)."""
+    with open(table) as f:
+        header = next((line for line in f if not line.startswith("#")), "")
+    return all(f"{FIELD}_{name} " in header for name in CORRELATIONS)
+
+
 def analyze(shaker, record):
     """The pattern table of a finished run (made once, kept beside the run file); None and a
     reason when there is none."""
     if record["status"] != "ok":
         return None, f"run {record['status']}"
     table = record["path"] + ".patterns.csv"
-    if not os.path.exists(table):
+    if not os.path.exists(table) or not has_every_column(table):
         result = subprocess.run([shaker, "analyze", record["path"], "--patterns",
                                  table + ".partial"], capture_output=True, text=True)
         if result.returncode != 0:
@@ -248,6 +256,14 @@ def analyze(shaker, record):
                          f"{result.stderr.strip()[-500:]}"
         os.replace(table + ".partial", table)
     return table, None
+
+
+# The correlations of a frame with the same phase one cycle earlier (docs/analysis.md,
+# "Patterns"), each with the name of its standard error: plain (-1 for a sinusoidal wave that
+# inverts) and with the earlier frame shifted by half a wavelength (+1 for a subharmonic
+# standing wave of any waveform; the ordered test's).
+CORRELATIONS = {"correlation_previous_cycle": "correlation_error",
+                "half_wavelength_correlation": "half_wavelength_error"}
 
 
 def frame_summary(columns):
@@ -261,12 +277,12 @@ def frame_summary(columns):
         if best is None or order.mean() > best["order"]:
             best = dict(phase=float(phase), frames=int(at.sum()), order=float(order.mean()),
                         order_error=standard_error(order))
-            for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
+            for name in ("wavelength", "a2", "a4", "a6", *CORRELATIONS):
                 values = columns[f"{FIELD}_{name}"][at]
                 values = values[np.isfinite(values)]
                 best[name] = float(values.mean()) if values.size else float("nan")
-                if name == "correlation_previous_cycle":
-                    best["correlation_error"] = standard_error(values)
+                if name in CORRELATIONS:
+                    best[CORRELATIONS[name]] = standard_error(values)
     return best
 
 
@@ -281,13 +297,13 @@ def point_summary(runs):
     error (one seed: its frames' standard error), and how many seeds show ordered waves (the
     wavelength is then theirs)."""
     order = np.array([r["order"] for r in runs])
-    correlation = [r["correlation_previous_cycle"] for r in runs]
     point = dict(order=float(order.mean()), seeds=len(runs),
                  ordered_seeds=sum(ordered_run(r) for r in runs),
-                 order_error=standard_error(order) if order.size > 1 else runs[0]["order_error"],
-                 correlation_error=standard_error(correlation) if len(runs) > 1
-                 else runs[0].get("correlation_error", float("nan")))
-    for name in ("wavelength", "a2", "a4", "a6", "correlation_previous_cycle"):
+                 order_error=standard_error(order) if order.size > 1 else runs[0]["order_error"])
+    for name, error in CORRELATIONS.items():
+        point[error] = standard_error([r[name] for r in runs]) if len(runs) > 1 \
+            else runs[0].get(error, float("nan"))
+    for name in ("wavelength", "a2", "a4", "a6", *CORRELATIONS):
         point[name] = float(np.mean([r[name] for r in runs]))
     if 0 < point["ordered_seeds"] < len(runs):   # the stripes' wavelength, not the noise's
         point["wavelength"] = float(np.mean([r["wavelength"] for r in runs if ordered_run(r)]))

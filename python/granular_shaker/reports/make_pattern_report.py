@@ -18,7 +18,7 @@ import numpy as np
 from granular_shaker.patterns.growth import GRID_SCALE_CELLS, SIGNIFICANT_GROWTH
 from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, coexisting,
                                             order_bracket, ordered, rising_branch)
-from granular_shaker.patterns.sweep import CHECK_KEYS
+from granular_shaker.patterns.sweep import CHECK_KEYS, CORRELATIONS
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
@@ -697,29 +697,41 @@ def continuum_case_lines(name, case):
         lines.append(f"- saturated at Gamma {p['gamma']:g} (over the last frames of a long "
                      f"run): order parameter {rc.fmt(p['order'])} ± "
                      f"{rc.fmt(p['order_error'], 2)} [1/sigma^2], wavelength "
-                     f"{rc.fmt(p['wavelength'])} sigma, A2 {rc.fmt(p['a2'], 3)}, cycle-to-cycle "
-                     f"correlation {rc.fmt(p['correlation_previous_cycle'], 3)}")
+                     f"{rc.fmt(p['wavelength'])} sigma, A2 {rc.fmt(p['a2'], 3)}, "
+                     f"{correlations_text(p)}")
     return lines + [""]
+
+
+def correlations_text(point, named=True):
+    """A point's cycle-to-cycle correlations, plain and half-wavelength shifted, with errors."""
+    texts = []
+    for name, error in CORRELATIONS.items():
+        text = rc.fmt(point.get(name, np.nan), 3)
+        if np.isfinite(point.get(error, np.nan)):
+            text += f" ± {rc.fmt(point[error], 1)}"
+        texts.append(text)
+    if named:
+        return f"cycle-to-cycle correlation {texts[0]}, half-wavelength shifted {texts[1]}"
+    return "; ".join(texts)
 
 
 def case_lines(name, case):
     if case.get("solver") == "continuum":
         return continuum_case_lines(name, case)
     lines = [f"### {name}", "", "| Gamma [g] | order parameter [1/sigma^2] | seeds (ordered) | "
-             "wavelength [sigma] | A2 | cycle-to-cycle correlation (± standard error) |",
+             "wavelength [sigma] | A2 | cycle-to-cycle correlation, plain and half-wavelength "
+             "shifted (± standard error) |",
              "| --- | --- | --- | --- | --- | --- |"]
     for p in case["points"]:
         seeds = f"{p['seeds']} ({p['ordered_seeds']})" if "ordered_seeds" in p else p["seeds"]
         lines.append(f"| {p['gamma']:g} | {rc.fmt(p['order'])} ± {rc.fmt(p['order_error'], 2)} "
                      f"| {seeds} | {rc.fmt(p['wavelength'])} | {rc.fmt(p['a2'], 3)} | "
-                     f"{rc.fmt(p['correlation_previous_cycle'], 3)}"
-                     + (f" ± {rc.fmt(p['correlation_error'], 1)}"
-                        if np.isfinite(p.get("correlation_error", np.nan)) else "") + " |")
+                     f"{correlations_text(p, named=False)} |")
     lines.append("")
     shown = ordered_gammas(case)
     if shown:
-        lines.append(f"- ordered standing waves (A2 >= {STRIPES_A2}, cycle-to-cycle correlation "
-                     f"<= {SUBHARMONIC_CORRELATION}, in some seed) at Gamma "
+        lines.append(f"- ordered standing waves (A2 >= {STRIPES_A2}, half-wavelength shifted "
+                     f"correlation >= {SUBHARMONIC_CORRELATION}, in some seed) at Gamma "
                      + ", ".join(f"{g:g}" for g in shown))
         mixed = [p for p in case["points"] if coexisting(p)]
         if mixed:
@@ -730,7 +742,8 @@ def case_lines(name, case):
                          "is the lowest Gamma where any seed orders")
     else:
         lines.append(f"- no ordered standing wave at any Gamma of the sweep (A2 >= {STRIPES_A2} "
-                     f"with cycle-to-cycle correlation <= {SUBHARMONIC_CORRELATION} nowhere): the "
+                     f"with half-wavelength shifted correlation >= {SUBHARMONIC_CORRELATION} "
+                     "nowhere): the "
                      "order parameter is the layer's disordered fluctuation, and an onset fitted "
                      "to it is the rise of that noise, not a pattern's onset")
     for model, key, parameter in (("onset fit", "onset", "gamma_c"),

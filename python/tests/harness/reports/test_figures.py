@@ -225,9 +225,9 @@ def pattern_views():
                     power=power, power_error=[p / 10 for p in power] if frames > 1 else
                     [None] * 16, fields={"0": field.tolist(), "0.5": (-0.3 * field).tolist()})
 
-    md = [dict(gamma=g, order=o, order_error=0.02, a2=1.0, correlation_previous_cycle=c,
+    md = [dict(gamma=g, order=o, order_error=0.02, a2=1.0, half_wavelength_correlation=c,
                wavelength=w, view=view(a, 4, 10)) for g, o, c, w, a in
-          zip((2.0, 2.1, 2.2, 2.6), (0.6, 0.7, 1.2, 1.9), (0.0, -0.2, -0.7, -0.8),
+          zip((2.0, 2.1, 2.2, 2.6), (0.6, 0.7, 1.2, 1.9), (0.0, 0.2, 0.7, 0.8),
               (42.0, 40.0, 21.2, 21.3), (0.05, 0.06, 0.3, 0.5))]
     continuum = [dict(gamma=g, rate=r, rate_error=0.01, mode=6, mode_wavelength=21.33,
                       view=view(a, 2, 1)) for g, r, a in
@@ -258,8 +258,8 @@ FIGURE_CASES = {
                              "onset": dict(reason="no onset")}}),
         patterns.figure_order_parameter({"pattern_md_f0p18": {
             "points": [dict(gamma=g, order=m, order_error=0.02, a2=1.0,
-                            correlation_previous_cycle=c) for g, m, c in
-                       zip((2.0, 2.1, 2.2, 2.4), (0.6, 0.7, 1.2, 1.8), (0.0, -0.2, -0.7, -0.8))],
+                            half_wavelength_correlation=c) for g, m, c in
+                       zip((2.0, 2.1, 2.2, 2.4), (0.6, 0.7, 1.2, 1.8), (0.0, 0.2, 0.7, 0.8))],
             "onset": dict(reason="the best onset is at the end of the sweep")}})],
     "make_pattern_report.figure_growth_rate": lambda i: [patterns.figure_growth_rate({
         "pattern_continuum_f0p18": {"points": [dict(gamma=g, rate=r, rate_error=0.02) for g, r in

@@ -64,11 +64,13 @@ def tiny_repository(path):
 
 
 def table(phase, order, correlation):
+    """A pattern table whose half-wavelength correlation is minus the plain one (sinusoids)."""
     rows = len(phase)
     return {"phase": np.array(phase, float), "mass_order_parameter": np.array(order, float),
             "mass_wavelength": np.full(rows, 16.0), "mass_a2": np.full(rows, 0.9),
             "mass_a4": np.full(rows, 0.8), "mass_a6": np.full(rows, 0.7),
-            "mass_correlation_previous_cycle": np.array(correlation, float)}
+            "mass_correlation_previous_cycle": np.array(correlation, float),
+            "mass_half_wavelength_correlation": -np.array(correlation, float)}
 
 
 def test_a_run_is_summarised_at_the_phase_of_the_larger_pattern():
@@ -81,28 +83,35 @@ def test_a_run_is_summarised_at_the_phase_of_the_larger_pattern():
     assert summary["correlation_previous_cycle"] == pytest.approx(-0.75)  # NaN left out
     # -0.8 and -0.7: sd 0.0707 over the 2 frames that have a previous cycle
     assert summary["correlation_error"] == pytest.approx(0.05)
+    assert summary["half_wavelength_correlation"] == pytest.approx(0.75)
+    assert summary["half_wavelength_error"] == pytest.approx(0.05)
     assert summary["frames"] == 3
 
 
 def test_a_point_of_several_seeds_takes_their_spread_as_its_error():
     runs = [dict(order=x, order_error=1e-6, wavelength=16.0, a2=1.0, a4=1.0, a6=1.0,
-                 correlation_previous_cycle=-x, correlation_error=1e-3) for x in (0.2, 0.4)]
+                 correlation_previous_cycle=-x, correlation_error=1e-3,
+                 half_wavelength_correlation=x, half_wavelength_error=2e-3) for x in (0.2, 0.4)]
     point = sweep.point_summary(runs)
     assert point["order"] == pytest.approx(0.3)
     assert point["order_error"] == pytest.approx(0.1)  # sd 0.1414 / sqrt 2
     assert point["correlation_error"] == pytest.approx(0.1)   # the seeds' spread, likewise
     assert sweep.point_summary(runs[:1])["order_error"] == 1e-6
     assert sweep.point_summary(runs[:1])["correlation_error"] == 1e-3   # one seed: its frames'
+    assert point["half_wavelength_correlation"] == pytest.approx(0.3)
+    assert point["half_wavelength_error"] == pytest.approx(0.1)
+    assert sweep.point_summary(runs[:1])["half_wavelength_error"] == 2e-3
 
 
 def test_seeds_that_disagree_make_a_coexisting_point_and_the_onset_is_the_first_ordered_seed():
     def run(correlation, wavelength):
         return dict(order=1.0, order_error=0.1, wavelength=wavelength, a2=0.9, a4=0.5, a6=0.5,
-                    correlation_previous_cycle=correlation, correlation_error=0.01)
-    disordered, ordered = run(-0.1, 60.0), run(-0.7, 20.0)
+                    correlation_previous_cycle=-correlation, correlation_error=0.01,
+                    half_wavelength_correlation=correlation, half_wavelength_error=0.01)
+    disordered, ordered = run(0.1, 60.0), run(0.7, 20.0)
     both = sweep.point_summary([disordered, ordered])
-    # The mean correlation (-0.4) fails the test; one seed of two passes it.
-    assert both["correlation_previous_cycle"] == pytest.approx(-0.4)
+    # The mean correlation (0.4) fails the test; one seed of two passes it.
+    assert both["half_wavelength_correlation"] == pytest.approx(0.4)
     assert both["ordered_seeds"] == 1 and both["wavelength"] == 20.0   # the ordered seed's
     assert pattern_onset.ordered(both) and pattern_onset.coexisting(both)
     none = sweep.point_summary([disordered, disordered])
@@ -219,7 +228,7 @@ def synthetic_case(wavelength, onset, ordered_below=False):
         points.append(dict(gamma=gamma, order=1.0 if stripes else 0.2, order_error=0.01, seeds=1,
                            wavelength=wavelength + {2.6: -0.5, 2.8: 0.5}.get(gamma, 0.0),
                            a2=1.0 if stripes else 0.2, a4=0.1, a6=0.1,
-                           correlation_previous_cycle=-0.95 if stripes else 0.0))
+                           half_wavelength_correlation=0.95 if stripes else 0.0))
     return dict(points=points, onset=dict(gamma_c=onset, gamma_c_error=0.05, floor=0.04,
                                           slope=1.0, chi2_per_dof=1.0, points=len(points)))
 
@@ -299,7 +308,7 @@ def synthetic_continuum(onset, mode_wavelength=21.3333, slope=0.5):
                            final_order=1e-6 if gamma < onset else 0.1, order=0.1,
                            grid_scale_gain=30.0 if gamma == 3.0 else 0.01,
                            order_error=0.01, seeds=1, wavelength=21.3, a2=1.0, a4=1.0, a6=1.0,
-                           correlation_previous_cycle=-1.0))
+                           half_wavelength_correlation=1.0))
     edge = dict(gamma_c=onset, gamma_c_error=0.02, slope=slope, slope_error=0.01,
                 chi2_per_dof=1.0, points=4)
     growing = [p["gamma"] for p in points if p["gamma"] > onset]
@@ -333,7 +342,7 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
     # P5 with a saturation run at Gamma 2.8, above both onsets (the MD's 2.5): the MD's order
     # parameter there against 0.1 saturated
     saturated = dict(gamma=2.8, order=0.1, order_error=0.002, wavelength=17.0, a2=1.0,
-                     correlation_previous_cycle=-0.9)
+                     correlation_previous_cycle=-0.9, half_wavelength_correlation=0.9)
     cases["pattern_continuum_f0p18"]["saturation"] = [saturated]
     rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
         claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
@@ -449,7 +458,7 @@ def test_a_fitted_onset_outside_the_bracket_of_ordered_points_is_not_the_onset_o
                 (2.2, 1.201, 0.013, -0.70), (2.3, 1.693, 0.0044, -0.78),
                 (2.4, 1.839, 0.0099, -0.79), (2.6, 1.975, 0.018, -0.75),
                 (2.8, 2.029, 0.011, -0.72)]
-    points = [dict(gamma=g, order=m, order_error=e, a2=1.0, correlation_previous_cycle=c)
+    points = [dict(gamma=g, order=m, order_error=e, a2=1.0, half_wavelength_correlation=-c)
               for g, m, e, c in measured]
     gamma, order, error = (np.array(column) for column in list(zip(*measured))[:3])
     fitted = pattern_onset.fit_onset(gamma, order, error)
@@ -516,7 +525,7 @@ def test_without_an_onset_fit_the_md_onset_is_the_bracket_of_ordered_points():
     # measured sweep at f = 0.18 and Gamma 3.4): the bracket and P1 use the rising branch.
     for point in case["points"]:
         point["order"] = {2.6: 1.5, 2.8: 2.0, 3.0: 1.2}.get(point["gamma"], point["order"])
-    case["points"][-1]["correlation_previous_cycle"] = -0.3
+    case["points"][-1]["half_wavelength_correlation"] = 0.3
     assert pattern_onset.order_bracket(case)[2:] == (2.4, 2.6)
     assert make_pattern_report.stripes_above_onset_only(case) is True
     case["points"][-1]["order"] = 2.5   # a disordered point on the rising branch: no bracket
@@ -667,10 +676,10 @@ def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the
     gamma_mf, floor, strength = 2.3, 0.01, 0.05
     noise = [np.sqrt(floor + strength / np.sqrt((gamma_mf - g) / gamma_mf))
              for g in (1.8, 1.9, 2.0, 2.1)]
-    points = [dict(gamma=g, order=float(m), a2=1.0, correlation_previous_cycle=0.0)
+    points = [dict(gamma=g, order=float(m), a2=1.0, half_wavelength_correlation=0.0)
               for g, m in zip((1.8, 1.9, 2.0, 2.1), noise)]
     points += [dict(gamma=g, order=1.5 + 0.1 * (g - 2.2), a2=1.0,
-                    correlation_previous_cycle=-0.8) for g in (2.2, 2.4, 2.6, 2.8)]
+                    half_wavelength_correlation=0.8) for g in (2.2, 2.4, 2.6, 2.8)]
     for point in points:
         point.update(order_error=1e-3 * point["order"], seeds=1, wavelength=21.3)
 
@@ -694,7 +703,7 @@ def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the
     assert curve.get_ydata()[0] == pytest.approx(points[0]["order"], rel=1e-3)
     assert figure_rules.figure_problems(figure) == []
     for point in points[:4]:  # one of them ordered: no bracket, no Swift-Hohenberg fit
-        point["correlation_previous_cycle"] = -0.8 if point["gamma"] == 1.9 else 0.0
+        point["half_wavelength_correlation"] = 0.8 if point["gamma"] == 1.9 else 0.0
     assert "swift_hohenberg" not in sweep.fits(points)
 
 
@@ -723,7 +732,8 @@ def test_a_below_table_is_checked_and_its_points_planned_first_and_sorted_in():
     # the points of a case come in increasing Gamma, those below the sweep among them
     for run in plan:
         run["summary"] = dict(order=run["gamma"], order_error=0.01, wavelength=21.0, a2=1.0,
-                              a4=1.0, a6=1.0, correlation_previous_cycle=-0.9)
+                              a4=1.0, a6=1.0, correlation_previous_cycle=-0.9,
+                              half_wavelength_correlation=0.9)
     gammas = [p["gamma"] for p in sweep.case_points(plan, "pattern_md_f0p18")]
     assert gammas == [1.8, 1.9, 2.0, 2.1, 2.2, 2.3, 2.4]
 
