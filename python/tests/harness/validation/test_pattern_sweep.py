@@ -131,6 +131,25 @@ def test_seeds_that_disagree_make_a_coexisting_point_and_the_onset_is_the_first_
     assert "- onset of order bracketed by the sweep: Gamma_c = 1.95" in text
 
 
+def test_a_pattern_table_without_the_half_wavelength_column_is_made_again(work_dir):
+    run = os.path.join(work_dir, "run.h5")
+    table = run + ".patterns.csv"
+    old_header = "cycle [1],phase [1],mass_correlation_previous_cycle [1]\n"
+    new_header = ("cycle [1],phase [1],mass_correlation_previous_cycle [1],"
+                  "mass_half_wavelength_correlation [1]\n")
+    with open(table, "w") as f:
+        f.write("# an older shaker analyze\n" + old_header)
+    fake = os.path.join(work_dir, "fake-shaker")
+    with open(fake, "w") as f:   # writes the new header to the path after --patterns
+        f.write(f"#!/bin/sh\nprintf '{new_header.strip()}\\n' > \"$4\"\n")
+    os.chmod(fake, 0o755)
+    assert not sweep.has_every_column(table)
+    made, reason = sweep.analyze(fake, dict(status="ok", path=run))
+    assert made == table and reason is None and sweep.has_every_column(table)
+    with open(table) as f:
+        assert f.read() == new_header
+
+
 def test_a_run_that_cannot_be_read_names_the_step_that_failed(monkeypatch):
     columns = table([0.0, 0.0], [0.1, 0.2], [np.nan, -0.9])
     monkeypatch.setattr(sweep, "analyze", lambda shaker, record: ("run.csv", None))
