@@ -23,6 +23,9 @@ double signed_mode(std::size_t i, std::size_t n) {
   return i <= n / 2 ? static_cast<double>(i) : static_cast<double>(i) - static_cast<double>(n);
 }
 
+/// The wavenumber (1/sigma) of Fourier mode i of n cells over `length`.
+double wavenumber(std::size_t i, std::size_t n, double length) { return two_pi * signed_mode(i, n) / length; }
+
 /// Forward FFT in place of `lines` complex sequences of length n, the l-th starting at complex
 /// element l * line_step with elements `stride` apart (GSL's packed layout: re, im).
 void fft_lines(std::vector<double>& data, std::size_t n, std::size_t stride, std::size_t lines,
@@ -50,8 +53,8 @@ void check_options(const SymmetryOptions& o) {
 
 }  // namespace
 
-double PowerSpectrum::kx(std::size_t i) const { return two_pi * signed_mode(i, grid.nx) / grid.lx; }
-double PowerSpectrum::ky(std::size_t j) const { return two_pi * signed_mode(j, grid.ny) / grid.ly; }
+double PowerSpectrum::kx(std::size_t i) const { return wavenumber(i, grid.nx, grid.lx); }
+double PowerSpectrum::ky(std::size_t j) const { return wavenumber(j, grid.ny, grid.ly); }
 double PowerSpectrum::total() const {
   double sum = 0.0;
   for (double p : power) sum += p;
@@ -99,8 +102,8 @@ double half_wavelength_correlation(const HorizontalField& before, const Horizont
                                  before.grid.lx, before.grid.ly, now.grid.nx, now.grid.ny, now.grid.lx,
                                  now.grid.ly));
   const std::vector<double> a = fourier_coefficients(before), b = fourier_coefficients(now);
-  const PowerSpectrum modes{now.grid, {}};  // for kx, ky
-  const std::size_t nx = now.grid.nx, cells = now.grid.cells();
+  const HorizontalGrid& g = now.grid;
+  const std::size_t nx = g.nx, cells = g.cells();
   std::size_t strongest = 0;
   double aa = 0.0, bb = 0.0, top = 0.0;
   for (std::size_t c = 0; c < cells; ++c) {
@@ -109,7 +112,7 @@ double half_wavelength_correlation(const HorizontalField& before, const Horizont
     aa += a[2 * c] * a[2 * c] + a[2 * c + 1] * a[2 * c + 1], bb += power;
   }
   if (!(aa > 0.0) || !(bb > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  double k0x = modes.kx(strongest % nx), k0y = modes.ky(strongest / nx);
+  double k0x = wavenumber(strongest % nx, nx, g.lx), k0y = wavenumber(strongest / nx, g.ny, g.ly);
   // k0 and -k0 carry the same power: take the one with kx > 0 (or kx = 0, ky > 0), so that the
   // shift does not hang on the last bits of the two.
   if (k0x < 0.0 || (k0x == 0.0 && k0y < 0.0)) k0x = -k0x, k0y = -k0y;
@@ -119,7 +122,7 @@ double half_wavelength_correlation(const HorizontalField& before, const Horizont
   for (std::size_t c = 0; c < cells; ++c) {
     const std::complex<double> shifted =
         std::complex<double>(a[2 * c], a[2 * c + 1]) *
-        std::polar(1.0, -(modes.kx(c % nx) * dx + modes.ky(c / nx) * dy));
+        std::polar(1.0, -(wavenumber(c % nx, nx, g.lx) * dx + wavenumber(c / nx, g.ny, g.ly) * dy));
     ab += std::real(shifted * std::complex<double>(b[2 * c], -b[2 * c + 1]));
   }
   return ab / std::sqrt(aa * bb);

@@ -69,6 +69,12 @@ LIMITERS = ("minmod", "van_leer", "mc", "first_order")
 # The continuum's checks, each run again with one setting changed (the grid: the cell; the
 # scheme: the slope limiter), and the key that names that setting in its runs and points.
 CHECK_KEYS = {"grid": "cell", "scheme": "limiter"}
+# The correlations of a frame with the same phase one cycle earlier (docs/analysis.md,
+# "Patterns"), each with the name of its standard error: plain (-1 for a sinusoidal wave that
+# inverts) and with the earlier frame shifted by half a wavelength (+1 for a subharmonic
+# standing wave of any waveform; the ordered test's).
+CORRELATIONS = {"correlation_previous_cycle": "correlation_error",
+                "half_wavelength_correlation": "half_wavelength_error"}
 
 
 def require_keys(part, keys, where):
@@ -256,14 +262,6 @@ def analyze(shaker, record):
                          f"{result.stderr.strip()[-500:]}"
         os.replace(table + ".partial", table)
     return table, None
-
-
-# The correlations of a frame with the same phase one cycle earlier (docs/analysis.md,
-# "Patterns"), each with the name of its standard error: plain (-1 for a sinusoidal wave that
-# inverts) and with the earlier frame shifted by half a wavelength (+1 for a subharmonic
-# standing wave of any waveform; the ordered test's).
-CORRELATIONS = {"correlation_previous_cycle": "correlation_error",
-                "half_wavelength_correlation": "half_wavelength_error"}
 
 
 def frame_summary(columns):
