@@ -290,17 +290,26 @@ def standard_error(values):
     return float(values.std(ddof=1) / np.sqrt(values.size)) if values.size > 1 else float("nan")
 
 
+def seeds_error(runs, name, error):
+    """The standard error of the mean over seeds of runs[i][name], given each run's own error
+    (its frames'): the seeds' spread, but never less than their own errors combined. Two seeds
+    give a spread of one degree of freedom, as often far too small as not; a seed's frames
+    bound the point's error from below, since each seed's mean carries its frames' noise."""
+    if len(runs) == 1:
+        return float(runs[0].get(error, float("nan")))
+    own = np.sqrt(np.nansum(np.square([r.get(error, np.nan) for r in runs]))) / len(runs)
+    return float(max(standard_error([r[name] for r in runs]), own))
+
+
 def point_summary(runs):
-    """A point (case, Gamma) from its runs' summaries: the mean over seeds, their standard
-    error (one seed: its frames' standard error), and how many seeds show ordered waves (the
-    wavelength is then theirs)."""
+    """A point (case, Gamma) from its runs' summaries: the mean over seeds with its error
+    (seeds_error), and how many seeds show ordered waves (the wavelength is then theirs)."""
     order = np.array([r["order"] for r in runs])
     point = dict(order=float(order.mean()), seeds=len(runs),
                  ordered_seeds=sum(ordered_run(r) for r in runs),
-                 order_error=standard_error(order) if order.size > 1 else runs[0]["order_error"])
+                 order_error=seeds_error(runs, "order", "order_error"))
     for name, error in CORRELATIONS.items():
-        point[error] = standard_error([r[name] for r in runs]) if len(runs) > 1 \
-            else runs[0].get(error, float("nan"))
+        point[error] = seeds_error(runs, name, error)
     for name in ("wavelength", "a2", "a4", "a6", *CORRELATIONS):
         point[name] = float(np.mean([r[name] for r in runs]))
     if 0 < point["ordered_seeds"] < len(runs):   # the stripes' wavelength, not the noise's

@@ -125,7 +125,8 @@ def test_seeds_that_disagree_make_a_coexisting_point_and_the_onset_is_the_first_
         p["order"] = 1.0 + i   # one rising branch
     assert pattern_onset.order_bracket(dict(points=points))[2:] == (1.9, 2.0)
     text = "\n".join(make_pattern_report.case_lines("pattern_md_f0p14", dict(points=points)))
-    assert "| 2 | 3 ± 0 | 2 (1) |" in text and "| 2.2 | 5 ± 0 | 2 (2) |" in text
+    # Identical orders: the error is the seeds' own (0.1 each), combined.
+    assert "| 2 | 3 ± 0.071 | 2 (1) |" in text and "| 2.2 | 5 ± 0.071 | 2 (2) |" in text
     assert "coexist (the seeds disagree) at Gamma 2 (1 of 2 ordered), 2.1 (1 of 2 ordered)" \
         in text
     assert "- onset of order bracketed by the sweep: Gamma_c = 1.95" in text
