@@ -85,9 +85,14 @@ def require_keys(part, keys, where):
 
 
 def check_some_gamma(part, where):
-    """ValueError unless a table's gamma is increasing and holds at least one value."""
-    if not part["gamma"] or sorted(set(part["gamma"])) != list(part["gamma"]):
-        raise ValueError(f"{where}: gamma must be increasing, at least 1")
+    """ValueError unless a table's gamma is increasing and holds at least one value: one list
+    for its cases, or a table of them by case (where one check belongs at a different Gamma
+    in each case)."""
+    gamma = part["gamma"]
+    for case, values in (gamma.items() if isinstance(gamma, dict) else [("", gamma)]):
+        if not isinstance(values, list) or not values or sorted(set(values)) != values:
+            raise ValueError(f"{where}: gamma{f'.{case}' if case else ''} {values!r}: allowed: "
+                             "increasing, at least 1 (one list, or one per case)")
 
 
 def check_part(repository, part, where):
@@ -178,7 +183,8 @@ def load_sweep(repository, name):
             check_scheme(sweep["continuum"]["scheme"],
                          f"{SWEEP_FILE} [study.{name}.continuum.scheme]")
         for table in ("saturation", "grid", "scheme"):
-            unknown = set(sweep["continuum"].get(table, {}).get("cases", [])) \
+            given = sweep["continuum"].get(table)
+            unknown = set(table_cases(sweep["continuum"], given) if given else []) \
                 - set(sweep["continuum"]["cases"])
             if unknown:
                 raise ValueError(f"{SWEEP_FILE} [study.{name}.continuum.{table}]: cases "
@@ -194,11 +200,22 @@ def solver_parts(sweep):
     return parts
 
 
+def table_cases(part, table):
+    """The cases a part's below, saturation, grid or scheme table runs: those its gamma is
+    given for, by case; else those it names; else the part's."""
+    if isinstance(table["gamma"], dict):
+        return list(table["gamma"])
+    return table.get("cases", part["cases"])
+
+
 def within(part, table):
-    """The gamma, timeout and cases of a part's below, saturation or grid table (its cases:
-    the part's unless the table names some of them)."""
-    return dict(gamma=table["gamma"], timeout=table["timeout"],
-                cases=table.get("cases", part["cases"]))
+    """The gamma, timeout and cases of a part's below, saturation, grid or scheme table."""
+    return dict(gamma=table["gamma"], timeout=table["timeout"], cases=table_cases(part, table))
+
+
+def gammas(part, case):
+    """A part's (or table's) values of Gamma for one case."""
+    return part["gamma"][case] if isinstance(part["gamma"], dict) else part["gamma"]
 
 
 def plan_points(repository, sweep):
@@ -227,7 +244,7 @@ def plan_points(repository, sweep):
     plan = []
     for solver, part, extra, kind, variant in parts:
         for case in part["cases"]:
-            for gamma in part["gamma"]:
+            for gamma in gammas(part, case):
                 for seed in part["seeds"]:
                     plan.append(dict(case=case, case_file=case_file(repository, case),
                                      solver=solver, kind=kind, **variant, replicas=1,

@@ -443,9 +443,34 @@ def reversal_text(kind, gamma, rate, which, other):
             f"{rc.fmt(other, 3)} {check.theirs.format(value)})")
 
 
+def refinement_keeps(case, gamma, rate):
+    """The grid check's finest run at Gamma (cell, rate) when it keeps the sign of the sweep's
+    growth rate there, significantly; else None."""
+    runs = [p for p in case.get("grid", []) if p["gamma"] == gamma]
+    if not runs:
+        return None
+    finest = min(runs, key=lambda p: p["cell"])
+    if abs(finest["rate"]) > SIGNIFICANT_GROWTH * finest["rate_error"] \
+            and (finest["rate"] > 0) == (rate > 0):
+        return finest["cell"], finest["rate"]
+    return None
+
+
+def consequence(case, kind, change):
+    """What a check's reversal means. A limiter that reverses growth which refinement keeps
+    damps it by its own dissipation at the sweep's cell (that error shrinks with the cell): the
+    growth is then the equations'; without that refinement it is the scheme's."""
+    kept = refinement_keeps(case, change[0], change[1]) if kind == "scheme" else None
+    if kept is None:
+        return CHECKS[kind].consequence
+    return (f"but refinement keeps it ({rc.fmt(kept[1], 3)} per cycle at cell {kept[0]:g}): "
+            "the limiter's own dissipation at the sweep's cell hides growth that is the "
+            "equations'")
+
+
 def check_note(cases):
     """The caveat of continuum cases whose growth a grid or scheme check reverses, or ""."""
-    notes = [f"{name}: {reversal_text(kind, *change)}, {CHECKS[kind].consequence}"
+    notes = [f"{name}: {reversal_text(kind, *change)}, {consequence(case, kind, change)}"
              for name, case in solver_cases(cases, "continuum").items()
              for kind in CHECKS for change in reversals(case, kind)]
     return "; ".join(notes)
@@ -466,7 +491,8 @@ def check_lines(case, kind):
               f"{p['fit_cycles'][0]:g} to {p['fit_cycles'][1]:g} | "
               f"{gain_text(p)} |"
               for p in checked]
-    found = [f"- {reversal_text(kind, *change)}" for change in reversals(case, kind)]
+    found = [f"- {reversal_text(kind, *change)}, {consequence(case, kind, change)}"
+             for change in reversals(case, kind)]
     if not found and kind == "grid" and len({p["cell"] for p in checked}) < 2:
         found = ["- no run at a finer cell has finished: the grid check is incomplete"]
     return lines + [""] + (found or [f"- the {kind} check keeps the sign of every growth rate "

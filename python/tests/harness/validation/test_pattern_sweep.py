@@ -628,7 +628,7 @@ def test_a_grid_table_is_checked_and_a_reversed_growth_is_noted():
                     "not the converged continuum's")
     lines = make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
     assert "- refinement reverses the growth at Gamma 2.6 (0.15 per cycle at the sweep's " \
-        "cell, -0.04 at cell 0.5)" in lines
+        "cell, -0.04 at cell 0.5), so its onset there is not the converged continuum's" in lines
     case["grid"][-1]["rate"] = -0.015   # within two errors of zero: no reversal
     assert make_pattern_report.reversals(case, "grid") == []
     assert make_pattern_report.check_note({"pattern_continuum_f0p18": case}) == ""
@@ -674,6 +674,43 @@ def test_a_scheme_table_is_checked_planned_and_a_reversed_growth_is_noted():
     lines = make_pattern_report.continuum_case_lines("pattern_continuum_f0p18", case)
     assert "| 3 | minmod | 0.01 ± 0.01 | 7 | 5 to 39 | 0.1 |" in lines
     assert "Scheme check (the same run with other slope limiters at the sweep's cell):" in lines
+
+
+def test_a_limiter_that_reverses_growth_refinement_keeps_hides_the_equations_growth():
+    case = synthetic_continuum(2.3)   # grows at 3.0 at +0.35 +- 0.01
+    case["scheme"] = [dict(limiter="minmod", gamma=3.0, rate=-0.05, rate_error=0.005, mode=5,
+                           fit_cycles=[5, 39], grid_scale_gain=0.01)]
+    case["grid"] = [dict(cell=c, gamma=3.0, rate=r, rate_error=0.002, mode=5,
+                         fit_cycles=[5, 39], grid_scale_gain=0.01)
+                    for c, r in ((1.0, 0.069), (0.8, 0.063))]
+    note = make_pattern_report.check_note({"pattern_continuum_f0p14": case})
+    assert note == ("pattern_continuum_f0p14: another slope limiter reverses the growth at "
+                    "Gamma 3 (0.35 per cycle with the sweep's limiter, -0.05 with minmod), but "
+                    "refinement keeps it (0.063 per cycle at cell 0.8): the limiter's own "
+                    "dissipation at the sweep's cell hides growth that is the equations'")
+    case["grid"][-1]["rate"] = 0.003   # the finest cell's growth within two errors of zero
+    assert "so the growth there is the scheme's" in make_pattern_report.check_note(
+        {"pattern_continuum_f0p14": case})
+
+
+def test_a_check_table_may_give_each_case_its_own_gamma():
+    where = "[study.x.continuum.scheme]"
+    table = dict(gamma={"pattern_continuum_f0p18": [3.4], "pattern_continuum_f0p14": [2.2, 3.4]},
+                 limiters=["minmod"], timeout=60)
+    sweep.check_scheme(table, where)
+    for bad in ({"pattern_continuum_f0p14": []}, {"pattern_continuum_f0p14": [3.4, 2.2]},
+                {"pattern_continuum_f0p14": 2.2}):
+        with pytest.raises(ValueError, match=r"gamma.pattern_continuum_f0p14 .*one per case"):
+            sweep.check_scheme(dict(table, gamma=bad), where)
+    continuum = dict(cases=["pattern_continuum_f0p18", "pattern_continuum_f0p14"],
+                     gamma=[2.2, 2.6, 3.0, 3.4, 3.8], seeds=[1], overrides=[], timeout=60,
+                     scheme=table)
+    study = dict(cases=["pattern_md_f0p18"], gamma=[2.0, 2.4, 2.8, 3.2, 3.6], seeds=[1],
+                 overrides=[], timeout=60, continuum=continuum)
+    scheme = [(r["case"], r["gamma"]) for r in sweep.plan_points(REPOSITORY, study)
+              if r["kind"] == "scheme"]
+    assert scheme == [("pattern_continuum_f0p18", 3.4), ("pattern_continuum_f0p14", 2.2),
+                      ("pattern_continuum_f0p14", 3.4)]
 
 
 def test_a_grid_or_saturation_table_may_name_some_of_the_continuums_cases(work_dir):
