@@ -815,8 +815,9 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
              + f". {len(runs)} runs of {sum(r['seconds'] for r in runs):.0f} s in all when they "
              f"were made ({sum(r['reused'] for r in runs)} reused from earlier calls); this call "
              f"took {results['seconds']:.0f} s.", "",
-             "Errors are standard errors over independent seeds (one seed: over its sampled "
-             "frames, which consecutive cycles make optimistic). The onset is fitted to the "
+             "Errors are standard errors over independent seeds, never less than the seeds' "
+             "own errors combined (two seeds' spread has one degree of freedom); one seed's "
+             "are over its sampled frames, which consecutive cycles make optimistic. The onset is fitted to the "
              "pattern's power, M^2 = floor + slope max(Gamma - Gamma_c, 0); below it the "
              "Swift-Hohenberg form floor + strength / sqrt((Gamma_mf - Gamma)/Gamma_mf) "
              "(python/granular_shaker/patterns/onset.py, whose tests measure the bias and "
