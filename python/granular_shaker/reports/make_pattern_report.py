@@ -377,6 +377,32 @@ def md_against_continuum(claim, md, continuum):
     return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)}", judge(value, claim)), ""
 
 
+def onset_ratio_lines(cases, parameters):
+    """The MD's onset of order over the continuum's onset of growth at each frequency both
+    solvers ran, with the caveats of the continuum's checks: P2 names f = 0.18, and this table
+    shows whether the ratio it judges holds at the other frequency."""
+    md, continuum = solver_cases(cases, "md"), solver_cases(cases, "continuum")
+    rows = []
+    for name_md, case_md in md.items():
+        frequency = parameters.get(name_md, (None,))[0]
+        name_continuum = next((n for n in continuum if frequency is not None
+                               and parameters.get(n, (None,))[0] == frequency), None)
+        if name_continuum is None:
+            continue
+        onsets = md_onset(case_md), onset_of(continuum[name_continuum])
+        shown = ["n/a" if o is None else f"{rc.fmt(o[0])} ± {rc.fmt(o[1], 2)}"
+                 for o in (*onsets, None if None in onsets else ratio_with_error(*onsets))]
+        caveat = "; ".join(caveats(continuum[name_continuum])) or "none"
+        rows.append(f"| {frequency:g} | {shown[0]} | {shown[1]} | {shown[2]} | {caveat} |")
+    if not rows:
+        return []
+    return ["## Onsets at each frequency", "",
+            "The MD's onset of order (fitted, else the bracket of ordered points) over the "
+            "continuum's onset of growth at the same drive frequency; P2 judges f = 0.18.", "",
+            "| f [sqrt(g/sigma)] | MD Gamma_c | continuum Gamma_c | MD / continuum | the "
+            "continuum's checks |", "| --- | --- | --- | --- | --- |", *rows, ""]
+
+
 def coarse_continuum_note(sweep):
     """The caveat of a continuum run at a coarser cell than its case files' (a study override),
     or "" when it ran as designed."""
@@ -468,12 +494,17 @@ def consequence(case, kind, change):
             "equations'")
 
 
+def caveats(case):
+    """Each reversal of a continuum case's growth by its grid or scheme check, and what it
+    means."""
+    return [f"{reversal_text(kind, *change)}, {consequence(case, kind, change)}"
+            for kind in CHECKS for change in reversals(case, kind)]
+
+
 def check_note(cases):
     """The caveat of continuum cases whose growth a grid or scheme check reverses, or ""."""
-    notes = [f"{name}: {reversal_text(kind, *change)}, {consequence(case, kind, change)}"
-             for name, case in solver_cases(cases, "continuum").items()
-             for kind in CHECKS for change in reversals(case, kind)]
-    return "; ".join(notes)
+    return "; ".join(f"{name}: {caveat}" for name, case in solver_cases(cases, "continuum").items()
+                     for caveat in caveats(case))
 
 
 def check_lines(case, kind):
@@ -817,11 +848,11 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
              f"took {results['seconds']:.0f} s.", "",
              "Errors are standard errors over independent seeds, never less than the seeds' "
              "own errors combined (two seeds' spread has one degree of freedom); one seed's "
-             "are over its sampled frames, which consecutive cycles make optimistic. The onset is fitted to the "
-             "pattern's power, M^2 = floor + slope max(Gamma - Gamma_c, 0); below it the "
-             "Swift-Hohenberg form floor + strength / sqrt((Gamma_mf - Gamma)/Gamma_mf) "
-             "(python/granular_shaker/patterns/onset.py, whose tests measure the bias and "
-             "coverage of both fits' errors).", "",
+             "are over its sampled frames, which consecutive cycles make optimistic. The onset "
+             "is fitted to the pattern's power, M^2 = floor + slope max(Gamma - Gamma_c, 0); "
+             "below it the Swift-Hohenberg form floor + strength / sqrt((Gamma_mf - Gamma)/"
+             "Gamma_mf) (python/granular_shaker/patterns/onset.py, whose tests measure the bias "
+             "and coverage of both fits' errors).", "",
              f"![order parameter]({figures['order_parameter']})", ""]
     if continuum:
         lines += [f"The continuum: cases {', '.join(continuum['cases'])}; Gamma "
@@ -848,6 +879,7 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
                   ""]
     for name, case in results["cases"].items():
         lines += case_lines(name, case)
+    lines += onset_ratio_lines(results["cases"], parameters or {})
     lines += ["## Claims (reference-data/pattern-claims.toml)", "",
               "| claim | statement | value | verdict | why |", "| --- | --- | --- | --- | --- |"]
     note = "; ".join(n for n in (coarse_continuum_note(sweep), check_note(results["cases"])) if n)

@@ -676,6 +676,24 @@ def test_a_scheme_table_is_checked_planned_and_a_reversed_growth_is_noted():
     assert "Scheme check (the same run with other slope limiters at the sweep's cell):" in lines
 
 
+def test_the_onsets_are_compared_at_each_frequency_both_solvers_ran():
+    md = dict(synthetic_case(21.3, 2.5), solver="md")   # onset 2.5 +- 0.05
+    continuum = synthetic_continuum(2.3)                 # onset 2.3 +- 0.02
+    continuum["scheme"] = [dict(limiter="minmod", gamma=3.0, rate=-0.05, rate_error=0.005,
+                                mode=5, fit_cycles=[5, 39], grid_scale_gain=0.01)]
+    cases = {"pattern_md_f0p18": md, "pattern_md_f0p14": dict(md),
+             "pattern_continuum_f0p18": continuum}
+    parameters = {"pattern_md_f0p18": (0.18, 5.0), "pattern_md_f0p14": (0.14, 5.0),
+                  "pattern_continuum_f0p18": (0.18, 5.0)}
+    lines = make_pattern_report.onset_ratio_lines(cases, parameters)
+    rows = [line for line in lines if line.startswith("| 0.")]
+    assert len(rows) == 1   # no continuum at f = 0.14
+    ratio, error = 2.5 / 2.3, 2.5 / 2.3 * np.hypot(0.05 / 2.5, 0.02 / 2.3)
+    assert rows[0].startswith(f"| 0.18 | 2.5 ± 0.05 | 2.3 ± 0.02 | {ratio:.4g} ± {error:.2g} | "
+                              "another slope limiter reverses the growth at Gamma 3")
+    assert make_pattern_report.onset_ratio_lines({"pattern_md_f0p18": md}, parameters) == []
+
+
 def test_a_limiter_that_reverses_growth_refinement_keeps_hides_the_equations_growth():
     case = synthetic_continuum(2.3)   # grows at 3.0 at +0.35 +- 0.01
     case["scheme"] = [dict(limiter="minmod", gamma=3.0, rate=-0.05, rate_error=0.005, mode=5,
