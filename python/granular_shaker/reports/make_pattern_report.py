@@ -542,7 +542,11 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_no
         value, verdict, reason = "n/a", "not measured", ""
         if claim["id"] == "P7":
             reason = ("the Swift-Hohenberg coefficients (xi0, tau0, q0) that make the fitted "
-                      "noise power dimensionless are not measured")
+                      "noise power dimensionless are not measured (they come from the "
+                      "continuum's linear growth near its onset at the same frequency, which "
+                      "at f = 0.18 no scheme-independent onset gives); and the claim's band is "
+                      "relative to a reference the claims file lacks: " + claim.get(
+                          "missing", "none named"))
         elif claim["solvers"] == "md_vs_continuum":
             part, reason = md_against_continuum(claim, md, continuum)
             if part is not None:
