@@ -182,6 +182,15 @@ def judge(value, claim):
     raise ValueError(f"claim {claim['id']}: comparison {claim['comparison']} not judged here")
 
 
+def no_onset_of_order(case):
+    """Why an MD case without an onset of order has none."""
+    if not ordered_gammas(case):
+        return " (no ordered point)"
+    if all(ordered(p) for p in rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))):
+        return " (no onset of order in the sweep: ordered from its lowest Gamma)"
+    return " (no onset of order: ordered and disordered points alternate)"
+
+
 def md_part(claim, md, parameters, dispersion):
     """(value, MD verdict) of a claim on both solvers, from the MD cases alone, or None."""
     if claim["id"] == "P1":
@@ -192,9 +201,7 @@ def md_part(claim, md, parameters, dispersion):
             return None
         return ("; ".join(f"{n}: ordered at Gamma " + (", ".join(
             f"{g:g}" for g in ordered_gammas(md[n])) or "none") + (
-                "" if found[n] is not None else
-                " (no onset of order: ordered and disordered points alternate)"
-                if ordered_gammas(md[n]) else " (no ordered point)") for n in md),
+                "" if found[n] is not None else no_onset_of_order(md[n])) for n in md),
                 "pass" if all(f is True for f in found.values()) else "fail")
     wavelengths = {name: stripe_wavelength(case) for name, case in md.items()}
     if claim["id"] == "P3" and len(md) == 2 and None not in wavelengths.values():
@@ -494,17 +501,22 @@ def consequence(case, kind, change):
             "equations'")
 
 
-def caveats(case):
+def caveats(case, weakening_only=False):
     """Each reversal of a continuum case's growth by its grid or scheme check, and what it
-    means."""
+    means; with weakening_only, only those that put the growth in doubt (not a limiter's
+    reversal that refinement undoes)."""
     return [f"{reversal_text(kind, *change)}, {consequence(case, kind, change)}"
-            for kind in CHECKS for change in reversals(case, kind)]
+            for kind in CHECKS for change in reversals(case, kind)
+            if not (weakening_only and kind == "scheme"
+                    and refinement_keeps(case, change[0], change[1]))]
 
 
-def check_note(cases):
-    """The caveat of continuum cases whose growth a grid or scheme check reverses, or ""."""
+def check_note(cases, names=None):
+    """The caveat, on a verdict, of the continuum cases (of `names`, if given) whose growth a
+    grid or scheme check puts in doubt, or ""."""
     return "; ".join(f"{name}: {caveat}" for name, case in solver_cases(cases, "continuum").items()
-                     for caveat in caveats(case))
+                     if names is None or name in names
+                     for caveat in caveats(case, weakening_only=True))
 
 
 def check_lines(case, kind):
@@ -533,7 +545,8 @@ def check_lines(case, kind):
 def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_note=""):
     """Every claim with its verdict: measured by the sweep, or not measured and why. A claim on
     both solvers that only one of them measures gets that one's verdict, marked as its alone.
-    `continuum_note` is added to the reason of every verdict the continuum takes part in."""
+    `continuum_note` is added to the reason of every verdict the continuum takes part in, and
+    the caveats of the grid and scheme checks of the claim's continuum cases (check_note)."""
     md = {n: c for n, c in solver_cases(cases, "md").items() if n.startswith("pattern_md")}
     continuum = solver_cases(cases, "continuum")
     parameters = parameters or {}
@@ -578,8 +591,9 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_no
                     for n, c in md.items())
         uses_continuum = claim["solvers"] == "md_vs_continuum" and verdict != "not measured" \
             or claim["solvers"] == "both" and "continuum:" in str(value)
-        if continuum_note and uses_continuum:
-            reason = "; ".join(r for r in (reason, continuum_note) if r)
+        if uses_continuum:
+            reason = "; ".join(r for r in (reason, continuum_note,
+                                           check_note(cases, claim["cases"])) if r)
         rows.append(dict(id=claim["id"], statement=claim["statement"], value=value,
                          verdict=verdict, reason=reason, status=claim["status"]))
     return rows
@@ -886,7 +900,7 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
     lines += onset_ratio_lines(results["cases"], parameters or {})
     lines += ["## Claims (reference-data/pattern-claims.toml)", "",
               "| claim | statement | value | verdict | why |", "| --- | --- | --- | --- | --- |"]
-    note = "; ".join(n for n in (coarse_continuum_note(sweep), check_note(results["cases"])) if n)
+    note = coarse_continuum_note(sweep)
     for row in claim_verdicts(claims, results["cases"], parameters, dispersion, note):
         lines.append(f"| {row['id']} ({row['status']}) | {row['statement']} | {row['value']} | "
                      f"{row['verdict']} | {row['reason']} |")

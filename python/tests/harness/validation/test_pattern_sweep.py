@@ -292,8 +292,14 @@ def test_stripes_below_the_onset_fail_the_md_part_of_p1():
     cases = {"pattern_md_f0p18": synthetic_case(21.3, 2.5), "pattern_md_f0p14": alternating}
     row = verdicts(cases, None)["P1"]
     assert row["verdict"] == "MD fail; continuum not measured"
-    assert "pattern_md_f0p14: ordered at Gamma 2, 2.4, 2.6, 2.8, 3 (no onset of order" in \
-        row["value"] and "pattern_md_f0p18: ordered at Gamma 2.6, 2.8, 3;" in row["value"]
+    assert "pattern_md_f0p14: ordered at Gamma 2, 2.4, 2.6, 2.8, 3 (no onset of order: " \
+        "ordered and disordered points alternate)" in row["value"] \
+        and "pattern_md_f0p18: ordered at Gamma 2.6, 2.8, 3;" in row["value"]
+    everywhere = synthetic_case(25.6, 1.5)   # ordered at every point of the sweep
+    everywhere["onset"] = dict(reason="the best onset is at the end of the sweep")
+    row = verdicts({**cases, "pattern_md_f0p14": everywhere}, None)["P1"]
+    assert "pattern_md_f0p14: ordered at Gamma 2, 2.2, 2.4, 2.6, 2.8, 3 (no onset of order in " \
+        "the sweep: ordered from its lowest Gamma)" in row["value"]
     for point in alternating["points"]:
         point["a2"] = 0.2
     assert "pattern_md_f0p14: ordered at Gamma none (no ordered point)" in \
@@ -701,14 +707,20 @@ def test_a_limiter_that_reverses_growth_refinement_keeps_hides_the_equations_gro
     case["grid"] = [dict(cell=c, gamma=3.0, rate=r, rate_error=0.002, mode=5,
                          fit_cycles=[5, 39], grid_scale_gain=0.01)
                     for c, r in ((1.0, 0.069), (0.8, 0.063))]
-    note = make_pattern_report.check_note({"pattern_continuum_f0p14": case})
-    assert note == ("pattern_continuum_f0p14: another slope limiter reverses the growth at "
-                    "Gamma 3 (0.35 per cycle with the sweep's limiter, -0.05 with minmod), but "
-                    "refinement keeps it (0.063 per cycle at cell 0.8): the limiter's own "
-                    "dissipation at the sweep's cell hides growth that is the equations'")
+    assert make_pattern_report.caveats(case) == [
+        "another slope limiter reverses the growth at Gamma 3 (0.35 per cycle with the sweep's "
+        "limiter, -0.05 with minmod), but refinement keeps it (0.063 per cycle at cell 0.8): "
+        "the limiter's own dissipation at the sweep's cell hides growth that is the equations'"]
+    # It does not put the growth in doubt: no caveat on the verdicts.
+    assert make_pattern_report.check_note({"pattern_continuum_f0p14": case}) == ""
     case["grid"][-1]["rate"] = 0.003   # the finest cell's growth within two errors of zero
-    assert "so the growth there is the scheme's" in make_pattern_report.check_note(
-        {"pattern_continuum_f0p14": case})
+    note = make_pattern_report.check_note({"pattern_continuum_f0p14": case})
+    assert "so the growth there is the scheme's" in note
+    # A verdict carries the caveats of its own claim's continuum cases only.
+    assert make_pattern_report.check_note({"pattern_continuum_f0p14": case},
+                                          ["pattern_continuum_f0p18"]) == ""
+    assert make_pattern_report.check_note({"pattern_continuum_f0p14": case},
+                                          ["pattern_continuum_f0p14"]) == note
 
 
 def test_a_check_table_may_give_each_case_its_own_gamma():
