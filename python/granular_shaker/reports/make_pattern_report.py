@@ -186,8 +186,8 @@ def no_onset_of_order(case):
     """Why an MD case without an onset of order has none."""
     if not ordered_gammas(case):
         return " (no ordered point)"
-    if all(ordered(p) for p in rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))):
-        return " (no onset of order in the sweep: ordered from its lowest Gamma)"
+    if all(ordered(p) for p in case["points"]):
+        return " (no onset of order in the sweep: ordered at every Gamma)"
     return " (no onset of order: ordered and disordered points alternate)"
 
 

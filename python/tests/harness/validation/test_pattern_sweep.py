@@ -299,7 +299,7 @@ def test_stripes_below_the_onset_fail_the_md_part_of_p1():
     everywhere["onset"] = dict(reason="the best onset is at the end of the sweep")
     row = verdicts({**cases, "pattern_md_f0p14": everywhere}, None)["P1"]
     assert "pattern_md_f0p14: ordered at Gamma 2, 2.2, 2.4, 2.6, 2.8, 3 (no onset of order in " \
-        "the sweep: ordered from its lowest Gamma)" in row["value"]
+        "the sweep: ordered at every Gamma)" in row["value"]
     for point in alternating["points"]:
         point["a2"] = 0.2
     assert "pattern_md_f0p14: ordered at Gamma none (no ordered point)" in \
