@@ -808,13 +808,19 @@ def case_lines(name, case):
         lines.append(f"- ordered standing waves (A2 >= {STRIPES_A2}, half-wavelength shifted "
                      f"correlation >= {SUBHARMONIC_CORRELATION}, in some seed) at Gamma "
                      + ", ".join(f"{g:g}" for g in shown))
-        mixed = [p for p in case["points"] if coexisting(p)]
-        if mixed:
-            lines.append("- ordered and disordered states coexist (the seeds disagree) at Gamma "
-                         + ", ".join(f"{p['gamma']:g} ({p['ordered_seeds']} of {p['seeds']} "
-                                     "ordered)" for p in mixed)
-                         + ": the onset is hysteretic, and the onset of order from a flat start "
-                         "is the lowest Gamma where any seed orders")
+        by_gamma = sorted(case["points"], key=lambda p: p["gamma"])
+        rising = {p["gamma"] for p in rising_branch(by_gamma)}
+        for near_onset, meaning in (
+                (True, "the onset is hysteretic, and the onset of order from a flat start is "
+                       "the lowest Gamma where any seed orders"),
+                (False, "past the order parameter's peak, where the stripes give way")):
+            mixed = [p for p in case["points"]
+                     if coexisting(p) and (p["gamma"] in rising) == near_onset]
+            if mixed:
+                lines.append("- ordered and disordered states coexist (the seeds disagree) at "
+                             "Gamma " + ", ".join(f"{p['gamma']:g} ({p['ordered_seeds']} of "
+                                                  f"{p['seeds']} ordered)" for p in mixed)
+                             + f": {meaning}")
     else:
         lines.append(f"- no ordered standing wave at any Gamma of the sweep (A2 >= {STRIPES_A2} "
                      f"with half-wavelength shifted correlation >= {SUBHARMONIC_CORRELATION} "

@@ -128,8 +128,14 @@ def test_seeds_that_disagree_make_a_coexisting_point_and_the_onset_is_the_first_
     # Identical orders: the error is the seeds' own (0.1 each), combined.
     assert "| 2 | 3 ± 0.071 | 2 (1) |" in text and "| 2.2 | 5 ± 0.071 | 2 (2) |" in text
     assert "coexist (the seeds disagree) at Gamma 2 (1 of 2 ordered), 2.1 (1 of 2 ordered)" \
-        in text
+        ": the onset is hysteretic" in text
     assert "- onset of order bracketed by the sweep: Gamma_c = 1.95" in text
+    # Seeds that disagree past the order parameter's peak mark where the stripes give way.
+    points.append(dict(gamma=2.3, **dict(both, order=2.0)))
+    text = "\n".join(make_pattern_report.case_lines("pattern_md_f0p14", dict(points=points)))
+    assert "at Gamma 2 (1 of 2 ordered), 2.1 (1 of 2 ordered): the onset is hysteretic" in text
+    assert "at Gamma 2.3 (1 of 2 ordered): past the order parameter's peak, where the stripes " \
+        "give way" in text
 
 
 def test_a_pattern_table_without_the_half_wavelength_column_is_made_again(work_dir):
