@@ -43,7 +43,7 @@ def swift_hohenberg_curve(fit, gamma):
 def figure_order_parameter(cases):
     """The saturated order parameter against Gamma, each MD case with its onset fit."""
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for name, case in solver_cases(cases, "md").items():
         points = case["points"]
         gamma = np.array([p["gamma"] for p in points])
