@@ -177,9 +177,10 @@ def fit_swift_hohenberg(gamma, order, error, onset_at_most=None):
 
 
 def rising_branch(points):
-    """The points up to the one with the largest order parameter. Past it the pattern's
-    amplitude falls again as Gamma grows (the layer's flight lengthens towards the next
-    bifurcation), which the supercritical form near onset does not describe."""
+    """The points, in order of Gamma, up to the one with the largest order parameter. Past it
+    the pattern's amplitude falls again as Gamma grows (the layer's flight lengthens towards
+    the next bifurcation), which the supercritical form near onset does not describe."""
+    points = sorted(points, key=lambda p: p["gamma"])
     if not points:
         return points
     top = int(np.argmax([p["order"] for p in points]))
@@ -213,7 +214,7 @@ def order_bracket(case):
     error as a uniform distribution over the bracket, last disordered Gamma, first ordered
     Gamma), when on the rising branch of the order parameter (the points the onset fit uses)
     every point above some Gamma is ordered and none below it; else None."""
-    points = rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))
+    points = rising_branch(case["points"])
     flags = [ordered(p) for p in points]
     if True not in flags or False not in flags:
         return None

@@ -164,8 +164,7 @@ def stripes_above_onset_only(case):
     if onset is None or not shown:
         return None
     below = [g for g in shown if g < onset]
-    above = [p["gamma"] for p in rising_branch(sorted(case["points"], key=lambda p: p["gamma"]))
-             if p["gamma"] > onset]
+    above = [p["gamma"] for p in rising_branch(case["points"]) if p["gamma"] > onset]
     return not below and bool(above) and all(g in shown for g in above)
 
 
@@ -808,8 +807,7 @@ def case_lines(name, case):
         lines.append(f"- ordered standing waves (A2 >= {STRIPES_A2}, half-wavelength shifted "
                      f"correlation >= {SUBHARMONIC_CORRELATION}, in some seed) at Gamma "
                      + ", ".join(f"{g:g}" for g in shown))
-        by_gamma = sorted(case["points"], key=lambda p: p["gamma"])
-        rising = {p["gamma"] for p in rising_branch(by_gamma)}
+        rising = {p["gamma"] for p in rising_branch(case["points"])}
         for near_onset, meaning in (
                 (True, "the onset is hysteretic, and the onset of order from a flat start is "
                        "the lowest Gamma where any seed orders"),
