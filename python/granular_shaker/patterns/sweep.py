@@ -124,14 +124,14 @@ def check_grid(part, where):
     check_some_gamma(part, where)
 
 
-def check_below(part, sweep, where):
-    """ValueError naming what is wrong with a sweep's `below` table: points of some MD cases
-    below the sweep's lowest Gamma."""
+def check_extra(part, sweep, where):
+    """ValueError naming what is wrong with a sweep's `extra` table: points of some MD cases at
+    accelerations the sweep lacks (below it for the Swift-Hohenberg fit, or near the onset)."""
     require_keys(part, ("cases", "gamma", "timeout"), where)
     gamma = part["gamma"]
-    if not gamma or sorted(set(gamma)) != list(gamma) or gamma[-1] >= sweep["gamma"][0]:
-        raise ValueError(f"{where}: gamma {gamma!r}: allowed: increasing, at least 1, each below "
-                         f"the sweep's lowest Gamma {sweep['gamma'][0]:g}")
+    if not gamma or sorted(set(gamma)) != list(gamma) or set(gamma) & set(sweep["gamma"]):
+        raise ValueError(f"{where}: gamma {gamma!r}: allowed: increasing, at least 1, none of "
+                         "the sweep's own")
     unknown = set(part["cases"]) - set(sweep["cases"])
     if unknown:
         raise ValueError(f"{where}: cases {sorted(unknown)} are not the sweep's")
@@ -170,8 +170,8 @@ def load_sweep(repository, name):
                          f"({SWEEP_FILE})")
     sweep = studies[name]
     check_part(repository, sweep, f"{SWEEP_FILE} [study.{name}]")
-    if "below" in sweep:
-        check_below(sweep["below"], sweep, f"{SWEEP_FILE} [study.{name}.below]")
+    if "extra" in sweep:
+        check_extra(sweep["extra"], sweep, f"{SWEEP_FILE} [study.{name}.extra]")
     if "continuum" in sweep:
         check_part(repository, sweep["continuum"], f"{SWEEP_FILE} [study.{name}.continuum]")
         if "saturation" in sweep["continuum"]:
@@ -201,7 +201,7 @@ def solver_parts(sweep):
 
 
 def table_cases(part, table):
-    """The cases a part's below, saturation, grid or scheme table runs: those its gamma is
+    """The cases a part's extra, saturation, grid or scheme table runs: those its gamma is
     given for, by case; else those it names; else the part's."""
     if isinstance(table["gamma"], dict):
         return list(table["gamma"])
@@ -209,7 +209,7 @@ def table_cases(part, table):
 
 
 def within(part, table):
-    """The gamma, timeout and cases of a part's below, saturation, grid or scheme table."""
+    """The gamma, timeout and cases of a part's extra, saturation, grid or scheme table."""
     return dict(gamma=table["gamma"], timeout=table["timeout"], cases=table_cases(part, table))
 
 
@@ -220,13 +220,13 @@ def gammas(part, case):
 
 def plan_points(repository, sweep):
     """One run per solver, case, Gamma and seed, in the run dicts of the validation study (the
-    MD's points of the `below` table first); the continuum's saturation runs (kind
+    MD's points of the `extra` table first); the continuum's saturation runs (kind
     "saturation"), grid-check runs (kind "grid", one per cell, key "cell") and scheme-check
     runs (kind "scheme", one per limiter, key "limiter") after its growth runs."""
     parts = [(solver, part, [], "sweep", {}) for solver, part in solver_parts(sweep)]
-    if "below" in sweep:
-        # The dense, cold layer below onset makes these the longest runs: they go first.
-        parts.insert(0, ("md", dict(sweep, **within(sweep, sweep["below"])), [], "sweep", {}))
+    if "extra" in sweep:
+        # Below onset the dense, cold layer makes these the longest runs: they go first.
+        parts.insert(0, ("md", dict(sweep, **within(sweep, sweep["extra"])), [], "sweep", {}))
     continuum = sweep.get("continuum") or {}
     if "saturation" in continuum:
         saturation = continuum["saturation"]

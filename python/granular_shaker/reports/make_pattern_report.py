@@ -860,9 +860,9 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
              "docs/patterns.md). Cases "
              + ", ".join(sweep["cases"]) + f"; Gamma {sweep['gamma'][0]:g} to "
              f"{sweep['gamma'][-1]:g} ({len(sweep['gamma'])} points)" + (
-                 f", and below it {', '.join(sweep['below']['cases'])} at Gamma "
-                 + ", ".join(f"{g:g}" for g in sweep["below"]["gamma"])
-                 if "below" in sweep else "") + "; seeds "
+                 f", and {', '.join(sweep['extra']['cases'])} also at Gamma "
+                 + ", ".join(f"{g:g}" for g in sweep["extra"]["gamma"])
+                 if "extra" in sweep else "") + "; seeds "
              + ", ".join(map(str, sweep["seeds"])) + "; overrides "
              + (", ".join(f"`{o}`" for o in sweep["overrides"]) or "none")
              + f". {len(runs)} runs of {sum(r['seconds'] for r in runs):.0f} s in all when they "

@@ -800,35 +800,35 @@ def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the
     assert "swift_hohenberg" not in sweep.fits(points)
 
 
-def test_a_below_table_is_checked_and_its_points_planned_first_and_sorted_in():
+def test_an_extra_table_is_checked_and_its_points_planned_first_and_sorted_in():
     study = dict(cases=["pattern_md_f0p18", "pattern_md_f0p14"], gamma=[2.0, 2.1, 2.2, 2.3, 2.4],
                  seeds=[1, 2], overrides=["run.transient_cycles=120"], timeout=60)
-    good = dict(cases=["pattern_md_f0p18"], gamma=[1.8, 1.9], timeout=14400)
-    where = "[study.x.below]"
-    sweep.check_below(good, study, where)
+    good = dict(cases=["pattern_md_f0p18"], gamma=[1.8, 1.9, 2.15], timeout=14400)
+    where = "[study.x.extra]"
+    sweep.check_extra(good, study, where)
     for bad, message in ((dict(good, gamma=[]), "at least 1"),
                          (dict(good, gamma=[1.9, 1.8]), "increasing"),
-                         (dict(good, gamma=[1.8, 2.0]), "below the sweep's lowest Gamma 2"),
+                         (dict(good, gamma=[1.8, 2.0]), "none of the sweep's own"),
                          (dict(good, cases=["pattern_md_f0p10"]), "not the sweep's")):
         with pytest.raises(ValueError, match=message):
-            sweep.check_below(bad, study, where)
+            sweep.check_extra(bad, study, where)
     with pytest.raises(ValueError, match="no 'timeout'"):
-        sweep.check_below({k: v for k, v in good.items() if k != "timeout"}, study, where)
-    plan = sweep.plan_points(REPOSITORY, dict(study, below=good))
-    assert len(plan) == 2 * 5 * 2 + 2 * 2
+        sweep.check_extra({k: v for k, v in good.items() if k != "timeout"}, study, where)
+    plan = sweep.plan_points(REPOSITORY, dict(study, extra=good))
+    assert len(plan) == 2 * 5 * 2 + 3 * 2
     first = plan[:4]  # the longest runs start first
     assert [(r["case"], r["gamma"], r["seed"]) for r in first] == [
         ("pattern_md_f0p18", 1.8, 1), ("pattern_md_f0p18", 1.8, 2),
         ("pattern_md_f0p18", 1.9, 1), ("pattern_md_f0p18", 1.9, 2)]
     assert all(r["kind"] == "sweep" and r["timeout"] == 14400
                and "run.transient_cycles=120" in r["overrides"] for r in first)
-    # the points of a case come in increasing Gamma, those below the sweep among them
+    # the points of a case come in increasing Gamma, the extra ones among them
     for run in plan:
         run["summary"] = dict(order=run["gamma"], order_error=0.01, wavelength=21.0, a2=1.0,
                               a4=1.0, a6=1.0, correlation_previous_cycle=-0.9,
                               half_wavelength_correlation=0.9)
     gammas = [p["gamma"] for p in sweep.case_points(plan, "pattern_md_f0p18")]
-    assert gammas == [1.8, 1.9, 2.0, 2.1, 2.2, 2.3, 2.4]
+    assert gammas == [1.8, 1.9, 2.0, 2.1, 2.15, 2.2, 2.3, 2.4]
 
 
 @pytest.mark.parametrize("name", ["full", "reduced", "bracket"])
@@ -836,11 +836,11 @@ def test_every_study_of_the_repository_loads_and_plans(name):
     study = sweep.load_sweep(REPOSITORY, name)
     plan = sweep.plan_points(REPOSITORY, study)
     md = [r for r in plan if r["solver"] == "md"]
-    expected = len(study["cases"]) * len(study["gamma"]) * len(study["seeds"]) + len(
-        study.get("below", {}).get("cases", [])) * len(study.get("below", {}).get("gamma", [])) \
-        * len(study["seeds"])
+    extra = study.get("extra", dict(cases=[], gamma=[]))
+    expected = (len(study["cases"]) * len(study["gamma"])
+                + len(extra["cases"]) * len(extra["gamma"])) * len(study["seeds"])
     assert len(md) == expected
-    assert min(r["gamma"] for r in md) == min(study.get("below", study)["gamma"])
+    assert {r["gamma"] for r in md} == set(study["gamma"]) | set(extra["gamma"])
 
 
 MD_CONFIG = """[run]
