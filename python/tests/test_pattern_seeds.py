@@ -62,3 +62,13 @@ def test_one_seed_keeps_its_frames_error_and_every_error_is_no_less_than_the_fra
     assert seeds_error(runs, "order", "order_error") == pytest.approx(0.02 / np.sqrt(2))
     apart = [dict(order=0.2, order_error=0.02), dict(order=0.4, order_error=0.02)]
     assert seeds_error(apart, "order", "order_error") == pytest.approx(0.1)
+
+
+def test_a_spectrum_over_seeds_has_each_modes_error_as_a_number_would():
+    runs = [dict(power=[0.3, 0.2], error=[0.02, 0.02]),
+            dict(power=[0.3001, 0.4], error=[0.02, 0.02])]
+    errors = seeds_error(runs, "power", "error")
+    for mode in (0, 1):
+        alone = [dict(order=r["power"][mode], order_error=r["error"][mode]) for r in runs]
+        assert errors[mode] == pytest.approx(seeds_error(alone, "order", "order_error"))
+    assert list(seeds_error(runs[:1], "power", "error")) == [0.02, 0.02]

@@ -9,7 +9,7 @@ import pytest
 
 import synthetic_files as synthetic
 from granular_shaker.patterns.views import (column_mass_frames, last_cycle_views, mode_power,
-                                            run_view)
+                                            phase_spectra, run_view)
 
 LX, LY, PARTICLES, MODE = 128.0, 8.0, 12800, 6
 AMPLITUDE = {0.0: 0.4, 0.5: 0.1}   # relative amplitude of the stripes at each phase
@@ -75,6 +75,19 @@ def test_the_view_is_the_last_complete_cycle_and_the_spectrum_of_the_stronger_ph
     assert relative[0].mean() > 0.3 and view["power"][MODE - 1] > 0.035
     # Identical frames at a phase: the spectrum's standard error is zero there.
     assert view["power_error"][MODE - 1] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_spectra_at_every_phase_hold_each_stripes_amplitude(tmp_path):
+    write_md_particles(tmp_path / "run.particles.h5")
+    spectra = phase_spectra(column_mass_frames(tmp_path / "run.h5"))
+    assert spectra["box_length"] == LX and sorted(spectra["power"]) == ["0", "0.5"]
+    for phase, amplitude in AMPLITUDE.items():
+        # |c_m| / c_0 of 1 + a cos is a / 2, less the binning's attenuation of mode 6 on
+        # 2-sigma cells (sinc(pi 6 * 2 / 128) = 0.986); the whole particles in each cell of
+        # about 200 round it by a few 1e-4.
+        power = spectra["power"][f"{phase:g}"][MODE - 1]
+        assert np.sqrt(power) == pytest.approx(0.986 * amplitude / 2, abs=5e-4)
+        assert spectra["power_error"][f"{phase:g}"][MODE - 1] == pytest.approx(0.0, abs=1e-12)
 
 
 def test_a_continuum_view_is_its_last_frame(tmp_path):

@@ -2,22 +2,25 @@
 mean, docs/analysis.md "Patterns") measured at accelerations Gamma, each with its standard
 error from independent frames or seeds.
 
-Two models, both fitted to M^2 (the pattern's power), by weighted least squares and a profile
-of chi^2 over the onset, so that the one non-linear parameter is scanned and the linear ones
-solved exactly at each value:
+Two models, each fitted to a power (the onset to M^2, the Swift-Hohenberg form to one Fourier
+mode's), by weighted least squares and a profile of chi^2 over the onset, so that the one
+non-linear parameter is scanned and the linear ones solved exactly at each value:
 
 - fit_onset: a supercritical bifurcation over a noise floor,
       M^2 = floor + slope * max(Gamma - Gamma_c, 0),
   the saturated amplitude growing as sqrt(Gamma - Gamma_c) above onset (the continuum's
   onset, and the MD's ordered onset).
 - fit_swift_hohenberg: the fluctuations below onset of the linear Swift-Hohenberg equation
-  with additive noise (Swift and Hohenberg 1977; Goldman, Swift and Swinney 2004), whose
-  power summed over the ring of wavenumbers near q0 grows in two dimensions as
-  1 / sqrt(-epsilon) towards the mean-field onset,
-      M^2 = floor + strength / sqrt((Gamma_mf - Gamma) / Gamma_mf),   Gamma < Gamma_mf.
-  `strength` is the noise's power in the field's units; turning it into the dimensionless
-  noise strength F of Swift-Hohenberg theory needs the coefficients xi0, tau0 and q0 of the
-  linear growth rates, which this fit does not measure.
+  with additive noise (Swift and Hohenberg 1977; Goldman, Swift and Swinney 2004). Each
+  Fourier mode of the field relaxes at its own rate and the noise keeps it stirred, so its
+  mean power (the structure factor) is the noise's over that rate; at the critical wavenumber
+  q0 the rate vanishes at the mean-field onset, and the power there grows as 1 / (-epsilon):
+      S(q0) = floor + strength / ((Gamma_mf - Gamma) / Gamma_mf),   Gamma < Gamma_mf.
+  Fitted to the power of the box's Fourier mode at the stripes' wavenumber, not to the
+  field's whole variance M^2, in which the particles' counting noise at every wavenumber
+  buries the critical mode's growth. `strength` is the noise's power in that mode's units;
+  turning it into the dimensionless noise strength F of Swift-Hohenberg theory needs the
+  coefficients xi0, tau0 and q0 of the linear growth rates, which this fit does not measure.
 
 The onset's error is the half-width of the interval where chi^2 rises by one above its
 minimum, with chi^2 scaled by its value per degree of freedom when that exceeds one (a model
@@ -28,6 +31,7 @@ synthetic sweeps of known onset.
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 PROFILE_POINTS = 4001
 # A point shows an ordered standing wave when its spectrum's angular moments name stripes (A2,
@@ -65,12 +69,17 @@ class SwiftHohenbergFit:
     points: int
 
 
+def _checked(values, error, what):
+    values, error = np.asarray(values, float), np.asarray(error, float)
+    if values.shape != error.shape or values.ndim != 1:
+        raise ValueError(f"{what}s and errors must be 1D arrays of one length")
+    if not (np.all(np.isfinite(values)) and np.all(np.isfinite(error)) and np.all(error > 0)):
+        raise ValueError(f"{what}s must be finite and their errors finite and > 0")
+    return values, error
+
+
 def _power_and_error(order, error):
-    order, error = np.asarray(order, float), np.asarray(error, float)
-    if order.shape != error.shape or order.ndim != 1:
-        raise ValueError("order parameters and errors must be 1D arrays of one length")
-    if not (np.all(np.isfinite(order)) and np.all(np.isfinite(error)) and np.all(error > 0)):
-        raise ValueError("order parameters must be finite and their errors finite and > 0")
+    order, error = _checked(order, error, "order parameter")
     return order ** 2, 2.0 * np.abs(order) * error
 
 
@@ -108,11 +117,17 @@ def _best_fit(x_of, candidates, chi2, best, y, sigma, what):
     inside = np.flatnonzero(chi2 <= chi2[best] + scale)
     step = candidates[1] - candidates[0]
     half_width = 0.5 * (candidates[inside[-1]] - candidates[inside[0]] + step)
-    coefficients, covariance, _ = linear_fit([np.ones_like(y), x_of(candidates[best])], y, sigma)
+    # The grid's best candidate refined between its neighbours, so that the coefficients are
+    # not those of a value up to half a step off.
+    refined = minimize_scalar(lambda c: _profile(x_of, np.array([c]), y, sigma)[1][0],
+                              bounds=(candidates[max(best - 1, 0)],
+                                      candidates[min(best + 1, candidates.size - 1)]),
+                              method="bounded", options=dict(xatol=1e-9 * abs(step) + 1e-12)).x
+    coefficients, covariance, _ = linear_fit([np.ones_like(y), x_of(refined)], y, sigma)
     errors = np.sqrt(np.diag(covariance) * scale)
     if not coefficients[1] > 2.0 * errors[1]:
         raise NoOnset(f"{what} ({coefficients[1]:.3g} +- {errors[1]:.2g})")
-    return (float(candidates[best]), float(half_width), coefficients, errors,
+    return (float(refined), float(half_width), coefficients, errors,
             chi2[best] / dof if dof > 0 else np.nan)
 
 
@@ -144,15 +159,16 @@ def fit_onset(gamma, order, error):
                     float(errors[0]), chi2_per_dof, int(gamma.size))
 
 
-def fit_swift_hohenberg(gamma, order, error, onset_at_most=None):
-    """Fits M^2 = floor + strength / sqrt((Gamma_mf - Gamma) / Gamma_mf) to the points below
-    `onset_at_most` (all points if None), Gamma_mf sought above the highest of them, up to
-    twice the sweep's span beyond it. Raises NoOnset when the best Gamma_mf is at the upper
-    end (no divergence in sight) or the strength is not above twice its error."""
+def fit_swift_hohenberg(gamma, power, error, onset_at_most=None):
+    """Fits S = floor + strength / ((Gamma_mf - Gamma) / Gamma_mf) to the critical mode's power
+    S at the points below `onset_at_most` (all points if None), Gamma_mf sought above the
+    highest of them, up to twice the sweep's span beyond it. Raises NoOnset when the best
+    Gamma_mf is at the upper end (no divergence in sight) or the strength is not above twice
+    its error."""
     gamma = np.asarray(gamma, float)
-    y, sigma = _power_and_error(order, error)
+    y, sigma = _checked(power, error, "mode power")
     if gamma.shape != y.shape:
-        raise ValueError("one order parameter per acceleration")
+        raise ValueError("one mode power per acceleration")
     below = gamma < onset_at_most if onset_at_most is not None else np.ones(gamma.shape, bool)
     gamma, y, sigma = gamma[below], y[below], sigma[below]
     if gamma.size < 4:
@@ -163,7 +179,7 @@ def fit_swift_hohenberg(gamma, order, error, onset_at_most=None):
     candidates = np.linspace(top + 1e-3 * span, top + 2.0 * span, PROFILE_POINTS)
 
     def growth(c):
-        return 1.0 / np.sqrt((c - gamma) / c)
+        return c / (c - gamma)
 
     best, chi2 = _profile(growth, candidates, y, sigma)
     if best == candidates.size - 1:

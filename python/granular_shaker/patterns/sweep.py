@@ -48,8 +48,8 @@ import numpy as np
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                              grid_scale_gain, growth_bands, lower_edge)
 from granular_shaker.patterns.onset import (NoOnset, fit_onset, fit_swift_hohenberg, order_bracket,
-                                            ordered_run, rising_branch)
-from granular_shaker.patterns.views import column_mass_frames, run_view
+                                            ordered, ordered_run, rising_branch)
+from granular_shaker.patterns.views import column_mass_frames, phase_spectra, run_view
 from granular_shaker.reports.report_common import read_shaker_csv
 from granular_shaker.repository import (add_repository_option, fill_missing_paths,
                                         repository_argument)
@@ -308,19 +308,25 @@ def standard_error(values):
 
 
 def seeds_error(runs, name, error):
-    """The standard error of the mean over seeds of runs[i][name], given each run's own error
-    (its frames'): the seeds' spread, but never less than their own errors combined. Two seeds
-    give a spread of one degree of freedom, as often far too small as not; a seed's frames
-    bound the point's error from below, since each seed's mean carries its frames' noise."""
+    """The standard error of the mean over seeds of runs[i][name] (a number, or an array
+    element by element), given each run's own error (its frames'): the seeds' spread, but
+    never less than their own errors combined. Two seeds give a spread of one degree of
+    freedom, as often far too small as not; a seed's frames bound the point's error from
+    below, since each seed's mean carries its frames' noise."""
+    values = np.array([r[name] for r in runs], float)
+    errors = np.array([r.get(error, np.nan) for r in runs], float)
     if len(runs) == 1:
-        return float(runs[0].get(error, float("nan")))
-    own = np.sqrt(np.nansum(np.square([r.get(error, np.nan) for r in runs]))) / len(runs)
-    return float(max(standard_error([r[name] for r in runs]), own))
+        found = errors[0]
+    else:
+        own = np.sqrt(np.nansum(np.square(errors), axis=0)) / len(runs)
+        found = np.maximum(values.std(axis=0, ddof=1) / np.sqrt(len(runs)), own)
+    return float(found) if np.ndim(found) == 0 else found
 
 
 def point_summary(runs):
     """A point (case, Gamma) from its runs' summaries: the mean over seeds with its error
-    (seeds_error), and how many seeds show ordered waves (the wavelength is then theirs)."""
+    (seeds_error), and how many seeds show ordered waves (the wavelength is then theirs); with
+    the runs' spectra, the mean power of each mode at each phase they all store."""
     order = np.array([r["order"] for r in runs])
     point = dict(order=float(order.mean()), seeds=len(runs),
                  ordered_seeds=sum(ordered_run(r) for r in runs),
@@ -331,7 +337,43 @@ def point_summary(runs):
         point[name] = float(np.mean([r[name] for r in runs]))
     if 0 < point["ordered_seeds"] < len(runs):   # the stripes' wavelength, not the noise's
         point["wavelength"] = float(np.mean([r["wavelength"] for r in runs if ordered_run(r)]))
+    if all("spectra" in r for r in runs):
+        point.update(spectra_over_seeds([r["spectra"] for r in runs]))
     return point
+
+
+def spectra_over_seeds(spectra):
+    """The box length and, at each phase every run stores, the mean over the runs of each
+    mode's power with its error (seeds_error)."""
+    phases = set.intersection(*(set(s["power"]) for s in spectra))
+    out = dict(box_length=spectra[0]["box_length"], mode_power={}, mode_power_error={})
+    for phase in sorted(phases):
+        runs = [dict(power=s["power"][phase], error=s["power_error"][phase]) for s in spectra]
+        out["mode_power"][phase] = np.mean([r["power"] for r in runs], axis=0).tolist()
+        out["mode_power_error"][phase] = np.atleast_1d(
+            seeds_error(runs, "power", "error")).tolist()
+    return out
+
+
+def stripes_mode(points):
+    """(phase, mode) of the stripes at the first ordered point of the rising branch: the
+    box's Fourier mode nearest their wavenumber, at the stored phase where its power is the
+    larger; None without an ordered point or spectra."""
+    first = next((p for p in rising_branch(points) if ordered(p)), None)
+    if first is None or "mode_power" not in first:
+        return None
+    mode = int(round(first["box_length"] / first["wavelength"]))
+    phase = max(first["mode_power"], key=lambda ph: first["mode_power"][ph][mode - 1])
+    return phase, mode
+
+
+def critical_power(points, phase, mode):
+    """(gamma, power, error) of one mode at one phase, at the points that have it with an
+    error."""
+    found = [(p["gamma"], p["mode_power"][phase][mode - 1],
+              p["mode_power_error"][phase][mode - 1])
+             for p in points if phase in p.get("mode_power", {})]
+    return [np.array(column, float) for column in zip(*found)] if found else [np.array([])] * 3
 
 
 def check_against_bracket(onset, bracket):
@@ -375,12 +417,27 @@ def fits(points):
         if bracket is None:
             return out
         below = bracket[3]
-    try:
-        out["swift_hohenberg"] = dict(vars(fit_swift_hohenberg(gamma, order, error, below)),
-                                      below=float(below))
-    except (NoOnset, ValueError) as reason:
-        out["swift_hohenberg"] = dict(reason=str(reason), below=float(below))
+    out["swift_hohenberg"] = fit_critical_mode(points, below)
     return out
+
+
+def fit_critical_mode(points, below):
+    """The Swift-Hohenberg fit to the power of the stripes' mode (stripes_mode) at the points
+    below `below`, with that mode and phase; or the reason there is none."""
+    found = dict(below=float(below))
+    critical = stripes_mode(points)
+    if critical is None:
+        return dict(found, reason="no spectra at the first ordered point, whose stripes name "
+                    "the critical mode")
+    found.update(phase=critical[0], mode=critical[1])
+    gamma, power, error = critical_power(points, *critical)
+    usable = np.isfinite(error) & (error > 0)
+    try:
+        found.update(vars(fit_swift_hohenberg(gamma[usable], power[usable], error[usable],
+                                              below)))
+    except (NoOnset, ValueError) as reason:
+        found["reason"] = str(reason)
+    return found
 
 
 def growth_summary(frames):
@@ -473,6 +530,8 @@ def read_run(shaker, run):
         if frames is None:
             frames = column_mass_frames(run["record"]["path"])
         run["view"] = run_view(frames, "last" if growing else "all")
+        if run["solver"] == "md":
+            run["summary"]["spectra"] = phase_spectra(frames)
     except READ_ERRORS as error:
         return f"no top view or spectrum: {error}"
     return None

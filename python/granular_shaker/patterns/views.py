@@ -82,6 +82,16 @@ def spectrum_at(phase, power, which):
     return at.mean(axis=0), at.std(axis=0, ddof=1) / np.sqrt(len(at))
 
 
+def phase_spectra(frames):
+    """The box length and, at each stored phase, the mean power of each mode over the frames
+    at that phase with its standard error (spectrum_at): the structure factor along the box."""
+    cycle, phase, fields, (lx, ly) = frames
+    power = mode_power(fields)
+    spectra = {f"{p:g}": spectrum_at(phase, power, p) for p in np.unique(phase)}
+    return dict(box_length=lx, power={p: s[0] for p, s in spectra.items()},
+                power_error={p: s[1] for p, s in spectra.items()})
+
+
 def run_view(frames, which="all"):
     """The view of one run for the results file, from its column mass (column_mass_frames):
     the last complete cycle's fields at its phases (relative to their mean) and the spectrum

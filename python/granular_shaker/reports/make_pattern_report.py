@@ -18,7 +18,7 @@ import numpy as np
 from granular_shaker.patterns.growth import GRID_SCALE_CELLS, SIGNIFICANT_GROWTH
 from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, coexisting,
                                             order_bracket, ordered, rising_branch)
-from granular_shaker.patterns.sweep import CHECK_KEYS, CORRELATIONS
+from granular_shaker.patterns.sweep import CHECK_KEYS, CORRELATIONS, critical_power
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
@@ -36,8 +36,7 @@ def onset_curve(fit, gamma):
 
 
 def swift_hohenberg_curve(fit, gamma):
-    return np.sqrt(fit["floor"] + fit["strength"]
-                   / np.sqrt((fit["gamma_mf"] - gamma) / fit["gamma_mf"]))
+    return fit["floor"] + fit["strength"] * fit["gamma_mf"] / (fit["gamma_mf"] - gamma)
 
 
 def figure_order_parameter(cases):
@@ -58,15 +57,37 @@ def figure_order_parameter(cases):
             low, high = bracket[2:]
             ax.axvspan(low, high, color=drawn[0].get_color(), alpha=0.15,
                        label=f"{name}: onset of order between Gamma {low:g} and {high:g}")
-        if "gamma_mf" in case.get("swift_hohenberg", {}):
-            fit = case["swift_hohenberg"]
-            below = gamma[gamma < fit.get("below", fit["gamma_mf"])]   # the points fitted
+    ax.set_xlabel("plate acceleration Gamma [g]")
+    ax.set_ylabel("order parameter of the column mass [1/sigma^2]")
+    rc.legend_above(fig, columns=1)
+    return fig
+
+
+def critical_cases(cases):
+    """The MD cases whose Swift-Hohenberg fit names a critical mode."""
+    return {name: case for name, case in solver_cases(cases, "md").items()
+            if "mode" in case.get("swift_hohenberg", {})}
+
+
+def figure_critical_mode(cases):
+    """The power of each MD case's critical mode (its stripes' Fourier mode at their phase)
+    against Gamma, with the Swift-Hohenberg fit over the points below onset."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    for name, case in critical_cases(cases).items():
+        fit = case["swift_hohenberg"]
+        gamma, power, error = critical_power(case["points"], fit["phase"], fit["mode"])
+        drawn = ax.errorbar(gamma, power, yerr=error, label=f"MD {name}: mode {fit['mode']} at "
+                            f"phase {fit['phase']} (± standard error)", **rc.MD_STYLE)
+        if "gamma_mf" in fit:
+            below = gamma[gamma < fit["below"]]   # the points fitted
             fine = np.linspace(below.min(), below.max(), 200)
             ax.plot(fine, swift_hohenberg_curve(fit, fine), color=drawn[0].get_color(), lw=1,
                     ls="--", label=f"{name}: Swift-Hohenberg fit below onset, Gamma_mf = "
                     f"{fit['gamma_mf']:.3f}")
+    ax.set_yscale("log")
     ax.set_xlabel("plate acceleration Gamma [g]")
-    ax.set_ylabel("order parameter of the column mass [1/sigma^2]")
+    ax.set_ylabel("power of the critical mode, |c_m|^2 / |c_0|^2 [1]")
     rc.legend_above(fig, columns=1)
     return fig
 
@@ -833,8 +854,9 @@ def case_lines(name, case):
             continue
         if parameter in fit:
             strength = (f", noise power strength = {fit['strength']:.3g} ± "
-                        f"{fit['strength_error']:.2g} [1/sigma^4]" if key == "swift_hohenberg"
-                        else "")
+                        f"{fit['strength_error']:.2g} (mode {fit['mode']} at phase "
+                        f"{fit['phase']}, its power relative to the mean's)"
+                        if key == "swift_hohenberg" else "")
             lines.append(f"- {model}: {parameter} = {fit[parameter]:.4f} ± "
                          f"{fit[parameter + '_error']:.2g}{strength} (chi^2 per degree of "
                          f"freedom {fit['chi2_per_dof']:.3g}, {fit['points']} points)")
@@ -872,10 +894,16 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
              "own errors combined (two seeds' spread has one degree of freedom); one seed's "
              "are over its sampled frames, which consecutive cycles make optimistic. The onset "
              "is fitted to the pattern's power, M^2 = floor + slope max(Gamma - Gamma_c, 0); "
-             "below it the Swift-Hohenberg form floor + strength / sqrt((Gamma_mf - Gamma)/"
-             "Gamma_mf) (python/granular_shaker/patterns/onset.py, whose tests measure the bias "
-             "and coverage of both fits' errors).", "",
+             "below it the Swift-Hohenberg form floor + strength Gamma_mf / (Gamma_mf - Gamma) "
+             "to the power of the critical mode, the box's Fourier mode at the stripes' "
+             "wavenumber at the phase where they show (python/granular_shaker/patterns/"
+             "onset.py, whose tests measure the bias and coverage of both fits' errors).", "",
              f"![order parameter]({figures['order_parameter']})", ""]
+    if "critical_mode" in figures:
+        lines += ["The critical mode below and above the onset of order: below it the "
+                  "particles' noise stirs it, and in Swift-Hohenberg theory its power grows as "
+                  "1 / (Gamma_mf - Gamma) towards the mean-field onset:", "",
+                  f"![critical mode]({figures['critical_mode']})", ""]
     if continuum:
         lines += [f"The continuum: cases {', '.join(continuum['cases'])}; Gamma "
                   f"{continuum['gamma'][0]:g} to {continuum['gamma'][-1]:g} "
@@ -921,6 +949,8 @@ def write(results, repository, output):
     directory = os.path.join(os.path.dirname(os.path.abspath(output)), FIGURES)
     cases, continuum = results["cases"], solver_cases(results["cases"], "continuum")
     drawn = {"order_parameter": lambda: figure_order_parameter(cases)}
+    if critical_cases(cases):
+        drawn["critical_mode"] = lambda: figure_critical_mode(cases)
     if continuum:
         drawn["growth_rate"] = lambda: figure_growth_rate(continuum)
     if any("view" in p for case in cases.values() for p in case["points"]):

@@ -261,6 +261,16 @@ FIGURE_CASES = {
                             half_wavelength_correlation=c) for g, m, c in
                        zip((2.0, 2.1, 2.2, 2.4), (0.6, 0.7, 1.2, 1.8), (0.0, 0.2, 0.7, 0.8))],
             "onset": dict(reason="the best onset is at the end of the sweep")}})],
+    "make_pattern_report.figure_critical_mode": lambda i: [patterns.figure_critical_mode({
+        "pattern_md_f0p18": {"solver": "md", "points": [
+            dict(gamma=g, mode_power={"0": [1e-4] * 5 + [p]}, mode_power_error={"0": [1e-5] * 6})
+            for g, p in zip((1.9, 2.0, 2.1, 2.2, 2.4), (2e-4, 3e-4, 5e-4, 1e-2, 4e-2))],
+            "swift_hohenberg": dict(mode=6, phase="0", below=2.2, gamma_mf=2.2, floor=1e-4,
+                                    strength=2e-5)},
+        "pattern_md_f0p14": {"solver": "md", "points": [
+            dict(gamma=g, mode_power={"0": [1e-4] * 4 + [p]}, mode_power_error={"0": [1e-5] * 5})
+            for g, p in zip((1.9, 2.0, 2.2), (3e-4, 5e-2, 8e-2))],
+            "swift_hohenberg": dict(mode=5, phase="0", below=2.0, reason="too few points")}})],
     "make_pattern_report.figure_growth_rate": lambda i: [patterns.figure_growth_rate({
         "pattern_continuum_f0p18": {"points": [dict(gamma=g, rate=r, rate_error=0.02) for g, r in
                                                zip((2.2, 3.0, 3.8, 4.2), (-0.2, -0.1, 0.06, -0.1))],

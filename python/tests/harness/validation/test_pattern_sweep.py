@@ -73,6 +73,16 @@ def table(phase, order, correlation):
             "mass_half_wavelength_correlation": -np.array(correlation, float)}
 
 
+def with_critical_mode(point, power, mode=6, box_length=128.0):
+    """The point with spectra at phases 0 and 0.5: `power` in `mode` at phase 0 (10 % error),
+    every other mode and phase at a counting-noise floor of 1e-4."""
+    spectrum = [1e-4] * 16
+    spectrum[mode - 1] = power
+    return dict(point, box_length=box_length,
+                mode_power={"0": spectrum, "0.5": [1e-4] * 16},
+                mode_power_error={"0": [0.1 * v for v in spectrum], "0.5": [1e-5] * 16})
+
+
 def test_a_run_is_summarised_at_the_phase_of_the_larger_pattern():
     columns = table([0.0, 0.5, 0.0, 0.5, 0.0, 0.5], [0.1, 0.3, 0.2, 0.5, 0.3, 0.4],
                     [np.nan, np.nan, -0.9, -0.8, -1.0, -0.7])
@@ -490,7 +500,11 @@ def test_a_fitted_onset_outside_the_bracket_of_ordered_points_is_not_the_onset_o
                 (2.2, 1.201, 0.013, -0.70), (2.3, 1.693, 0.0044, -0.78),
                 (2.4, 1.839, 0.0099, -0.79), (2.6, 1.975, 0.018, -0.75),
                 (2.8, 2.029, 0.011, -0.72)]
-    points = [dict(gamma=g, order=m, order_error=e, a2=1.0, half_wavelength_correlation=-c)
+    # Their critical mode (6, the stripes' 21.3 sigma in the 128 sigma box) at the noise floor
+    # below 2.2 apart from a rise at 2.05: no divergence towards the onset.
+    points = [with_critical_mode(dict(gamma=g, order=m, order_error=e, a2=1.0,
+                                      half_wavelength_correlation=-c, wavelength=21.3),
+                                 1e-2 if g >= 2.2 else 3e-4 if g == 2.05 else 1e-4)
               for g, m, e, c in measured]
     gamma, order, error = (np.array(column) for column in list(zip(*measured))[:3])
     fitted = pattern_onset.fit_onset(gamma, order, error)
@@ -498,10 +512,10 @@ def test_a_fitted_onset_outside_the_bracket_of_ordered_points_is_not_the_onset_o
     found = sweep.fits(points)
     assert "gamma_c" not in found["onset"]
     assert "outside the sweep's bracket of ordered points, 2.1 to 2.2" in found["onset"]["reason"]
-    # The points below the bracket (1.9 to 2.1) do not diverge towards an onset: 2.1 lies below
-    # 2.05.
+    # The critical mode below the bracket (1.9 to 2.1) does not diverge towards an onset.
     assert found["swift_hohenberg"]["below"] == 2.2
-    assert "do not grow towards a mean-field onset" in found["swift_hohenberg"]["reason"]
+    assert (found["swift_hohenberg"]["mode"], found["swift_hohenberg"]["phase"]) == (6, "0")
+    assert "do not grow towards" in found["swift_hohenberg"]["reason"]
     # An onset inside the bracket stands: the supercritical form exact, onset 2.15.
     inside = [dict(p, order=float(np.sqrt(0.36 + 10.0 * max(p["gamma"] - 2.15, 0.0))))
               for p in points]
@@ -764,15 +778,16 @@ def test_a_grid_or_saturation_table_may_name_some_of_the_continuums_cases(work_d
 
 def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the_bracket(
         monkeypatch):
-    # Noise below the onset of order in the Swift-Hohenberg form towards Gamma_mf = 2.3, then
-    # ordered stripes from 2.2 whose amplitude the supercritical form cannot place.
-    gamma_mf, floor, strength = 2.3, 0.01, 0.05
-    noise = [np.sqrt(floor + strength / np.sqrt((gamma_mf - g) / gamma_mf))
-             for g in (1.8, 1.9, 2.0, 2.1)]
-    points = [dict(gamma=g, order=float(m), a2=1.0, half_wavelength_correlation=0.0)
-              for g, m in zip((1.8, 1.9, 2.0, 2.1), noise)]
-    points += [dict(gamma=g, order=1.5 + 0.1 * (g - 2.2), a2=1.0,
-                    half_wavelength_correlation=0.8) for g in (2.2, 2.4, 2.6, 2.8)]
+    # The critical mode's power below the onset of order in the Swift-Hohenberg form towards
+    # Gamma_mf = 2.3, then ordered stripes from 2.2 whose amplitude the supercritical form
+    # cannot place; the order parameter below onset flat (the counting noise of every mode).
+    gamma_mf, floor, strength = 2.3, 1e-4, 2e-5
+    points = [with_critical_mode(dict(gamma=g, order=0.6, a2=1.0, half_wavelength_correlation=0.0),
+                                 floor + strength * gamma_mf / (gamma_mf - g))
+              for g in (1.8, 1.9, 2.0, 2.1)]
+    points += [with_critical_mode(dict(gamma=g, order=1.5 + 0.1 * (g - 2.2), a2=1.0,
+                                       half_wavelength_correlation=0.8), 0.05)
+               for g in (2.2, 2.4, 2.6, 2.8)]
     for point in points:
         point.update(order_error=1e-3 * point["order"], seeds=1, wavelength=21.3)
 
@@ -785,16 +800,22 @@ def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the
     assert fit["points"] == 4  # 1.8 to 2.1: below the bracket's first ordered point, 2.2
     assert fit["gamma_mf"] == pytest.approx(gamma_mf, abs=2e-3)
     assert fit["strength"] == pytest.approx(strength, rel=0.02)
+    assert (fit["mode"], fit["phase"]) == (6, "0")
     lines = make_pattern_report.case_lines("pattern_md_f0p18", dict(points=points, **found))
     assert any(line.startswith("- Swift-Hohenberg fit below onset: gamma_mf = 2.30")
-               and "noise power strength = 0.05" in line for line in lines)
-    figure = make_pattern_report.figure_order_parameter(
+               and "noise power strength = 2e-05" in line and "mode 6 at phase 0" in line
+               for line in lines)
+    figure = make_pattern_report.figure_critical_mode(
         {"pattern_md_f0p18": dict(solver="md", points=points, **found)})
     curve = next(line for line in figure.axes[0].lines
                  if "Swift-Hohenberg fit below onset, Gamma_mf = 2.300" in line.get_label())
     assert curve.get_xdata().max() == pytest.approx(2.1)  # the highest point fitted
-    assert curve.get_ydata()[0] == pytest.approx(points[0]["order"], rel=1e-3)
+    assert curve.get_ydata()[0] == pytest.approx(points[0]["mode_power"]["0"][5], rel=1e-3)
     assert figure_rules.figure_problems(figure) == []
+    # Without spectra at the first ordered point no mode is critical: no fit, and why.
+    bare = [{k: v for k, v in p.items() if k != "mode_power"} for p in points]
+    assert "no spectra at the first ordered point" in sweep.fits(bare)["swift_hohenberg"][
+        "reason"]
     for point in points[:4]:  # one of them ordered: no bracket, no Swift-Hohenberg fit
         point["half_wavelength_correlation"] = 0.8 if point["gamma"] == 1.9 else 0.0
     assert "swift_hohenberg" not in sweep.fits(points)
