@@ -126,15 +126,20 @@ def check_grid(part, where):
 
 def check_extra(part, sweep, where):
     """ValueError naming what is wrong with a sweep's `extra` table: points of some MD cases at
-    accelerations the sweep lacks (below it for the Swift-Hohenberg fit, or near the onset)."""
-    require_keys(part, ("cases", "gamma", "timeout"), where)
-    gamma = part["gamma"]
-    if not gamma or sorted(set(gamma)) != list(gamma) or set(gamma) & set(sweep["gamma"]):
-        raise ValueError(f"{where}: gamma {gamma!r}: allowed: increasing, at least 1, none of "
-                         "the sweep's own")
-    unknown = set(part["cases"]) - set(sweep["cases"])
+    accelerations the sweep lacks (below it for the Swift-Hohenberg fit, or near the onset):
+    one list of Gamma for its cases, or a table of them by case."""
+    require_keys(part, ("gamma", "timeout"), where)
+    if not isinstance(part["gamma"], dict):
+        require_keys(part, ("cases",), where)
+    check_some_gamma(part, where)
+    cases = table_cases(sweep, part)
+    unknown = set(cases) - set(sweep["cases"])
     if unknown:
         raise ValueError(f"{where}: cases {sorted(unknown)} are not the sweep's")
+    for case in cases:
+        if set(gammas(part, case)) & set(sweep["gamma"]):
+            raise ValueError(f"{where}: gamma {gammas(part, case)!r}: allowed: none of the "
+                             "sweep's own")
 
 
 def check_scheme(part, where):

@@ -830,9 +830,13 @@ def test_an_extra_table_is_checked_and_its_points_planned_first_and_sorted_in():
     for bad, message in ((dict(good, gamma=[]), "at least 1"),
                          (dict(good, gamma=[1.9, 1.8]), "increasing"),
                          (dict(good, gamma=[1.8, 2.0]), "none of the sweep's own"),
-                         (dict(good, cases=["pattern_md_f0p10"]), "not the sweep's")):
+                         (dict(good, cases=["pattern_md_f0p10"]), "not the sweep's"),
+                         (dict(timeout=60, gamma={"pattern_md_f0p14": [2.2]}), "sweep's own"),
+                         (dict(timeout=60, gamma={"pattern_md_f0p10": [1.8]}), "not the sweep's")):
         with pytest.raises(ValueError, match=message):
             sweep.check_extra(bad, study, where)
+    with pytest.raises(ValueError, match="no 'cases'"):
+        sweep.check_extra(dict(timeout=60, gamma=[1.8]), study, where)
     with pytest.raises(ValueError, match="no 'timeout'"):
         sweep.check_extra({k: v for k, v in good.items() if k != "timeout"}, study, where)
     plan = sweep.plan_points(REPOSITORY, dict(study, extra=good))
@@ -850,6 +854,12 @@ def test_an_extra_table_is_checked_and_its_points_planned_first_and_sorted_in():
                               half_wavelength_correlation=0.9)
     gammas = [p["gamma"] for p in sweep.case_points(plan, "pattern_md_f0p18")]
     assert gammas == [1.8, 1.9, 2.0, 2.1, 2.15, 2.2, 2.3, 2.4]
+    # Gamma by case: each case's own extra points.
+    by_case = dict(timeout=60, gamma={"pattern_md_f0p18": [2.15], "pattern_md_f0p14": [1.8]})
+    sweep.check_extra(by_case, study, where)
+    plan = sweep.plan_points(REPOSITORY, dict(study, extra=by_case))
+    extra = [(r["case"], r["gamma"]) for r in plan[:4]]
+    assert extra == [("pattern_md_f0p18", 2.15)] * 2 + [("pattern_md_f0p14", 1.8)] * 2
 
 
 @pytest.mark.parametrize("name", ["full", "reduced", "bracket"])
@@ -858,10 +868,13 @@ def test_every_study_of_the_repository_loads_and_plans(name):
     plan = sweep.plan_points(REPOSITORY, study)
     md = [r for r in plan if r["solver"] == "md"]
     extra = study.get("extra", dict(cases=[], gamma=[]))
-    expected = (len(study["cases"]) * len(study["gamma"])
-                + len(extra["cases"]) * len(extra["gamma"])) * len(study["seeds"])
+    extra_points = {(case, g) for case in sweep.table_cases(study, extra)
+                    for g in sweep.gammas(extra, case)}
+    expected = (len(study["cases"]) * len(study["gamma"]) + len(extra_points)) \
+        * len(study["seeds"])
     assert len(md) == expected
-    assert {r["gamma"] for r in md} == set(study["gamma"]) | set(extra["gamma"])
+    assert {(r["case"], r["gamma"]) for r in md} == extra_points | {
+        (case, g) for case in study["cases"] for g in study["gamma"]}
 
 
 MD_CONFIG = """[run]
