@@ -707,16 +707,21 @@ def test_the_onsets_are_compared_at_each_frequency_both_solvers_ran():
     continuum = synthetic_continuum(2.3)                 # onset 2.3 +- 0.02
     continuum["scheme"] = [dict(limiter="minmod", gamma=3.0, rate=-0.05, rate_error=0.005,
                                 mode=5, fit_cycles=[5, 39], grid_scale_gain=0.01)]
-    cases = {"pattern_md_f0p18": md, "pattern_md_f0p14": dict(md),
-             "pattern_continuum_f0p18": continuum}
+    cases = {"pattern_md_f0p18": dict(md, swift_hohenberg=dict(gamma_mf=2.4, gamma_mf_error=0.1)),
+             "pattern_md_f0p14": dict(md), "pattern_continuum_f0p18": continuum}
     parameters = {"pattern_md_f0p18": (0.18, 5.0), "pattern_md_f0p14": (0.14, 5.0),
                   "pattern_continuum_f0p18": (0.18, 5.0)}
     lines = make_pattern_report.onset_ratio_lines(cases, parameters)
     rows = [line for line in lines if line.startswith("| 0.")]
     assert len(rows) == 1   # no continuum at f = 0.14
     ratio, error = 2.5 / 2.3, 2.5 / 2.3 * np.hypot(0.05 / 2.5, 0.02 / 2.3)
-    assert rows[0].startswith(f"| 0.18 | 2.5 ± 0.05 | 2.3 ± 0.02 | {ratio:.4g} ± {error:.2g} | "
+    mean_field, mean_field_error = 2.4 / 2.3, 2.4 / 2.3 * np.hypot(0.1 / 2.4, 0.02 / 2.3)
+    assert rows[0].startswith(f"| 0.18 | 2.5 ± 0.05 | 2.4 ± 0.1 | 2.3 ± 0.02 | {ratio:.4g} ± "
+                              f"{error:.2g} | {mean_field:.4g} ± {mean_field_error:.2g} | "
                               "another slope limiter reverses the growth at Gamma 3")
+    # Without a Swift-Hohenberg fit its columns are n/a.
+    bare = make_pattern_report.onset_ratio_lines(dict(cases, pattern_md_f0p18=md), parameters)
+    assert "| 0.18 | 2.5 ± 0.05 | n/a | 2.3 ± 0.02 |" in "\n".join(bare)
     assert make_pattern_report.onset_ratio_lines({"pattern_md_f0p18": md}, parameters) == []
 
 
