@@ -44,6 +44,7 @@ import sys
 import time
 
 import numpy as np
+from scipy.stats import chi2 as chi2_distribution
 
 from granular_shaker.patterns.growth import (NoGrowthFit, column_mass_modes, fastest_pattern_mode,
                                              grid_scale_gain, growth_bands, lower_edge)
@@ -66,6 +67,9 @@ CHECKPOINT_EVERY = 10
 # The continuum's slope limiters a scheme check may try (docs/configuration.md; `none` is for
 # smooth solutions only).
 LIMITERS = ("minmod", "van_leer", "mc", "first_order")
+# A supercritical fit whose chi^2 lies above this quantile of its distribution is rejected: the
+# odds that the form holds and the points' errors alone scatter them so far are 1 in 1000.
+REJECTED_QUANTILE = 0.999
 # The continuum's checks, each run again with one setting changed (the grid: the cell; the
 # scheme: the slope limiter), and the key that names that setting in its runs and points.
 CHECK_KEYS = {"grid": "cell", "scheme": "limiter"}
@@ -395,10 +399,23 @@ def check_against_bracket(onset, bracket):
                       f"points, {low:g} to {high:g}: it is not the onset of order")
 
 
+def check_goodness(onset):
+    """Raises NoOnset when the supercritical form is rejected by its own chi^2 (above the
+    chi^2 distribution's REJECTED_QUANTILE for its degrees of freedom): the order parameter
+    jumps at onset, and the fit's error, scaled by chi^2 per degree of freedom, only smears
+    the jump over the points around it."""
+    dof = onset.points - 3
+    if dof > 0 and onset.chi2_per_dof > chi2_distribution.ppf(REJECTED_QUANTILE, dof) / dof:
+        raise NoOnset(f"the supercritical form does not describe the points (chi^2 per degree "
+                      f"of freedom {onset.chi2_per_dof:.3g} for {dof}, above its "
+                      f"{REJECTED_QUANTILE} quantile): the order parameter jumps at onset")
+
+
 def fits(points):
     """The onset and Swift-Hohenberg fits of one case's points (the onset on the rising
     branch), or the reason there are none. The fitted onset stands only within the sweep's
-    bracket of ordered points (order_bracket), where there is one. The Swift-Hohenberg fit takes
+    bracket of ordered points (order_bracket), where there is one, and where its form is not
+    rejected by its chi^2 (check_goodness). The Swift-Hohenberg fit takes
     the points below the fitted onset (less its error), or where the onset fit cannot place it,
     those below the bracket's first ordered point."""
     rising = rising_branch(points)
@@ -415,6 +432,7 @@ def fits(points):
     try:
         onset = fit_onset(gamma, order, error)
         check_against_bracket(onset, bracket)
+        check_goodness(onset)
         out["onset"] = vars(onset)
         below = onset.gamma_c - onset.gamma_c_error
     except (NoOnset, ValueError) as reason:

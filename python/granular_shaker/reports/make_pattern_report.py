@@ -18,7 +18,8 @@ import numpy as np
 from granular_shaker.patterns.growth import GRID_SCALE_CELLS, SIGNIFICANT_GROWTH
 from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, coexisting,
                                             order_bracket, ordered, rising_branch)
-from granular_shaker.patterns.sweep import CHECK_KEYS, CORRELATIONS, critical_power
+from granular_shaker.patterns.sweep import (CHECK_KEYS, CORRELATIONS, critical_power, gammas,
+                                            table_cases)
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 
@@ -877,6 +878,15 @@ def case_lines(name, case):
     return lines + [""]
 
 
+def extra_points(sweep):
+    """The sweep's extra points (its `extra` table), by case, for the report's first lines."""
+    extra = sweep.get("extra")
+    if extra is None:
+        return ""
+    return "".join(f", {case} also at Gamma " + ", ".join(f"{g:g}" for g in gammas(extra, case))
+                   for case in table_cases(sweep, extra))
+
+
 def report_text(results, claims, figures, parameters=None, dispersion=None):
     """The report; `figures` maps order_parameter, growth_rate, top_views, spectra and
     wavelength to their paths (any but the first may be missing)."""
@@ -888,10 +898,8 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
              f"{results['commit'][:12]} (granular_shaker.patterns.sweep; design and definitions: "
              "docs/patterns.md). Cases "
              + ", ".join(sweep["cases"]) + f"; Gamma {sweep['gamma'][0]:g} to "
-             f"{sweep['gamma'][-1]:g} ({len(sweep['gamma'])} points)" + (
-                 f", and {', '.join(sweep['extra']['cases'])} also at Gamma "
-                 + ", ".join(f"{g:g}" for g in sweep["extra"]["gamma"])
-                 if "extra" in sweep else "") + "; seeds "
+             f"{sweep['gamma'][-1]:g} ({len(sweep['gamma'])} points)" + extra_points(sweep)
+             + "; seeds "
              + ", ".join(map(str, sweep["seeds"])) + "; overrides "
              + (", ".join(f"`{o}`" for o in sweep["overrides"]) or "none")
              + f". {len(runs)} runs of {sum(r['seconds'] for r in runs):.0f} s in all when they "

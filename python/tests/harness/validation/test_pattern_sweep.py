@@ -516,6 +516,23 @@ def test_a_fitted_onset_outside_the_bracket_of_ordered_points_is_not_the_onset_o
     assert found["swift_hohenberg"]["below"] == 2.2
     assert (found["swift_hohenberg"]["mode"], found["swift_hohenberg"]["phase"]) == (6, "0")
     assert "do not grow towards" in found["swift_hohenberg"]["reason"]
+    # The reduced study's two seeds, with Gamma 2.15 (disordered): the bracket is 2.15 to 2.2,
+    # and the fit's onset, its error scaled by a chi^2 per degree of freedom in the hundreds,
+    # reaches into it; the form is rejected by its chi^2 all the same, and the bracket stands.
+    reduced = [(1.9, 0.6209, 0.025, 0.03), (2.0, 0.6465, 0.028, 0.02),
+               (2.05, 0.7199, 0.036, 0.06), (2.1, 0.7049, 0.032, 0.11),
+               (2.15, 0.7449, 0.012, 0.11), (2.2, 1.225, 0.024, 0.67),
+               (2.3, 1.709, 0.015, 0.85), (2.4, 1.831, 0.0086, 0.88),
+               (2.6, 1.931, 0.044, 0.88), (2.8, 2.043, 0.013, 0.90)]
+    gamma, order, error = (np.array(column) for column in list(zip(*reduced))[:3])
+    fitted = pattern_onset.fit_onset(gamma, order, error)
+    assert fitted.gamma_c + fitted.gamma_c_error > 2.15 and fitted.chi2_per_dof > 100
+    found = sweep.fits([with_critical_mode(dict(gamma=g, order=m, order_error=e, a2=1.0,
+                                                half_wavelength_correlation=c, wavelength=21.3),
+                                           1e-2 if g >= 2.2 else 1e-4)
+                        for g, m, e, c in reduced])
+    assert "does not describe the points" in found["onset"]["reason"]
+    assert found["swift_hohenberg"]["below"] == 2.2
     # An onset inside the bracket stands: the supercritical form exact, onset 2.15.
     inside = [dict(p, order=float(np.sqrt(0.36 + 10.0 * max(p["gamma"] - 2.15, 0.0))))
               for p in points]
@@ -865,6 +882,12 @@ def test_an_extra_table_is_checked_and_its_points_planned_first_and_sorted_in():
     plan = sweep.plan_points(REPOSITORY, dict(study, extra=by_case))
     extra = [(r["case"], r["gamma"]) for r in plan[:4]]
     assert extra == [("pattern_md_f0p18", 2.15)] * 2 + [("pattern_md_f0p14", 1.8)] * 2
+    # The report names them, in either form.
+    assert make_pattern_report.extra_points(dict(study, extra=by_case)) == (
+        ", pattern_md_f0p18 also at Gamma 2.15, pattern_md_f0p14 also at Gamma 1.8")
+    assert make_pattern_report.extra_points(dict(study, extra=good)) == (
+        ", pattern_md_f0p18 also at Gamma 1.8, 1.9, 2.15")
+    assert make_pattern_report.extra_points(study) == ""
 
 
 @pytest.mark.parametrize("name", ["full", "reduced", "bracket"])
