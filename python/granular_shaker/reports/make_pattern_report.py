@@ -686,9 +686,22 @@ def figure_top_views(cases):
     return fig
 
 
+def md_spectrum(point):
+    """(power, error, what they are over) of an MD point's spectrum at its view's phase: the
+    mean over its seeds where the point has it, else its first seed's over its frames."""
+    view = point["view"]
+    phase = f"{view['spectrum_phase']:g}"
+    if phase in point.get("mode_power", {}):
+        return (np.array(point["mode_power"][phase], dtype=float),
+                np.array(point["mode_power_error"][phase], dtype=float),
+                f"{point.get('seeds', 1)} seeds of {view['frames']} frames")
+    return (np.array(view["power"], dtype=float), np.array(view["power_error"], dtype=float),
+            f"{view['frames']} frames")
+
+
 def figure_spectra(cases):
     """The power of the column mass's Fourier modes along x, below and above onset: the MD's
-    mean over its sampled frames with standard errors, the continuum's last frame."""
+    mean over its seeds and sampled frames with standard errors, the continuum's last frame."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
     for solver in ("md", "continuum"):
@@ -702,9 +715,10 @@ def figure_spectra(cases):
             modes = np.arange(1, len(view["power"]) + 1)
             power = np.array(view["power"], dtype=float)
             if solver == "md":
-                ax.errorbar(modes, power, yerr=np.array(view["power_error"], dtype=float),
-                            label=f"MD {name}, Gamma {point['gamma']:g} ({where}; "
-                                  f"{view['frames']} frames, ± standard error)", **rc.MD_STYLE)
+                power, error, over = md_spectrum(point)
+                ax.errorbar(modes, power, yerr=error, label=f"MD {name}, Gamma "
+                            f"{point['gamma']:g} ({where}; {over}, ± standard error)",
+                            **rc.MD_STYLE)
             else:
                 ax.plot(modes, power, marker="s", ms=3, **rc.CONTINUUM_STYLE,
                         label=f"continuum {name}, Gamma {point['gamma']:g} ({where}; cycle "

@@ -237,6 +237,14 @@ def pattern_views():
                                             onset=dict(gamma_c=3.05, gamma_c_error=0.05))}
 
 
+def with_seed_spectra(cases):
+    """The MD points' spectra over two seeds at phase 0: their views' spectra, errors doubled."""
+    for point in cases["pattern_md_f0p18"]["points"]:
+        point.update(seeds=2, mode_power={"0": point["view"]["power"]},
+                     mode_power_error={"0": [2 * e for e in point["view"]["power_error"]]})
+    return cases
+
+
 FIGURE_CASES = {
     **{f"make_validation_report.{n}": validation_figures(n) for n in (
         "figure_profiles", "figure_single_shock", "figure_mach", "figure_mach_width",
@@ -281,7 +289,9 @@ FIGURE_CASES = {
     "make_pattern_report.figure_top_views": lambda i: [
         patterns.figure_top_views(pattern_views()),
         patterns.figure_top_views({"pattern_md_f0p18": pattern_views()["pattern_md_f0p18"]})],
-    "make_pattern_report.figure_spectra": lambda i: [patterns.figure_spectra(pattern_views())],
+    "make_pattern_report.figure_spectra": lambda i: [
+        patterns.figure_spectra(pattern_views()),
+        patterns.figure_spectra(with_seed_spectra(pattern_views()))],
     "make_pattern_report.figure_wavelength": lambda i: [patterns.figure_wavelength(
         pattern_views(), {"pattern_md_f0p18": (0.18, 5.0), "pattern_continuum_f0p18": (0.18, 5.0)},
         dict(offset=1.0, amplitude=1.1, exponent=1.32))],

@@ -834,6 +834,15 @@ def test_without_an_onset_fit_the_swift_hohenberg_fit_takes_the_points_below_the
     assert curve.get_xdata().max() == pytest.approx(2.1)  # the highest point fitted
     assert curve.get_ydata()[0] == pytest.approx(points[0]["mode_power"]["0"][5], rel=1e-3)
     assert figure_rules.figure_problems(figure) == []
+    # The spectra figure shows a point's mean over its seeds where it has one.
+    point = dict(points[0], view=dict(spectrum_phase=0.0, frames=10, power=[1.0] * 16,
+                                      power_error=[0.1] * 16), seeds=2)
+    power, error, over = make_pattern_report.md_spectrum(point)
+    assert power[5] == pytest.approx(points[0]["mode_power"]["0"][5]) and error[0] == 1e-5
+    assert over == "2 seeds of 10 frames"
+    power, error, over = make_pattern_report.md_spectrum(
+        {k: v for k, v in point.items() if k != "mode_power"})
+    assert list(power) == [1.0] * 16 and over == "10 frames"
     # Without spectra at the first ordered point no mode is critical: no fit, and why.
     bare = [{k: v for k, v in p.items() if k != "mode_power"} for p in points]
     assert "no spectra at the first ordered point" in sweep.fits(bare)["swift_hohenberg"][
