@@ -606,13 +606,16 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_no
                     reason = continuum_missing(claim, continuum) if "continuum not" in verdict \
                         else "the MD sweep does not measure it"
         elif claim["id"] == "P9":
-            strengths = {name: case.get("swift_hohenberg", {}).get("strength")
+            strengths = {name: onset_of(case, "swift_hohenberg", "strength")
                          for name, case in md.items()}
             if len(strengths) == 2 and None not in strengths.values():
                 low, high = (strengths[n] for n in sorted(
                     strengths, key=lambda n: parameters.get(n, (0.0, 0.0))[0]))
-                value = low / high
-                verdict = judge(value, claim)
+                ratio, error = ratio_with_error(low, high)
+                value = (f"{rc.fmt(ratio)} ± {rc.fmt(error, 2)} (strengths "
+                         f"{low[0]:.3g} ± {low[1]:.2g} at the lower frequency, {high[0]:.3g} ± "
+                         f"{high[1]:.2g} at the higher)")
+                verdict = judge(ratio, claim)
             else:
                 reason = "needs Swift-Hohenberg fits at both frequencies: " + "; ".join(
                     f"{n}: {c.get('swift_hohenberg', c.get('onset', {})).get('reason', 'fitted')}"

@@ -392,6 +392,19 @@ def test_the_continuum_parts_and_the_comparisons_are_judged():
     md_order = next(p["order"] for p in md["points"] if p["gamma"] == 2.8)
     assert rows["P5"]["verdict"] == ("pass" if not 0.8 <= md_order / 0.1 <= 1.25 else "fail")
     assert rows["P5"]["value"].startswith(f"{md_order / 0.1:.4g} ± ")
+    # P9: the lower frequency's Swift-Hohenberg strength over the higher's, below 1 to pass.
+    frequencies = {**parameters, "pattern_md_f0p14": (0.14, 5.0), "pattern_md_f0p18": (0.18, 5.0)}
+    assert "needs Swift-Hohenberg fits at both" in rows["P9"]["reason"]
+    for low, verdict in ((3e-6, "pass"), (9e-6, "fail")):
+        cases["pattern_md_f0p14"]["swift_hohenberg"] = dict(strength=low, strength_error=1e-6)
+        md["swift_hohenberg"].update(strength=6e-6, strength_error=2e-6)
+        p9 = next(row for row in make_pattern_report.claim_verdicts(
+            claims, cases, frequencies, relation) if row["id"] == "P9")
+        ratio = low / 6e-6
+        error = ratio * np.hypot(1e-6 / low, 2e-6 / 6e-6)
+        assert p9["verdict"] == verdict
+        assert p9["value"].startswith(f"{ratio:.4g} ± {error:.2g} (strengths {low:.3g} ± 1e-06 "
+                                      "at the lower frequency, 6e-06 ± 2e-06 at the higher)")
     saturated["order"] = md_order  # the same amplitude in both: P5 fails
     rows = {row["id"]: row for row in make_pattern_report.claim_verdicts(
         claims, cases, {**parameters, "pattern_md_f0p14": (0.14, 5.0),
