@@ -969,7 +969,8 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
         lines.append(f"| {row['id']} ({row['status']}) | {row['statement']} | {row['value']} | "
                      f"{row['verdict']} | {row['reason']} |")
     if results["failures"]:
-        lines += ["", "## Runs that failed", ""] + [f"- {f}" for f in results["failures"]]
+        lines += ["", "## Runs that failed or are not made yet", ""] + [
+            f"- {f}" for f in results["failures"]]
     return "\n".join(lines) + "\n"
 
 
