@@ -652,22 +652,39 @@ def shown_points(case):
     return (below[-1] if below else None), above
 
 
-def first_case(cases, solver):
-    """The first case of a solver whose points carry views, or (None, None)."""
-    for name, case in solver_cases(cases, solver).items():
-        if any("view" in p for p in case["points"]):
-            return name, case
-    return None, None
+def shown_cases(cases, parameters=None):
+    """{solver: (name, case)} of the cases whose views the figures show, among those whose
+    points carry views: the first continuum case whose growth no check puts in doubt (else the
+    first), and the MD case at that continuum case's drive frequency (else the first)."""
+    parameters = parameters or {}
+    with_views = {solver: {name: case for name, case in solver_cases(cases, solver).items()
+                           if any("view" in p for p in case["points"])}
+                  for solver in ("md", "continuum")}
+    continuum = with_views["continuum"]
+    trusted = [name for name, case in continuum.items() if not caveats(case, True)]
+    shown = {}
+    if continuum:
+        name = (trusted or list(continuum))[0]
+        shown["continuum"] = (name, continuum[name])
+    frequency = parameters.get(shown.get("continuum", ("",))[0], (None,))[0]
+    md = with_views["md"]
+    same = [name for name in md if frequency is not None
+            and parameters.get(name, (None,))[0] == frequency]
+    if md:
+        name = (same or list(md))[0]
+        shown["md"] = (name, md[name])
+    return shown
 
 
-def figure_top_views(cases):
+def figure_top_views(cases, parameters=None):
     """The column mass seen from above at the stored phases of one cycle, relative to its
-    mean (column mass / mean - 1), at a point above onset of the first MD and the first
-    continuum case."""
+    mean (column mass / mean - 1), at a point above onset of the MD and the continuum case
+    shown (shown_cases)."""
     import matplotlib.pyplot as plt
     rows = []
+    shown = shown_cases(cases, parameters)
     for solver in ("md", "continuum"):
-        name, case = first_case(cases, solver)
+        name, case = shown.get(solver, (None, None))
         point = shown_points(case)[1] if case else None
         if point is not None:
             rows += [(solver, name, point, phase) for phase in point["view"]["fields"]]
@@ -702,13 +719,15 @@ def md_spectrum(point):
             f"{view['frames']} frames")
 
 
-def figure_spectra(cases):
-    """The power of the column mass's Fourier modes along x, below and above onset: the MD's
-    mean over its seeds and sampled frames with standard errors, the continuum's last frame."""
+def figure_spectra(cases, parameters=None):
+    """The power of the column mass's Fourier modes along x, below and above onset, of the
+    cases shown (shown_cases): the MD's mean over its seeds and sampled frames with standard
+    errors, the continuum's last frame."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    shown = shown_cases(cases, parameters)
     for solver in ("md", "continuum"):
-        name, case = first_case(cases, solver)
+        name, case = shown.get(solver, (None, None))
         if case is None:
             continue
         for where, point in zip(("below onset", "above onset"), shown_points(case)):
@@ -951,7 +970,9 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
         lines += ["The layer seen from above at the stored phases of one cycle (its column mass "
                   "relative to the mean; the MD's last sampled cycle, the continuum's last "
                   "cycle), above each solver's onset, and the spectra of the column mass along "
-                  "the box below and above it (python/granular_shaker/patterns/views.py):", "",
+                  "the box below and above it (python/granular_shaker/patterns/views.py); the "
+                  "continuum case shown is one whose growth its grid and scheme checks keep, "
+                  "where there is one, and the MD case its drive frequency's:", "",
                   f"![top views]({figures['top_views']})", "",
                   f"![spectra]({figures['spectra']})", ""]
     if "wavelength" in figures:
@@ -987,8 +1008,8 @@ def write(results, repository, output):
     if continuum:
         drawn["growth_rate"] = lambda: figure_growth_rate(continuum)
     if any("view" in p for case in cases.values() for p in case["points"]):
-        drawn["top_views"] = lambda: figure_top_views(cases)
-        drawn["spectra"] = lambda: figure_spectra(cases)
+        drawn["top_views"] = lambda: figure_top_views(cases, parameters)
+        drawn["spectra"] = lambda: figure_spectra(cases, parameters)
     if dispersion is not None:
         drawn["wavelength"] = lambda: figure_wavelength(cases, parameters, dispersion)
     figures = {key: f"{FIGURES}/" + rc.write_figure(draw(), directory, f"{key}.png")

@@ -732,6 +732,32 @@ def test_a_scheme_table_is_checked_planned_and_a_reversed_growth_is_noted():
     assert "Scheme check (the same run with other slope limiters at the sweep's cell):" in lines
 
 
+def test_the_figures_show_the_continuum_case_its_checks_keep_and_the_md_case_at_its_frequency():
+    view = dict(view={})
+    doubted = synthetic_continuum(2.3)
+    doubted["grid"] = [dict(cell=0.5, gamma=p["gamma"], rate=-0.5, rate_error=0.01, mode=6,
+                            fit_cycles=[5, 39], grid_scale_gain=0.01)
+                       for p in doubted["points"] if p["rate"] > 0]
+    kept = synthetic_continuum(2.1)
+    for case in (doubted, kept):
+        case["points"][0].update(view)
+    md_high, md_low = (dict(synthetic_case(w, 2.5), solver="md") for w in (21.3, 25.6))
+    for case in (md_high, md_low):
+        case["points"][0].update(view)
+    cases = {"pattern_md_f0p18": md_high, "pattern_md_f0p14": md_low,
+             "pattern_continuum_f0p18": doubted, "pattern_continuum_f0p14": kept}
+    parameters = {"pattern_md_f0p18": (0.18, 5.0), "pattern_md_f0p14": (0.14, 5.0),
+                  "pattern_continuum_f0p18": (0.18, 5.0), "pattern_continuum_f0p14": (0.14, 5.0)}
+    assert make_pattern_report.caveats(doubted, True) and not make_pattern_report.caveats(kept)
+    shown = make_pattern_report.shown_cases(cases, parameters)
+    assert (shown["continuum"][0], shown["md"][0]) == ("pattern_continuum_f0p14",
+                                                       "pattern_md_f0p14")
+    # Without frequencies, or with every continuum case in doubt, the first of each.
+    shown = make_pattern_report.shown_cases(dict(cases, pattern_continuum_f0p14=doubted))
+    assert (shown["continuum"][0], shown["md"][0]) == ("pattern_continuum_f0p18",
+                                                       "pattern_md_f0p18")
+
+
 def test_the_onsets_are_compared_at_each_frequency_both_solvers_ran():
     md = dict(synthetic_case(21.3, 2.5), solver="md")   # onset 2.5 +- 0.05
     continuum = synthetic_continuum(2.3)                 # onset 2.3 +- 0.02
