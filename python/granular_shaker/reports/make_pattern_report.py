@@ -660,20 +660,15 @@ def shown_cases(cases, parameters=None):
     with_views = {solver: {name: case for name, case in solver_cases(cases, solver).items()
                            if any("view" in p for p in case["points"])}
                   for solver in ("md", "continuum")}
-    continuum = with_views["continuum"]
+    continuum, md = with_views["continuum"], with_views["md"]
     trusted = [name for name, case in continuum.items() if not caveats(case, True)]
-    shown = {}
-    if continuum:
-        name = (trusted or list(continuum))[0]
-        shown["continuum"] = (name, continuum[name])
-    frequency = parameters.get(shown.get("continuum", ("",))[0], (None,))[0]
-    md = with_views["md"]
+    chosen = (trusted or list(continuum) or [None])[0]
+    frequency = parameters.get(chosen, (None,))[0]
     same = [name for name in md if frequency is not None
             and parameters.get(name, (None,))[0] == frequency]
-    if md:
-        name = (same or list(md))[0]
-        shown["md"] = (name, md[name])
-    return shown
+    shown = {"continuum": chosen, "md": (same or list(md) or [None])[0]}
+    return {solver: (name, with_views[solver][name]) for solver, name in shown.items()
+            if name is not None}
 
 
 def figure_top_views(cases, parameters=None):
@@ -735,14 +730,14 @@ def figure_spectra(cases, parameters=None):
                 continue
             view = point["view"]
             modes = np.arange(1, len(view["power"]) + 1)
-            power = np.array(view["power"], dtype=float)
             if solver == "md":
                 power, error, over = md_spectrum(point)
                 ax.errorbar(modes, power, yerr=error, label=f"MD {name}, Gamma "
                             f"{point['gamma']:g} ({where}; {over}, ± standard error)",
                             **rc.MD_STYLE)
             else:
-                ax.plot(modes, power, marker="s", ms=3, **rc.CONTINUUM_STYLE,
+                ax.plot(modes, np.array(view["power"], dtype=float), marker="s", ms=3,
+                        **rc.CONTINUUM_STYLE,
                         label=f"continuum {name}, Gamma {point['gamma']:g} ({where}; cycle "
                               f"{view['cycle']:g})")
     ax.set_yscale("log")
