@@ -22,6 +22,8 @@ from granular_shaker.patterns.sweep import (CHECK_KEYS, CORRELATIONS, critical_p
                                             table_cases)
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
+from granular_shaker.validation import quantities
+from granular_shaker.validation.claims import worst_status
 
 CLAIMS = os.path.join("reference-data", "pattern-claims.toml")
 FIGURES = "patterns"  # beside the report
@@ -190,8 +192,17 @@ def stripes_above_onset_only(case):
     return not below and bool(above) and all(g in shown for g in above)
 
 
-def judge(value, claim):
+def judge(value, claim, error=None):
+    """A value's verdict against the claim's band. With its standard error, as the validation
+    report judges (validation.quantities): pass or fail only beyond DECISION_ERRORS errors of
+    the band's edge, unresolved within them; without one, by the value alone."""
     lo_hi = claim["band"]
+    if error is not None and claim["comparison"] == "outside":
+        # The margin of a value outside a band is its distance beyond the nearer edge.
+        distance = max(lo_hi[0] - value, value - lo_hi[1])
+        return quantities.verdict(quantities.margin("greater_than", [0.0], distance, error))
+    if error is not None:
+        return quantities.verdict(quantities.margin(claim["comparison"], lo_hi, value, error))
     if claim["comparison"] == "range":
         return "pass" if lo_hi[0] <= value <= lo_hi[1] else "fail"
     if claim["comparison"] == "greater_than":
@@ -230,7 +241,7 @@ def md_part(claim, md, parameters, dispersion):
         (a, da), (b, db) = wavelengths[low], wavelengths[high]
         ratio = a / b
         error = ratio * np.hypot(da / a, db / b)
-        return f"{rc.fmt(ratio)} ± {rc.fmt(error, 2)}", judge(ratio, claim)
+        return f"{rc.fmt(ratio)} ± {rc.fmt(error, 2)}", judge(ratio, claim, error)
     if claim["id"] == "P4" and dispersion is not None:
         values, verdicts = [], []
         for name in claim["cases"]:
@@ -239,9 +250,9 @@ def md_part(claim, md, parameters, dispersion):
                 (length, error), ratio = wavelengths[name], wavelengths[name][0] / expected
                 values.append(f"{name}: {rc.fmt(ratio)} ± {rc.fmt(error / expected, 2)} "
                               f"({rc.fmt(length)} against {rc.fmt(expected)} sigma)")
-                verdicts.append(judge(ratio, claim))
+                verdicts.append(judge(ratio, claim, error / expected))
         if values:
-            return "; ".join(values), "pass" if all(v == "pass" for v in verdicts) else "fail"
+            return "; ".join(values), worst_status(verdicts)
     return None
 
 
@@ -302,7 +313,7 @@ def continuum_part(claim, continuum, parameters, dispersion):
                           f"{rc.fmt(expected)})")
             verdicts.append(judge(ratio, claim))
         if values:
-            return "; ".join(values), "pass" if all(v == "pass" for v in verdicts) else "fail"
+            return "; ".join(values), worst_status(verdicts)
     return None
 
 
@@ -312,7 +323,7 @@ def combined(md, continuum):
         return None
     parts = [f"{who}: {part[0]}" for who, part in (("MD", md), ("continuum", continuum)) if part]
     if md and continuum:
-        verdict = "pass" if md[1] == continuum[1] == "pass" else "fail"
+        verdict = worst_status([md[1], continuum[1]])
     elif md:
         verdict = f"MD {md[1]}; continuum not measured"
     else:
@@ -340,7 +351,7 @@ def amplitude_ratio(claim, md, continuum):
                                     (theirs["order"], theirs["order_error"]))
     return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)} (MD {rc.fmt(mine['order'])}, continuum "
             f"{rc.fmt(theirs['order'])} saturated, at Gamma {mine['gamma']:g} [1/sigma^2])",
-            judge(value, claim)), ""
+            judge(value, claim, error)), ""
 
 
 def continuum_missing(claim, continuum):
@@ -399,10 +410,10 @@ def md_against_continuum(claim, md, continuum):
         error = value * mine["order_error"] / mine["order"]
         return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)} (MD {rc.fmt(mine['order'])} at Gamma "
                 f"{mine['gamma']:g}, continuum's last frame {rc.fmt(point['final_order'])} at "
-                f"Gamma {point['gamma']:g} [1/sigma^2])", judge(value, claim)), ""
+                f"Gamma {point['gamma']:g} [1/sigma^2])", judge(value, claim, error)), ""
     else:
         return None, f"claim {claim['id']} is not judged from the sweep"
-    return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)}", judge(value, claim)), ""
+    return (f"{rc.fmt(value)} ± {rc.fmt(error, 2)}", judge(value, claim, error)), ""
 
 
 def onset_ratio_lines(cases, parameters):
@@ -615,7 +626,7 @@ def claim_verdicts(claims, cases, parameters=None, dispersion=None, continuum_no
                 value = (f"{rc.fmt(ratio)} ± {rc.fmt(error, 2)} (strengths "
                          f"{low[0]:.3g} ± {low[1]:.2g} at the lower frequency, {high[0]:.3g} ± "
                          f"{high[1]:.2g} at the higher)")
-                verdict = judge(ratio, claim)
+                verdict = judge(ratio, claim, error)
             else:
                 reason = "needs Swift-Hohenberg fits at both frequencies: " + "; ".join(
                     f"{n}: {c.get('swift_hohenberg', c.get('onset', {})).get('reason', 'fitted')}"
