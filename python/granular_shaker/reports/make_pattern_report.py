@@ -196,22 +196,10 @@ def judge(value, claim, error=None):
     """A value's verdict against the claim's band. With its standard error, as the validation
     report judges (validation.quantities): pass or fail only beyond DECISION_ERRORS errors of
     the band's edge, unresolved within them; without one, by the value alone."""
-    lo_hi = claim["band"]
-    if error is not None and claim["comparison"] == "outside":
-        # The margin of a value outside a band is its distance beyond the nearer edge.
-        distance = max(lo_hi[0] - value, value - lo_hi[1])
-        return quantities.verdict(quantities.margin("greater_than", [0.0], distance, error))
-    if error is not None:
-        return quantities.verdict(quantities.margin(claim["comparison"], lo_hi, value, error))
-    if claim["comparison"] == "range":
-        return "pass" if lo_hi[0] <= value <= lo_hi[1] else "fail"
-    if claim["comparison"] == "greater_than":
-        return "pass" if value > lo_hi[0] else "fail"
-    if claim["comparison"] == "less_than":
-        return "pass" if value < lo_hi[0] else "fail"
-    if claim["comparison"] == "outside":
-        return "pass" if not lo_hi[0] <= value <= lo_hi[1] else "fail"
-    raise ValueError(f"claim {claim['id']}: comparison {claim['comparison']} not judged here")
+    if error is None:
+        return "pass" if quantities.check(claim["comparison"], claim["band"], value) else "fail"
+    return quantities.verdict(quantities.margin(claim["comparison"], claim["band"], value,
+                                                error))
 
 
 def no_onset_of_order(case):

@@ -421,6 +421,8 @@ def check(comparison, band, value):
         return finite(value) and value < band[0]
     if comparison == "greater_than":
         return finite(value) and value > band[0]
+    if comparison == "outside":
+        return finite(value) and not band[0] <= value <= band[1]
     if comparison == "strictly_increasing":
         return (len(value) >= 2 and all(finite(v) for v in value)
                 and all(b > a for a, b in zip(value, value[1:])))
@@ -454,6 +456,8 @@ def margin(comparison, band, value, error):
         return sigmas(band[0] - value, error)
     if comparison == "greater_than":
         return sigmas(value - band[0], error)
+    if comparison == "outside":
+        return sigmas(max(band[0] - value, value - band[1]), error)
     if comparison == "strictly_increasing":
         errors = error if isinstance(error, list) else [None] * len(value)
         if len(value) < 2:

@@ -1,7 +1,8 @@
 """ctest validation.verdicts: the verdict of a claim from its value and standard error
 (granular_shaker.validation.quantities: margin and verdict) on cases of known answer: a value
 well inside its band passes, one well outside fails, one within 2 standard errors of the band's
-edge is unresolved; a value without an error is judged on its value alone; an ordering is judged on
+edge is unresolved (for a band the value must lie outside, its distance beyond the
+nearer edge); a value without an error is judged on its value alone; an ordering is judged on
 its smallest step over that step's error; a per-phase list on the phases where it exists, if
 they are at least half."""
 import math
@@ -26,6 +27,11 @@ CASES = [
     ("less_than", [0.03], 0.0351, 0.0014, "fail"),
     ("greater_than", [10.0], 30.3, 1.1, "pass"),
     ("greater_than", [1.0], 0.53, 0.025, "fail"),
+    ("outside", [0.8, 1.25], 2.3, 0.03, "pass"),
+    ("outside", [0.8, 1.25], 0.75, 0.03, "unresolved"),
+    ("outside", [0.8, 1.25], 1.0, 0.03, "fail"),
+    ("outside", [0.8, 1.25], 1.3, None, "pass"),
+    ("outside", [0.8, 1.25], NAN, 0.03, "fail"),
     ("strictly_increasing", [], [1.0, 2.0, 3.0], [0.1, 0.1, 0.1], "pass"),
     ("strictly_increasing", [], [3.49, 4.0, 5.2], [0.21, 0.29, 0.31], "unresolved"),
     ("strictly_increasing", [], [2.0, 1.0], [0.1, 0.1], "fail"),
