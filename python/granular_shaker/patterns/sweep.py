@@ -129,9 +129,10 @@ def check_grid(part, where):
 
 
 def check_extra(part, sweep, where):
-    """ValueError naming what is wrong with a sweep's `extra` table: points of some MD cases at
-    accelerations the sweep lacks (below it for the Swift-Hohenberg fit, or near the onset):
-    one list of Gamma for its cases, or a table of them by case."""
+    """ValueError naming what is wrong with one of a sweep's `extra` tables: points of some MD
+    cases at accelerations the sweep lacks (below it for the Swift-Hohenberg fit, or near the
+    onset): one list of Gamma for its cases, or a table of them by case; optionally overrides
+    of its own, which replace the sweep's of the same key."""
     require_keys(part, ("gamma", "timeout"), where)
     if not isinstance(part["gamma"], dict):
         require_keys(part, ("cases",), where)
@@ -144,6 +145,37 @@ def check_extra(part, sweep, where):
         if set(gammas(part, case)) & set(sweep["gamma"]):
             raise ValueError(f"{where}: gamma {gammas(part, case)!r}: allowed: none of the "
                              "sweep's own")
+    for override in part.get("overrides", []):
+        if not isinstance(override, str) or "=" not in override:
+            raise ValueError(f"{where}: overrides: {override!r}: allowed: 'key=value' strings, "
+                             "as --set takes them")
+
+
+def extra_tables(sweep):
+    """The sweep's `extra` tables: none, one ([study.x.extra]) or several ([[study.x.extra]],
+    each with its own Gamma and overrides)."""
+    extra = sweep.get("extra", [])
+    return [extra] if isinstance(extra, dict) else list(extra)
+
+
+def check_extra_tables(sweep, where):
+    """ValueError naming what is wrong with the sweep's `extra` tables, each on its own and
+    together: no point (case, Gamma) in two of them."""
+    seen = set()
+    for number, table in enumerate(extra_tables(sweep)):
+        at = where if isinstance(sweep["extra"], dict) else f"{where} (table {number + 1})"
+        check_extra(table, sweep, at)
+        points = {(case, g) for case in table_cases(sweep, table) for g in gammas(table, case)}
+        if points & seen:
+            raise ValueError(f"{at}: points {sorted(points & seen)} are in an earlier extra "
+                             "table too")
+        seen |= points
+
+
+def merged_overrides(base, more):
+    """`base` --set values with those of `more` in place of any of the same key."""
+    keys = {o.split("=", 1)[0].strip() for o in more}
+    return [o for o in base if o.split("=", 1)[0].strip() not in keys] + list(more)
 
 
 def check_scheme(part, where):
@@ -180,7 +212,7 @@ def load_sweep(repository, name):
     sweep = studies[name]
     check_part(repository, sweep, f"{SWEEP_FILE} [study.{name}]")
     if "extra" in sweep:
-        check_extra(sweep["extra"], sweep, f"{SWEEP_FILE} [study.{name}.extra]")
+        check_extra_tables(sweep, f"{SWEEP_FILE} [study.{name}.extra]")
     if "continuum" in sweep:
         check_part(repository, sweep["continuum"], f"{SWEEP_FILE} [study.{name}.continuum]")
         if "saturation" in sweep["continuum"]:
@@ -229,13 +261,16 @@ def gammas(part, case):
 
 def plan_points(repository, sweep):
     """One run per solver, case, Gamma and seed, in the run dicts of the validation study (the
-    MD's points of the `extra` table first); the continuum's saturation runs (kind
-    "saturation"), grid-check runs (kind "grid", one per cell, key "cell") and scheme-check
-    runs (kind "scheme", one per limiter, key "limiter") after its growth runs."""
+    MD's points of the `extra` tables first, with their own overrides); the continuum's
+    saturation runs (kind "saturation"), grid-check runs (kind "grid", one per cell, key
+    "cell") and scheme-check runs (kind "scheme", one per limiter, key "limiter") after its
+    growth runs."""
     parts = [(solver, part, [], "sweep", {}) for solver, part in solver_parts(sweep)]
-    if "extra" in sweep:
-        # Below onset the dense, cold layer makes these the longest runs: they go first.
-        parts.insert(0, ("md", dict(sweep, **within(sweep, sweep["extra"])), [], "sweep", {}))
+    # Below onset the dense, cold layer makes these the longest runs: they go first.
+    parts[:0] = [("md", dict(sweep, **within(sweep, table),
+                             overrides=merged_overrides(sweep["overrides"],
+                                                        table.get("overrides", []))),
+                  [], "sweep", {}) for table in extra_tables(sweep)]
     continuum = sweep.get("continuum") or {}
     if "saturation" in continuum:
         saturation = continuum["saturation"]

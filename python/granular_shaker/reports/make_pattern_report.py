@@ -18,8 +18,8 @@ import numpy as np
 from granular_shaker.patterns.growth import GRID_SCALE_CELLS, SIGNIFICANT_GROWTH
 from granular_shaker.patterns.onset import (STRIPES_A2, SUBHARMONIC_CORRELATION, coexisting,
                                             order_bracket, ordered, rising_branch)
-from granular_shaker.patterns.sweep import (CHECK_KEYS, CORRELATIONS, critical_power, gammas,
-                                            table_cases)
+from granular_shaker.patterns.sweep import (CHECK_KEYS, CORRELATIONS, critical_power,
+                                            extra_tables, gammas, table_cases)
 from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 from granular_shaker.validation import quantities
@@ -909,12 +909,15 @@ def case_lines(name, case):
 
 
 def extra_points(sweep):
-    """The sweep's extra points (its `extra` table), by case, for the report's first lines."""
-    extra = sweep.get("extra")
-    if extra is None:
-        return ""
-    return "".join(f", {case} also at Gamma " + ", ".join(f"{g:g}" for g in gammas(extra, case))
-                   for case in table_cases(sweep, extra))
+    """The sweep's extra points (its `extra` tables), by case, with any overrides of their own,
+    for the report's first lines."""
+    text = ""
+    for table in extra_tables(sweep):
+        own = ", ".join(f"`{o}`" for o in table.get("overrides", []))
+        text += "".join(f", {case} also at Gamma "
+                        + ", ".join(f"{g:g}" for g in gammas(table, case))
+                        + (f" (with {own})" if own else "") for case in table_cases(sweep, table))
+    return text
 
 
 def report_text(results, claims, figures, parameters=None, dispersion=None):

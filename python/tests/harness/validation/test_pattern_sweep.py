@@ -941,14 +941,47 @@ def test_an_extra_table_is_checked_and_its_points_planned_first_and_sorted_in():
     assert make_pattern_report.extra_points(study) == ""
 
 
+def test_several_extra_tables_each_with_its_own_overrides():
+    study = dict(cases=["pattern_md_f0p18", "pattern_md_f0p14"], gamma=[2.0, 2.1, 2.2, 2.3, 2.4],
+                 seeds=[1, 2], timeout=60,
+                 overrides=["run.transient_cycles=120", "run.sampled_cycles=10"])
+    far = dict(gamma={"pattern_md_f0p14": [1.8]}, timeout=14400,
+               overrides=["run.transient_cycles=40", "md.snapshot_cycles=[40, 41]"])
+    near = dict(gamma={"pattern_md_f0p14": [1.925, 1.95]}, timeout=7200)
+    where = "[study.x.extra]"
+    sweep.check_extra_tables(dict(study, extra=[far, near]), where)
+    for tables, message in (([far, dict(near, gamma={"pattern_md_f0p14": [1.8, 1.95]})],
+                             r"\(table 2\): points \[\('pattern_md_f0p14', 1.8\)\] are in an "
+                             "earlier extra table too"),
+                            ([dict(far, overrides=["run.transient_cycles"])],
+                             r"\(table 1\): overrides: 'run.transient_cycles': allowed: "
+                             "'key=value'"),
+                            ([dict(far, overrides=[40])], "overrides: 40: allowed")):
+        with pytest.raises(ValueError, match=message):
+            sweep.check_extra_tables(dict(study, extra=tables), where)
+    plan = sweep.plan_points(REPOSITORY, dict(study, extra=[far, near]))
+    assert len(plan) == 2 * 5 * 2 + 3 * 2
+    assert [(r["gamma"], r["seed"], r["timeout"]) for r in plan[:6]] == [
+        (1.8, 1, 14400), (1.8, 2, 14400), (1.925, 1, 7200), (1.925, 2, 7200),
+        (1.95, 1, 7200), (1.95, 2, 7200)]
+    # The table's own overrides replace the sweep's of the same key, the others stay.
+    assert plan[0]["overrides"] == ["shaker.gamma=1.8", "run.seed=1", "run.sampled_cycles=10",
+                                    "run.transient_cycles=40", "md.snapshot_cycles=[40, 41]"]
+    assert plan[2]["overrides"] == ["shaker.gamma=1.925", "run.seed=1",
+                                    "run.transient_cycles=120", "run.sampled_cycles=10"]
+    assert all(r["overrides"][2:] == study["overrides"] for r in plan[6:])
+    assert make_pattern_report.extra_points(dict(study, extra=[far, near])) == (
+        ", pattern_md_f0p14 also at Gamma 1.8 (with `run.transient_cycles=40`, "
+        "`md.snapshot_cycles=[40, 41]`), pattern_md_f0p14 also at Gamma 1.925, 1.95")
+
+
 @pytest.mark.parametrize("name", ["full", "reduced", "bracket"])
 def test_every_study_of_the_repository_loads_and_plans(name):
     study = sweep.load_sweep(REPOSITORY, name)
     plan = sweep.plan_points(REPOSITORY, study)
     md = [r for r in plan if r["solver"] == "md"]
-    extra = study.get("extra", dict(cases=[], gamma=[]))
-    extra_points = {(case, g) for case in sweep.table_cases(study, extra)
-                    for g in sweep.gammas(extra, case)}
+    extra_points = {(case, g) for extra in sweep.extra_tables(study)
+                    for case in sweep.table_cases(study, extra) for g in sweep.gammas(extra, case)}
     expected = (len(study["cases"]) * len(study["gamma"]) + len(extra_points)) \
         * len(study["seeds"])
     assert len(md) == expected
