@@ -5,6 +5,9 @@ reason where the sweep does not give the claim's quantity.
 
     shaker-pattern-report --results validation/work/patterns/patterns.json [--output FILE]
         [--repository DIR]
+
+The results go beside the report too (reports/patterns/results.json), so that a report can be
+drawn again from the repository alone.
 """
 import argparse
 import json
@@ -24,9 +27,13 @@ from granular_shaker.reports import report_common as rc
 from granular_shaker.repository import add_repository_option, repository_argument
 from granular_shaker.validation import quantities
 from granular_shaker.validation.claims import worst_status
+from granular_shaker.validation.summary import write_json_atomically
 
 CLAIMS = os.path.join("reference-data", "pattern-claims.toml")
 FIGURES = "patterns"  # beside the report
+# The sweep's results, kept with the figures: the report can be drawn again, and checked,
+# without the hours of runs behind it.
+RESULTS = "results.json"
 
 
 def solver_cases(cases, solver):
@@ -937,7 +944,10 @@ def report_text(results, claims, figures, parameters=None, dispersion=None):
              + (", ".join(f"`{o}`" for o in sweep["overrides"]) or "none")
              + f". {len(runs)} runs of {sum(r['seconds'] for r in runs):.0f} s in all when they "
              f"were made ({sum(r['reused'] for r in runs)} reused from earlier calls); this call "
-             f"took {results['seconds']:.0f} s.", "",
+             f"took {results['seconds']:.0f} s. Every number below is in "
+             f"[{FIGURES}/{RESULTS}]({FIGURES}/{RESULTS}), the sweep's results, from which "
+             f"`shaker-pattern-report --results {FIGURES}/{RESULTS}` draws this report again.",
+             "",
              "Errors are standard errors over independent seeds, never less than the seeds' "
              "own errors combined (two seeds' spread has one degree of freedom); one seed's "
              "are over its sampled frames, which consecutive cycles make optimistic. The onset "
@@ -1012,6 +1022,7 @@ def write(results, repository, output):
     figures = {key: f"{FIGURES}/" + rc.write_figure(draw(), directory, f"{key}.png")
                for key, draw in drawn.items()}
     text = report_text(results, reference["claim"], figures, parameters, dispersion)
+    write_json_atomically(os.path.join(directory, RESULTS), results)
     rc.write_text_atomically(output, text)
 
 

@@ -238,6 +238,14 @@ def test_a_small_sweep_runs_resumes_and_reports(work_dir, shaker):
     for claim in [f"P{i}" for i in range(1, 10)]:
         assert f"| {claim} (" in text
     assert ("ordered standing waves (A2" in text) != ("no ordered standing wave" in text)
+    # The results kept beside the report draw the same report again.
+    kept = os.path.join(work_dir, make_pattern_report.FIGURES, make_pattern_report.RESULTS)
+    with open(kept) as f:
+        assert json.load(f)["cases"] == second["cases"]
+    again = os.path.join(work_dir, "again.md")
+    assert make_pattern_report.main(["--results", kept, "--output", again,
+                                     "--repository", repository]) == 0
+    assert open(again).read() == text
     assert os.path.exists(os.path.join(work_dir, make_pattern_report.FIGURES,
                                        "order_parameter.png"))
 
